@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Install Debian's ROS 1 (ros_comm 1.15.15, Noetic) for /usr/bin/python3: the reference
+# implementation that minros's interoperability tests and benchmarks run against.
+# Idempotent; needs root (CI runs as root). See ../shared/spec/ros1-reference.md.
+set -euo pipefail
+if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
+PKGS="ros-core python3-rosmaster python3-roslaunch rosout
+  python3-rospy python3-rostopic python3-rosnode python3-rosparam python3-rosservice
+  python3-rosbag python3-rosmsg python3-genpy python3-genmsg
+  ros-std-msgs python3-std-msgs libstd-msgs-dev ros-std-srvs python3-std-srvs libstd-srvs-dev
+  ros-sensor-msgs python3-sensor-msgs libsensor-msgs-dev
+  ros-geometry-msgs python3-geometry-msgs libgeometry-msgs-dev
+  ros-nav-msgs python3-nav-msgs ros-actionlib-msgs python3-actionlib-msgs
+  ros-diagnostic-msgs python3-diagnostic-msgs ros-shape-msgs python3-shape-msgs
+  ros-stereo-msgs python3-stereo-msgs ros-trajectory-msgs python3-trajectory-msgs
+  ros-visualization-msgs python3-visualization-msgs ros-tf2-msgs python3-tf2-msgs
+  ros-roscpp-msg python3-roscpp-msg ros-rosgraph-msgs python3-rosgraph-msgs
+  python3-cv-bridge python3-numpy libroscpp-dev g++ pkg-config"
+if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msgs.msg, tf2_msgs.msg' 2>/dev/null \
+   && command -v rostopic >/dev/null && pkg-config --exists roscpp std_msgs; then
+  echo "ROS 1 reference already installed"
+  exit 0
+fi
+$SUDO apt-get update -q
+# shellcheck disable=SC2086
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $PKGS
+/usr/bin/python3 -c 'import rospy, rosmaster, genpy' && echo "ROS 1 reference installed"

@@ -1,0 +1,1 @@
+"""The ``minros`` command and its sub-commands; one module per tool."""

@@ -1,0 +1,122 @@
+"""``minros`` entry point: dispatches ``minros TOOL ...`` and the ROS-named aliases.
+
+Every tool is a module ``minros.cli.<module>`` exposing ``main(argv: list[str]) -> int``;
+its own argparse parser gives ``--help``. The ROS names (``roscore``, ``rostopic``, ...)
+are console scripts that call the same functions, so both spellings behave identically.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from typing import Callable, Dict, List, Optional, Tuple
+
+#: sub-command -> (module, one-line summary)
+COMMANDS: Dict[str, Tuple[str, str]] = {
+    "core": ("minros.cli.core", "run a ROS master with parameter server and rosout (roscore)"),
+    "run": ("minros.cli.run", "run an executable of a package (rosrun)"),
+    "launch": ("minros.cli.launch", "start nodes and parameters from a .launch file (roslaunch)"),
+    "topic": ("minros.cli.topic", "list, echo, publish and measure topics (rostopic)"),
+    "node": ("minros.cli.node", "list, inspect, ping and kill nodes (rosnode)"),
+    "param": ("minros.cli.param", "get, set, dump and load parameters (rosparam)"),
+    "service": ("minros.cli.service", "list, inspect and call services (rosservice)"),
+    "msg": ("minros.cli.msg", "show, hash and generate message types (rosmsg)"),
+    "srv": ("minros.cli.srv", "show and hash service types (rossrv)"),
+    "graph": ("minros.cli.graph", "draw the node/topic graph as DOT, SVG or PNG (rqt_graph)"),
+    "pkg": ("minros.cli.pkg", "find and list packages (rospack)"),
+    "ws": ("minros.cli.ws", "catkin workspaces: init, create_pkg, make"),
+}
+
+#: ROS command name -> (sub-command, arguments put before the user's)
+ALIASES: Dict[str, Tuple[str, List[str]]] = {
+    "roscore": ("core", []),
+    "rosrun": ("run", []),
+    "roslaunch": ("launch", []),
+    "rostopic": ("topic", []),
+    "rosnode": ("node", []),
+    "rosparam": ("param", []),
+    "rosservice": ("service", []),
+    "rosmsg": ("msg", []),
+    "rossrv": ("srv", []),
+    "rqt_graph": ("graph", []),
+    "rospack": ("pkg", []),
+    "catkin_init_workspace": ("ws", ["init"]),
+    "catkin_create_pkg": ("ws", ["create_pkg"]),
+    "catkin_make": ("ws", ["make"]),
+}
+
+
+def _usage() -> str:
+    width = max(len(name) for name in COMMANDS)
+    lines = ["usage: minros COMMAND [ARGS...]", "", "commands:"]
+    for name, (_module, summary) in COMMANDS.items():
+        lines.append(f"  {name.ljust(width)}  {summary}")
+    lines.append("")
+    lines.append("ROS names work too: " + ", ".join(sorted(ALIASES)))
+    lines.append("Run 'minros COMMAND --help' for the options of a command.")
+    return "\n".join(lines)
+
+
+def run(command: str, argv: List[str], prog: Optional[str] = None) -> int:
+    """Run sub-command ``command`` with ``argv``; returns the exit status."""
+    module_name, _summary = COMMANDS[command]
+    try:
+        module = importlib.import_module(module_name)
+    except ModuleNotFoundError as exc:
+        if exc.name != module_name:
+            raise
+        print(f"minros: '{command}' is not available in this version of minros", file=sys.stderr)
+        return 1
+    try:
+        return int(module.main(argv, prog=prog or f"minros {command}") or 0)
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        # `rostopic echo /x | head`: the reader went away; not an error worth a traceback.
+        try:
+            sys.stdout = None  # type: ignore[assignment]
+        finally:
+            return 0
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args or args[0] in ("-h", "--help", "help"):
+        print(_usage())
+        return 0
+    command, prefix = ALIASES.get(args[0], (args[0], []))
+    args[1:1] = prefix
+    if command not in COMMANDS:
+        print(f"minros: unknown command '{args[0]}'", file=sys.stderr)
+        print(_usage(), file=sys.stderr)
+        return 2
+    return run(command, args[1:])
+
+
+def _alias(ros_name: str) -> Callable[[], int]:
+    def entry() -> int:
+        command, prefix = ALIASES[ros_name]
+        return run(command, prefix + sys.argv[1:], prog=ros_name)
+
+    entry.__name__ = ros_name
+    return entry
+
+
+# Console-script targets, one per ROS command name (see pyproject.toml).
+roscore = _alias("roscore")
+rosrun = _alias("rosrun")
+roslaunch = _alias("roslaunch")
+rostopic = _alias("rostopic")
+rosnode = _alias("rosnode")
+rosparam = _alias("rosparam")
+rosservice = _alias("rosservice")
+rosmsg = _alias("rosmsg")
+rossrv = _alias("rossrv")
+rqt_graph = _alias("rqt_graph")
+rospack = _alias("rospack")
+catkin_init_workspace = _alias("catkin_init_workspace")
+catkin_create_pkg = _alias("catkin_create_pkg")
+catkin_make = _alias("catkin_make")
+
+if __name__ == "__main__":
+    sys.exit(main())

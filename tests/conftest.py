@@ -1,0 +1,69 @@
+"""Fixtures shared by every test directory; the machinery lives in tests/support.py."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from support import (  # noqa: E402
+    PYTHON,
+    REFERENCE_PYTHON,
+    Proc,
+    free_port,
+    reference_env,
+    require_reference,
+    ros_env,
+    wait_for_master,
+)
+
+
+@pytest.fixture
+def ros_home(tmp_path: Path) -> Path:
+    home = tmp_path / "ros_home"
+    (home / "log").mkdir(parents=True)
+    return home
+
+
+@pytest.fixture
+def debian_rosmaster(ros_home: Path):
+    """Debian's real ``rosmaster --core`` on a free port; yields the port."""
+    require_reference()
+    port = free_port()
+    env = reference_env(ros_env(port, ros_home))
+    proc = Proc(["/usr/bin/rosmaster", "--core", "-p", str(port)], env)
+    try:
+        wait_for_master(port)
+        yield port
+    finally:
+        proc.stop()
+
+
+@pytest.fixture
+def minros_master(ros_home: Path):
+    """minros's bare master (``python -m minros.master -p PORT``); yields the port."""
+    port = free_port()
+    proc = Proc([PYTHON, "-m", "minros.master", "-p", str(port)], ros_env(port, ros_home))
+    try:
+        wait_for_master(port)
+        yield port
+    finally:
+        proc.stop()
+
+
+@pytest.fixture
+def minros_core(ros_home: Path):
+    """``minros core -p PORT`` (master, roscore parameters and rosout); yields the port."""
+    port = free_port()
+    proc = Proc([PYTHON, "-m", "minros", "core", "-p", str(port)], ros_env(port, ros_home))
+    try:
+        wait_for_master(port)
+        yield port
+    finally:
+        proc.stop()
+
+
+__all__ = ["PYTHON", "REFERENCE_PYTHON", "Proc", "free_port", "reference_env", "ros_env"]

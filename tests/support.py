@@ -1,0 +1,185 @@
+"""Shared test machinery: free ports, ROS environments, process groups, the Debian reference.
+
+Processes are started in their own process group and stopped with SIGINT, then SIGTERM,
+then SIGKILL, each step bounded, so a test never leaves a node behind nor hangs CI.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+import xmlrpc.client
+from pathlib import Path
+from typing import Dict, List, Optional, Sequence
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+#: The interpreter that runs minros (the venv's).
+PYTHON = sys.executable
+#: The system interpreter that sees Debian's ROS 1.
+REFERENCE_PYTHON = "/usr/bin/python3"
+IN_CI = bool(os.environ.get("CI"))
+
+
+@functools.lru_cache(maxsize=None)
+def reference_available() -> bool:
+    """Whether Debian's ROS 1 (rospy, rosmaster, genpy, tools) is installed."""
+    if not os.path.exists(REFERENCE_PYTHON):
+        return False
+    probe = subprocess.run(
+        [REFERENCE_PYTHON, "-c", "import rospy, rosmaster, genpy, std_msgs.msg"],
+        env=reference_env({}),
+        capture_output=True,
+        timeout=60,
+    )
+    return probe.returncode == 0 and os.path.exists("/usr/bin/rostopic")
+
+
+def require_reference() -> None:
+    """Skip when the reference is absent locally; in CI its absence is a failure."""
+    if reference_available():
+        return
+    if IN_CI:
+        pytest.fail("Debian's ROS 1 reference is not installed (scripts/install-ros-reference.sh)")
+    pytest.skip("Debian's ROS 1 reference is not installed")
+
+
+def free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def ros_env(master_port: Optional[int], home: Path, extra: Optional[Dict[str, str]] = None) -> Dict[str, str]:
+    """Environment for a node on loopback talking to the master on ``master_port``."""
+    env = dict(os.environ)
+    for key in list(env):
+        if key.startswith("ROS_") or key == "PYTHONPATH":
+            del env[key]
+    if master_port is not None:
+        env["ROS_MASTER_URI"] = f"http://localhost:{master_port}"
+    env["ROS_HOSTNAME"] = "localhost"
+    env["ROS_HOME"] = str(home)
+    env["ROS_LOG_DIR"] = str(home / "log")
+    env["PYTHONUNBUFFERED"] = "1"
+    if extra:
+        env.update(extra)
+    return env
+
+
+def reference_env(env: Dict[str, str]) -> Dict[str, str]:
+    """``env`` made safe for Debian's ROS: no venv on PATH, no PYTHONPATH into minros."""
+    out = dict(env) if env else dict(os.environ)
+    out.pop("VIRTUAL_ENV", None)
+    out.pop("PYTHONPATH", None)
+    out.pop("PYTHONHOME", None)
+    out["PATH"] = "/usr/bin:/bin:/usr/sbin:/sbin"
+    return out
+
+
+class Proc:
+    """A subprocess in its own process group, with bounded, escalating shutdown."""
+
+    def __init__(self, argv: Sequence[str], env: Dict[str, str], cwd: Optional[Path] = None,
+                 stdin=subprocess.DEVNULL) -> None:
+        self.argv = list(argv)
+        self.popen = subprocess.Popen(
+            self.argv, env=env, cwd=cwd, stdin=stdin, stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT, start_new_session=True,
+        )
+        self._output: Optional[str] = None
+
+    @property
+    def pid(self) -> int:
+        return self.popen.pid
+
+    def alive(self) -> bool:
+        return self.popen.poll() is None
+
+    def stop(self, timeout: float = 5.0) -> str:
+        """Stop the whole process group (SIGINT, SIGTERM, SIGKILL); return its output."""
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
+            if self.popen.poll() is not None:
+                break
+            try:
+                os.killpg(self.popen.pid, sig)
+            except ProcessLookupError:
+                break
+            try:
+                self.popen.wait(timeout)
+            except subprocess.TimeoutExpired:
+                continue
+        try:  # children of the group that outlived the leader
+            os.killpg(self.popen.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        return self.output()
+
+    def output(self, timeout: float = 5.0) -> str:
+        if self._output is None:
+            try:
+                out, _ = self.popen.communicate(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                self.popen.kill()
+                out, _ = self.popen.communicate(timeout=timeout)
+            self._output = (out or b"").decode("utf-8", "replace")
+        return self._output
+
+    def read_until(self, needle: str, timeout: float) -> str:
+        """Read stdout lines until one contains ``needle``; fail after ``timeout`` seconds."""
+        import selectors
+
+        assert self.popen.stdout is not None
+        sel = selectors.DefaultSelector()
+        sel.register(self.popen.stdout, selectors.EVENT_READ)
+        seen: List[str] = []
+        deadline = time.monotonic() + timeout
+        try:
+            while time.monotonic() < deadline:
+                if not sel.select(timeout=max(0.0, deadline - time.monotonic())):
+                    continue
+                line = self.popen.stdout.readline()
+                if not line:
+                    break
+                text = line.decode("utf-8", "replace")
+                seen.append(text)
+                if needle in text:
+                    return "".join(seen)
+        finally:
+            sel.unregister(self.popen.stdout)
+        raise AssertionError(
+            f"{needle!r} not seen within {timeout}s from {self.argv}; output was:\n{''.join(seen)}")
+
+
+def wait_for_master(port: int, timeout: float = 15.0) -> None:
+    """Block until a master answers getPid on ``port``; fail after ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    last: Exception = TimeoutError()
+    while time.monotonic() < deadline:
+        try:
+            proxy = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{port}/")
+            code, _msg, _pid = proxy.getPid("/test")
+            if code == 1:
+                return
+        except (OSError, xmlrpc.client.Error) as exc:
+            last = exc
+        time.sleep(0.05)
+    raise AssertionError(f"no master answered on port {port} within {timeout}s: {last!r}")
+
+
+def wait_until(predicate, timeout: float, interval: float = 0.05, what: str = "condition"):
+    """Poll ``predicate`` until it returns a truthy value; fail after ``timeout`` seconds."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() >= deadline:
+            raise AssertionError(f"{what} not reached within {timeout}s")
+        time.sleep(interval)
