@@ -1,0 +1,1 @@
+"""catkin workspaces (init, create_pkg, make) and the executables minros ships with its packages."""

@@ -1,0 +1,168 @@
+"""Executables of the packages minros ships, and how rosrun/roslaunch find any executable.
+
+Real ROS installs a package's programs as files (``lib/<pkg>/talker.py``). minros ships its
+built-in nodes as Python modules instead, listed in :data:`BUILTIN_NODES`; they run as
+``python -m MODULE`` under minros's own interpreter. Everything else is searched in the
+package folder the way the ``rosrun`` script searches it (any depth, executable bit required,
+``build/`` skipped) plus the package's folders under ``<prefix>/lib/<pkg>`` of CMAKE_PREFIX_PATH.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import re
+import stat
+import sys
+from pathlib import Path
+from typing import Dict, List
+
+from minros import packages
+
+#: package -> executable name -> module run with ``python -m``. Turtlesim's modules are written
+#: separately (minros.turtlesim); a missing module is reported as "not available".
+BUILTIN_NODES: Dict[str, Dict[str, str]] = {
+    "rospy_tutorials": {
+        "talker.py": "minros.workspace.rospy_tutorials.talker",
+        "talker": "minros.workspace.rospy_tutorials.talker",
+        "listener.py": "minros.workspace.rospy_tutorials.listener",
+        "listener": "minros.workspace.rospy_tutorials.listener",
+        "add_two_ints_server": "minros.workspace.rospy_tutorials.add_two_ints_server",
+        "add_two_ints_client": "minros.workspace.rospy_tutorials.add_two_ints_client",
+    },
+    "turtlesim": {
+        "turtlesim_node": "minros.turtlesim.turtlesim_node",
+        "turtle_teleop_key": "minros.turtlesim.turtle_teleop_key",
+        "mimic": "minros.turtlesim.mimic",
+        "draw_square": "minros.turtlesim.draw_square",
+    },
+}
+
+# `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...
+_PYTHON_SHEBANG = re.compile(rb"^#!\s*(?:/usr/bin/env\s+(?:-S\s+)?)?(?:\S*/)?python[0-9.]*(\s|$)")
+
+
+class ExecutableError(Exception):
+    """rosrun/roslaunch could not resolve an executable; ``lines`` is what rosrun prints."""
+
+    def __init__(self, lines: List[str], exit_code: int, short: str) -> None:
+        super().__init__(short)
+        self.lines = lines
+        self.exit_code = exit_code
+        self.short = short
+
+
+def _is_executable_file(path: Path) -> bool:
+    try:
+        st = path.stat()
+    except OSError:
+        return False
+    return stat.S_ISREG(st.st_mode) and bool(st.st_mode & 0o111)
+
+
+def _libexec_dirs(pkg: str) -> List[Path]:
+    """``<prefix>/lib/<pkg>`` for every CMAKE_PREFIX_PATH entry (catkin's devel/install spaces)."""
+    dirs = []
+    for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
+        if prefix.strip():
+            candidate = Path(prefix) / "lib" / pkg
+            if candidate.is_dir():
+                dirs.append(candidate)
+    return dirs
+
+
+def _search(root: Path, name: str, skip_build: bool) -> List[Path]:
+    """Files called ``name`` below ``root`` (symlinks followed once, like ``find -L``)."""
+    found: List[Path] = []
+    seen = set()
+    for dirpath, dirnames, filenames in os.walk(root, followlinks=True):
+        try:
+            real = os.path.realpath(dirpath)
+        except OSError:
+            continue
+        if real in seen:  # a symlink loop
+            dirnames[:] = []
+            continue
+        seen.add(real)
+        if skip_build and Path(dirpath) == root:
+            dirnames[:] = [d for d in dirnames if d != "build"]
+        dirnames.sort()
+        for candidate in (name,):
+            if candidate in filenames or candidate in dirnames:
+                found.append(Path(dirpath) / candidate)
+    return found
+
+
+def builtin_module(pkg: str, executable: str) -> str | None:
+    """The module of a built-in node, or None."""
+    return BUILTIN_NODES.get(pkg, {}).get(executable)
+
+
+def _module_exists(module: str) -> bool:
+    try:
+        return importlib.util.find_spec(module) is not None
+    except ImportError:  # a parent package is missing
+        return False
+
+
+def command_for(path: Path) -> List[str]:
+    """argv prefix that runs ``path``: Python scripts run under minros's interpreter."""
+    try:
+        with open(path, "rb") as f:
+            first = f.readline(256)
+    except OSError:
+        first = b""
+    if _PYTHON_SHEBANG.match(first):
+        return [sys.executable, str(path)]
+    return [str(path)]
+
+
+def resolve_executable(pkg: str, executable: str) -> List[str]:
+    """The argv prefix that runs ``executable`` of package ``pkg``; raises ExecutableError."""
+    pkg_dir = packages.find_package(pkg)
+    module = builtin_module(pkg, executable)
+    if module and (pkg_dir is None or packages.is_builtin(pkg_dir)):
+        if not _module_exists(module):
+            raise ExecutableError(
+                [f"[rosrun] {executable} of package {pkg} is not available in this version of minros"],
+                3, f"{pkg}/{executable} is not available in this version of minros")
+        return [sys.executable, "-m", module]
+    if pkg_dir is None:
+        raise ExecutableError([f"[rospack] Error: package '{pkg}' not found"], 2,
+                              f"package '{pkg}' not found")
+    if executable.endswith("/"):
+        raise ExecutableError([f"Invalid filename:  {executable}"], 1, f"invalid filename {executable}")
+    if "/" in executable:
+        absname = pkg_dir / executable
+        if not _is_executable_file(absname):
+            raise ExecutableError([f"[rosrun] Couldn't find executable named {absname}"], 3,
+                                  f"couldn't find executable named {absname}")
+        return command_for(absname)
+    candidates: List[Path] = []
+    for root in _libexec_dirs(pkg) + [pkg_dir]:
+        candidates += [p for p in _search(root, executable, root == pkg_dir) if _is_executable_file(p)]
+    unique = list(dict.fromkeys(candidates))
+    if not unique:
+        lines = [f"[rosrun] Couldn't find executable named {executable} below {pkg_dir}"]
+        others = _search(pkg_dir, executable, skip_build=False)
+        if others:
+            lines.append("[rosrun] Found the following, but they're either not files,")
+            lines.append("[rosrun] or not executable:")
+            lines += [f"[rosrun]   {p}" for p in others]
+        raise ExecutableError(lines, 3, f"couldn't find executable named {executable} below {pkg_dir}")
+    if len(unique) > 1:
+        raise ExecutableError(
+            ["[rosrun] You have chosen a non-unique executable, please pick one of the following:"]
+            + [f"{i}) {p}" for i, p in enumerate(unique, 1)], 3,
+            f"non-unique executable {executable} in package {pkg}: " + ", ".join(map(str, unique)))
+    return command_for(unique[0])
+
+
+def child_environment(env: Dict[str, str] | None = None) -> Dict[str, str]:
+    """``env`` with minros's interpreter folder on PATH, so ``#!/usr/bin/env python`` finds it."""
+    out = dict(os.environ if env is None else env)
+    venv_bin = str(Path(sys.executable).absolute().parent)
+    path = out.get("PATH", "")
+    if venv_bin not in path.split(os.pathsep):
+        out["PATH"] = venv_bin + (os.pathsep + path if path else "")
+    return out
