@@ -1,0 +1,517 @@
+"""Node logging as rospy does it: the ``rosout`` Python logger, the console, and /rosout.
+
+``loginfo`` and friends log to the Python logger ``rosout`` (or ``rosout.<logger_name>``), so
+plain ``logging.getLogger('rosout')`` users get the same treatment. Two handlers hang off that
+logger:
+
+* the console handler (installed on import, so logging before ``init_node`` prints too) writes
+  one line per record in the ``ROSCONSOLE_FORMAT`` (default ``[${severity}] [${time}]:
+  ${message}``); DEBUG and INFO go to stdout, WARN and worse to stderr;
+* the /rosout handler (installed by ``init_node`` unless ``disable_rosout``) publishes a
+  ``rosgraph_msgs/Log`` per record.
+
+The console line itself is built by the pure function :func:`format_console_line`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import logging
+import os
+import sys
+import threading
+import time
+from typing import Any, Dict, Tuple
+
+__all__ = [
+    "DEBUG", "INFO", "WARN", "ERROR", "FATAL",
+    "logdebug", "loginfo", "logwarn", "logerr", "logerror", "logfatal", "logout",
+    "logdebug_throttle", "loginfo_throttle", "logwarn_throttle", "logerr_throttle",
+    "logfatal_throttle",
+    "logdebug_throttle_identical", "loginfo_throttle_identical", "logwarn_throttle_identical",
+    "logerr_throttle_identical", "logfatal_throttle_identical",
+    "logdebug_once", "loginfo_once", "logwarn_once", "logerr_once", "logfatal_once",
+    "format_console_line",
+]
+
+# rosgraph_msgs/Log levels (also rospy's level constants)
+DEBUG = 1
+INFO = 2
+WARN = 4
+ERROR = 8
+FATAL = 16
+
+#: rospy level -> Python logging level
+ROS_TO_LOGGING: Dict[int, int] = {
+    DEBUG: logging.DEBUG, INFO: logging.INFO, WARN: logging.WARNING,
+    ERROR: logging.ERROR, FATAL: logging.CRITICAL,
+}
+#: Python logging level -> rospy level
+LOGGING_TO_ROS: Dict[int, int] = {v: k for k, v in ROS_TO_LOGGING.items()}
+#: Python level name -> the severity word ROS prints, and its terminal colour
+_SEVERITY: Dict[str, Tuple[str, str | None]] = {
+    "DEBUG": ("DEBUG", "\033[32m"),
+    "INFO": ("INFO", None),
+    "WARNING": ("WARN", "\033[33m"),
+    "ERROR": ("ERROR", "\033[31m"),
+    "CRITICAL": ("FATAL", "\033[31m"),
+}
+_COLOR_RESET = "\033[0m"
+#: level names accepted by ~set_logger_level (upper-cased first)
+_NAME_TO_LOGGING = {"DEBUG": logging.DEBUG, "INFO": logging.INFO, "WARN": logging.WARNING,
+                    "ERROR": logging.ERROR, "FATAL": logging.CRITICAL}
+_LOGGING_TO_NAME = {logging.DEBUG: "debug", logging.INFO: "info", logging.WARNING: "warn",
+                    logging.ERROR: "error", logging.CRITICAL: "fatal", logging.NOTSET: "debug"}
+
+DEFAULT_FORMAT = "[${severity}] [${time}]: ${message}"
+ROSOUT_LOGGER = "rosout"
+
+
+# --------------------------------------------------------------------------- console
+
+def _expand_strftime_tag(text: str, tag: str, suffix: str) -> str:
+    """Replace every ``${tag:FORMAT}`` by ``time.strftime(FORMAT)`` (+ ``suffix``)."""
+    opener = "${" + tag + ":"
+    while opener in text:
+        start = text.index(opener)
+        end = text.find("}", start + len(opener))
+        if end < 0:  # unterminated tag: leave the rest alone rather than loop forever
+            break
+        fmt = text[start + len(opener):end]
+        text = text[:start] + time.strftime(fmt) + suffix + text[end + 1:]
+    return text
+
+
+def format_console_line(fmt: str, *, severity: str, message: str, wall_time: float,
+                        ros_time: float | None = None, node: str = "", logger: str = "",
+                        file: str = "", line: int = 0, function: str = "",
+                        thread: Any = "") -> str:
+    """One console line (without newline) for a log record, as rospy's console prints it.
+
+    ``fmt`` uses ROSCONSOLE_FORMAT tags: ``${severity} ${message} ${time} ${time:STRFTIME}
+    ${walltime} ${walltime:STRFTIME} ${node} ${logger} ${file} ${line} ${function} ${thread}``.
+    ``${time}`` is the wall time as ``%f``, followed by ``, <ros time>`` when the node runs on
+    simulated time (``ros_time`` given).
+    """
+    sim_suffix = "" if ros_time is None else f", {ros_time:f}"
+    out = fmt.replace("${severity}", severity)
+    out = out.replace("${message}", str(message))
+    out = out.replace("${walltime}", f"{wall_time:f}")
+    out = _expand_strftime_tag(out, "walltime", "")
+    out = out.replace("${thread}", str(thread))
+    out = out.replace("${logger}", str(logger))
+    out = out.replace("${file}", str(file))
+    out = out.replace("${line}", str(line))
+    out = out.replace("${function}", str(function))
+    out = out.replace("${node}", node)
+    out = out.replace("${time}", f"{wall_time:f}" + sim_suffix)
+    out = _expand_strftime_tag(out, "time", sim_suffix)
+    return out
+
+
+def _ros_time_or_none() -> float | None:
+    """The simulated time for the console's ``${time}``, or None on wall-clock time."""
+    from minros import rostime
+
+    if rostime.is_wallclock() or not rostime.is_rostime_initialized():
+        return None
+    return rostime.get_time()
+
+
+def _caller_id() -> str:
+    try:
+        from minros import node
+
+        return node.get_caller_id()
+    except (ImportError, AttributeError):
+        return "/unnamed"
+
+
+class ConsoleHandler(logging.Handler):
+    """Writes records in ROSCONSOLE_FORMAT: DEBUG/INFO to stdout, WARN and worse to stderr.
+
+    The streams are looked up per record (not captured at creation) so redirecting
+    ``sys.stdout`` later, as test runners do, is honoured.
+    """
+
+    _plain = logging.Formatter()
+
+    def __init__(self, colorize: bool = True, stdout=None, stderr=None) -> None:
+        super().__init__()
+        self._colorize = colorize
+        self._stdout = stdout
+        self._stderr = stderr
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            severity, color = _SEVERITY.get(record.levelname, (record.levelname, None))
+            line = format_console_line(
+                os.environ.get("ROSCONSOLE_FORMAT", DEFAULT_FORMAT),
+                severity=severity,
+                message=self._plain.format(record),
+                wall_time=time.time(),
+                ros_time=_ros_time_or_none(),
+                node=_caller_id(),
+                logger=record.name,
+                file=record.pathname,
+                line=record.lineno,
+                function=getattr(record, "ros_function", record.funcName),
+                thread=record.thread,
+            ) + "\n"
+            if record.levelno < logging.WARNING:
+                stream = self._stdout or sys.stdout
+            else:
+                stream = self._stderr or sys.stderr
+            if self._colorize and color and hasattr(stream, "isatty") and stream.isatty():
+                line = color + line + _COLOR_RESET
+            stream.write(line)
+            stream.flush()
+        except Exception:
+            self.handleError(record)
+
+
+def _install_console_handler() -> logging.Logger:
+    logger = logging.getLogger(ROSOUT_LOGGER)
+    if not any(isinstance(h, ConsoleHandler) for h in logger.handlers):
+        logger.addHandler(ConsoleHandler())
+    if logger.level == logging.NOTSET:  # rospy's logging config gives 'rosout' level INFO
+        logger.setLevel(logging.INFO)
+    return logger
+
+
+_install_console_handler()
+
+
+# --------------------------------------------------------------------------- /rosout
+
+class _RosoutState:
+    def __init__(self) -> None:
+        self.publisher = None
+        self.handler: RosoutHandler | None = None
+        self.services: list = []
+        self.local = threading.local()  # guards against logging from inside publish()
+
+
+_rosout = _RosoutState()
+
+
+def _node_topics() -> list:
+    """Names of the topics this node publishes or subscribes (the Log message's ``topics``)."""
+    try:
+        from minros import node
+
+        getter = getattr(node, "get_topics", None)
+        if getter is not None:
+            return sorted(getter())
+        # the node's registries: resolved topic name -> publication/subscription
+        topics = set(getattr(node, "_publications", {})) | set(getattr(node, "_subscriptions", {}))
+        return sorted(topics)
+    except ImportError:
+        return []
+
+
+class RosoutHandler(logging.Handler):
+    """Publishes every record as a rosgraph_msgs/Log on /rosout."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        publisher = _rosout.publisher
+        if publisher is None or getattr(_rosout.local, "busy", False):
+            return
+        _rosout.local.busy = True
+        try:
+            from rosgraph_msgs.msg import Log
+
+            from minros import rostime
+
+            try:
+                disable_topics = _get_param_cached("/rosout_disable_topics_generation", False)
+            except Exception:
+                disable_topics = False
+            log = Log(
+                level=LOGGING_TO_ROS.get(record.levelno, INFO),
+                name=_caller_id(),
+                msg=str(self.format(record)),
+                file=record.filename,
+                function=getattr(record, "ros_function", record.funcName),
+                line=record.lineno,
+                topics=[] if disable_topics else _node_topics(),
+            )
+            try:
+                log.header.stamp = rostime.get_rostime()
+            except Exception:  # time not initialised yet: stamp with the wall clock
+                log.header.stamp = rostime._wall_now()
+            publisher.publish(log)
+        except Exception:
+            # never let a broken /rosout break the caller; say so on the internal logger
+            logging.getLogger("rospy.rosout").debug("unable to report to /rosout", exc_info=True)
+        finally:
+            _rosout.local.busy = False
+
+
+def _get_param_cached(key: str, default: Any) -> Any:
+    from minros import params
+
+    return params.get_param_cached(key, default)
+
+
+def _get_loggers(_request):
+    from roscpp.msg import Logger
+    from roscpp.srv import GetLoggersResponse
+
+    response = GetLoggersResponse()
+    for name in list(logging.Logger.manager.loggerDict.keys()):
+        level = logging.getLogger(name).getEffectiveLevel()
+        response.loggers.append(Logger(name, _LOGGING_TO_NAME.get(level, "debug")))
+    return response
+
+
+def _set_logger_level(request):
+    from roscpp.srv import SetLoggerLevelResponse
+
+    level = request.level.upper()
+    if level in _NAME_TO_LOGGING:
+        logging.getLogger(request.logger).setLevel(_NAME_TO_LOGGING[level])
+    else:
+        logging.getLogger("rospy").error(f"Bad logging level: {level}")
+    return SetLoggerLevelResponse()
+
+
+def _start_node_logging(caller_id: str, log_level: int | None, disable_rosout: bool) -> None:
+    """Called by ``init_node``: level filter, /rosout publisher and the logger services."""
+    logger = _install_console_handler()
+    if log_level is not None:
+        logger.setLevel(ROS_TO_LOGGING.get(log_level, logging.INFO))
+    if not disable_rosout and _rosout.publisher is None:
+        from minros.topics import Publisher
+        from rosgraph_msgs.msg import Log
+
+        _rosout.publisher = Publisher("/rosout", Log, latch=True, queue_size=100)
+        _rosout.handler = RosoutHandler()
+        logger.addHandler(_rosout.handler)
+    if not _rosout.services:
+        from roscpp.srv import GetLoggers, SetLoggerLevel
+
+        from minros.services import Service
+
+        _rosout.services = [
+            Service("~get_loggers", GetLoggers, _get_loggers),
+            Service("~set_logger_level", SetLoggerLevel, _set_logger_level),
+        ]
+
+
+def _stop_node_logging() -> None:
+    """Undo ``_start_node_logging`` (node shutdown)."""
+    logger = logging.getLogger(ROSOUT_LOGGER)
+    if _rosout.handler is not None:
+        logger.removeHandler(_rosout.handler)
+        _rosout.handler = None
+    _rosout.publisher = None
+    _rosout.services = []
+
+
+# --------------------------------------------------------------------------- log functions
+
+_Key = Tuple[str, int, int]
+
+
+def _frame_key(frame) -> _Key:
+    """Identifies one call site: file, line and bytecode offset of the caller."""
+    return (frame.f_code.co_filename, frame.f_lineno, frame.f_lasti)
+
+
+def _now_for_throttle() -> float:
+    from minros import rostime
+
+    if rostime.is_rostime_initialized():
+        return rostime.get_time()
+    return time.time()  # before init_node: wall clock rather than an error
+
+
+class _Throttle:
+    """Lets a call site through at most once per ``period`` seconds of ROS time."""
+
+    def __init__(self) -> None:
+        self.last: Dict[_Key, float] = {}
+        self.lock = threading.Lock()
+
+    def __call__(self, key: _Key, period: float, now: float | None = None) -> bool:
+        now = _now_for_throttle() if now is None else now
+        with self.lock:
+            last = self.last.get(key)
+            if last is None or now - last > period:
+                self.last[key] = now
+                return True
+            if last > now:  # time jumped backwards: forget everything
+                self.last = {key: now}
+                return True
+            return False
+
+
+class _Identical:
+    """Lets a call site through only when its message differs from the previous one."""
+
+    def __init__(self) -> None:
+        self.last: Dict[_Key, str] = {}
+        self.lock = threading.Lock()
+
+    def __call__(self, key: _Key, msg: Any) -> bool:
+        digest = hashlib.md5(str(msg).encode()).hexdigest()
+        with self.lock:
+            if self.last.get(key) != digest:
+                self.last[key] = digest
+                return True
+            return False
+
+
+class _Once:
+    def __init__(self) -> None:
+        self.seen: set = set()
+        self.lock = threading.Lock()
+
+    def __call__(self, key: _Key) -> bool:
+        with self.lock:
+            if key in self.seen:
+                return False
+            self.seen.add(key)
+            return True
+
+
+_throttle = _Throttle()
+_identical = _Identical()
+_once = _Once()
+
+
+def _user_frame():
+    """The frame that called the public log function (two levels above ``_base_logger``)."""
+    frame = inspect.currentframe()
+    # _user_frame <- _base_logger <- log* <- user
+    return frame.f_back.f_back.f_back  # type: ignore[union-attr]
+
+
+def _function_name(frame) -> str:
+    """``Class.method`` when the caller is a method (as rospy reports it), else the function."""
+    name = frame.f_code.co_name
+    owner = frame.f_locals.get("self")
+    if owner is not None:
+        name = f"{owner.__class__.__name__}.{name}"
+    return name
+
+
+def _base_logger(msg: Any, args: tuple, kwargs: dict, level: int, throttle: float | None = None,
+                 throttle_identical: bool = False, once: bool = False) -> None:
+    logger = logging.getLogger(ROSOUT_LOGGER)
+    name = kwargs.pop("logger_name", None)
+    if name:
+        logger = logger.getChild(name)
+    frame = _user_frame()
+    if once:
+        if not _once(_frame_key(frame)):
+            return
+    elif throttle_identical:
+        key = _frame_key(frame)
+        elapsed = throttle is not None and _throttle(key, throttle)
+        # both checks run so each keeps its own state up to date
+        if not _identical(key, msg) and not elapsed:
+            return
+    elif throttle:
+        if not _throttle(_frame_key(frame), throttle):
+            return
+    if not logger.isEnabledFor(level):
+        return
+    extra = kwargs.pop("extra", None) or {}
+    extra.setdefault("ros_function", _function_name(frame))
+    # stacklevel 3 skips _base_logger and log*, so file/line name the user's call site
+    logger.log(level, msg, *args, extra=extra, stacklevel=3, **kwargs)
+
+
+def logdebug(msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at DEBUG (shown only with ``log_level=rospy.DEBUG``)."""
+    _base_logger(msg, args, kwargs, logging.DEBUG)
+
+
+def loginfo(msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at INFO: stdout and /rosout."""
+    _base_logger(msg, args, kwargs, logging.INFO)
+
+
+def logwarn(msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at WARN: stderr and /rosout."""
+    _base_logger(msg, args, kwargs, logging.WARNING)
+
+
+def logerr(msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at ERROR: stderr and /rosout."""
+    _base_logger(msg, args, kwargs, logging.ERROR)
+
+
+def logfatal(msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at FATAL: stderr and /rosout."""
+    _base_logger(msg, args, kwargs, logging.CRITICAL)
+
+
+logout = loginfo  # rospy's deprecated name
+logerror = logerr
+
+
+def logdebug_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.DEBUG, throttle=period)
+
+
+def loginfo_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at INFO at most once per ``period`` seconds from this call site."""
+    _base_logger(msg, args, kwargs, logging.INFO, throttle=period)
+
+
+def logwarn_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.WARNING, throttle=period)
+
+
+def logerr_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.ERROR, throttle=period)
+
+
+def logfatal_throttle(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.CRITICAL, throttle=period)
+
+
+def logdebug_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.DEBUG, throttle=period, throttle_identical=True)
+
+
+def loginfo_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at INFO when the message changed, or at least ``period`` seconds went by."""
+    _base_logger(msg, args, kwargs, logging.INFO, throttle=period, throttle_identical=True)
+
+
+def logwarn_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.WARNING, throttle=period, throttle_identical=True)
+
+
+def logerr_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.ERROR, throttle=period, throttle_identical=True)
+
+
+def logfatal_throttle_identical(period: float, msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.CRITICAL, throttle=period, throttle_identical=True)
+
+
+def logdebug_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.DEBUG, once=True)
+
+
+def loginfo_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    """Log at INFO the first time this call site runs, never again."""
+    _base_logger(msg, args, kwargs, logging.INFO, once=True)
+
+
+def logwarn_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.WARNING, once=True)
+
+
+def logerr_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.ERROR, once=True)
+
+
+def logfatal_once(msg: Any, *args: Any, **kwargs: Any) -> None:
+    _base_logger(msg, args, kwargs, logging.CRITICAL, once=True)
