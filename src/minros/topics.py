@@ -1,0 +1,1039 @@
+"""Publisher and Subscriber: topic registration, TCPROS connections, queues and latching.
+
+Publishing serializes a message once and hands the same bytes to every subscriber
+connection. Each connection has a bounded queue (oldest dropped when full) drained by its own
+writer thread; when the queue is empty the publishing thread first tries a non-blocking send
+itself, which keeps latency at raw-socket level without ever blocking on a slow subscriber.
+
+Receiving runs one thread per publisher connection: ``recv_into`` a preallocated buffer,
+frames cut by ``minros.tcpros.FrameReader`` (large frames land in their own buffer, zero-copy),
+deserialize, run the callbacks.
+"""
+
+from __future__ import annotations
+
+import collections
+import errno
+import logging
+import socket
+import struct
+import threading
+import time
+import traceback
+import warnings
+from typing import Any, Callable, Dict, List, Tuple
+
+from minros import node as _node_mod
+from minros import tcpros
+from minros.exceptions import (
+    ROSException,
+    ROSInterruptException,
+    ROSSerializationException,
+    SerializationError,
+)
+from minros.xmlrpc import ServerProxy
+
+__all__ = [
+    "AnyMsg",
+    "Publisher",
+    "SubscribeListener",
+    "Subscriber",
+    "Topic",
+    "get_published_topics",
+    "wait_for_message",
+]
+
+_logger = logging.getLogger("minros.topics")
+
+DEFAULT_BUFF_SIZE = 65536
+#: frames up to this size are joined into one bytes object; larger keep their parts (no copy)
+_JOIN_LIMIT = 65536
+_U32 = struct.Struct("<I")
+_MSG_DONTWAIT = getattr(socket, "MSG_DONTWAIT", 0)
+#: a synchronous (queue_size=None) publisher waits at most this long for a slow subscriber
+SYNC_SEND_TIMEOUT = 60.0
+
+_conn_ids = iter(range(1, 1 << 62))
+_conn_id_lock = threading.Lock()
+
+
+def _next_conn_id() -> int:
+    with _conn_id_lock:
+        return next(_conn_ids)
+
+
+def _log_error(text: str) -> None:
+    """User-visible error line (rospy's logerr), falling back to the module logger."""
+    try:
+        from minros import log
+
+        log.logerr(text)
+    except Exception:
+        _logger.error(text)
+
+
+def _log_warn(text: str) -> None:
+    try:
+        from minros import log
+
+        log.logwarn(text)
+    except Exception:
+        _logger.warning(text)
+
+
+# ---------------------------------------------------------------------------------------------
+# messages
+
+
+class AnyMsg:
+    """Receives any message type as raw bytes (``_buff``); publishing it re-sends those bytes."""
+
+    __slots__ = ("_buff", "_connection_header")
+    _md5sum = tcpros.ANYTYPE
+    _type = tcpros.ANYTYPE
+    _has_header = False
+    _full_text = ""
+    _slot_types: List[str] = []
+
+    def __init__(self, *args: Any) -> None:
+        if len(args) > 1:
+            raise ROSException("AnyMsg does not accept arguments")
+        self._buff = args[0] if args else None
+
+    def serialize(self, buff) -> None:
+        if self._buff is None:
+            raise ROSSerializationException("AnyMsg is not initialized")
+        buff.write(self._buff)
+
+    def deserialize(self, data) -> AnyMsg:
+        self._buff = data
+        return self
+
+
+class _Chunks:
+    """A write-only buffer that keeps the parts a message writes (no concatenation)."""
+
+    __slots__ = ("parts", "size")
+
+    def __init__(self) -> None:
+        self.parts: list = []
+        self.size = 0
+
+    def write(self, data) -> int:
+        if type(data) is not bytes:
+            data = bytes(data)  # mutable buffers are snapshotted: the frame may wait in a queue
+        self.parts.append(data)
+        self.size += len(data)
+        return len(data)
+
+
+def serialize_frame(msg: Any) -> Any:
+    """Serialize ``msg`` into one frame: ``bytes`` for small messages, else a tuple of buffers
+    (length prefix first) that ``sendmsg`` writes without joining them."""
+    chunks = _Chunks()
+    try:
+        msg.serialize(chunks)
+    except SerializationError as exc:
+        raise ROSSerializationException(str(exc)) from None
+    except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
+        raise ROSSerializationException(str(exc)) from None
+    if chunks.size <= _JOIN_LIMIT:
+        return _U32.pack(chunks.size) + b"".join(chunks.parts)
+    parts = [_U32.pack(chunks.size)]
+    small: list = []
+    for part in chunks.parts:  # coalesce the many small field writes around the big ones
+        if len(part) < 4096:
+            small.append(part)
+        else:
+            if small:
+                parts.append(b"".join(small))
+                small = []
+            parts.append(part)
+    if small:
+        parts.append(b"".join(small))
+    return tuple(parts)
+
+
+def _frame_len(frame: Any) -> int:
+    if type(frame) is tuple:
+        return sum(len(p) for p in frame)
+    return len(frame)
+
+
+def args_kwds_to_message(data_class: Any, args: tuple, kwds: dict) -> Any:
+    """rospy's publish(msg | *fields | **fields) convention."""
+    if args and kwds:
+        raise TypeError("publish() can be called with arguments or keywords, but not both.")
+    if kwds:
+        return data_class(**kwds)
+    if len(args) == 1:
+        arg = args[0]
+        if isinstance(arg, data_class):
+            return arg
+        if hasattr(arg, "_type") and hasattr(arg, "_md5sum") and not isinstance(arg, data_class):
+            if getattr(arg, "_type", None) != getattr(data_class, "_type", None):
+                raise TypeError(f"expected [{data_class._type}] but got [{arg._type}]")
+            return arg
+        return data_class(arg)
+    return data_class(*args)
+
+
+# ---------------------------------------------------------------------------------------------
+# publisher side
+
+
+class _PubConnection:
+    """One subscriber connected to one of our publications."""
+
+    __slots__ = ("id", "sock", "callerid", "local", "remote", "fileno", "queue", "queue_size",
+                 "cond", "busy", "done", "stat_bytes", "stat_msgs", "impl", "sync", "thread",
+                 "header")
+
+    def __init__(self, impl: _PublisherImpl, sock: socket.socket, addr, header: Dict[str, str],
+                 queue_size: int | None) -> None:
+        self.id = _next_conn_id()
+        self.impl = impl
+        self.sock = sock
+        self.header = header
+        self.callerid = header.get("callerid", "")
+        self.local = sock.getsockname()
+        self.remote = addr
+        self.fileno = sock.fileno()
+        self.queue: collections.deque = collections.deque()
+        self.queue_size = queue_size
+        self.cond = threading.Condition(threading.Lock())
+        self.busy = False
+        self.done = False
+        self.stat_bytes = 0
+        self.stat_msgs = 0
+        self.sync = queue_size is None
+        self.thread: threading.Thread | None = None
+        if self.sync:
+            sock.settimeout(SYNC_SEND_TIMEOUT)
+        else:
+            self.thread = threading.Thread(target=self._writer, daemon=True,
+                                           name=f"minros-pub:{impl.resolved_name}")
+            self.thread.start()
+        # a subscriber never sends after its header: a readable socket means it went away
+        threading.Thread(target=self._watch_close, daemon=True,
+                         name=f"minros-pub-watch:{impl.resolved_name}").start()
+
+    def info(self) -> str:
+        return (f"TCPROS connection on port {self.local[1]} to [{self.remote[0]}:{self.remote[1]}"
+                f" on socket {self.fileno}]")
+
+    # -- sending ---------------------------------------------------------------------------
+
+    def write(self, frame: Any) -> None:
+        """Queue (or directly send) one frame; never blocks a queued publisher."""
+        if self.done:
+            return
+        if self.sync:
+            with self.cond:
+                try:
+                    self._send_blocking(frame)
+                except OSError as exc:
+                    self._fail(exc)
+            return
+        with self.cond:
+            if not self.queue and not self.busy:
+                # fast path: the socket is idle, try to hand the bytes to the kernel now
+                try:
+                    sent = self._send_nowait(frame)
+                except OSError as exc:
+                    self._fail(exc)
+                    return
+                if sent is None:
+                    return
+                self.queue.append(sent)
+                self.cond.notify()
+                return
+            queue = self.queue
+            if self.queue_size and len(queue) >= self.queue_size:
+                # drop the oldest, but never the half-sent frame at the front
+                if type(queue[0]) is _Partial:
+                    if len(queue) > 1:
+                        del queue[1]
+                else:
+                    queue.popleft()
+            queue.append(frame)
+            self.cond.notify()
+
+    def _send_nowait(self, frame: Any) -> Any:
+        """Send what the kernel takes without blocking; return the unsent rest or None."""
+        sock = self.sock
+        if type(frame) is tuple:
+            parts = list(frame)
+            total = sum(len(p) for p in parts)
+            try:
+                sent = sock.sendmsg(parts, (), _MSG_DONTWAIT)
+            except BlockingIOError:
+                sent = 0
+            self.stat_bytes += sent
+            if sent == total:
+                self.stat_msgs += 1
+                return None
+            return _advance(parts, sent)
+        try:
+            sent = sock.send(frame, _MSG_DONTWAIT)
+        except BlockingIOError:
+            sent = 0
+        self.stat_bytes += sent
+        if sent == len(frame):
+            self.stat_msgs += 1
+            return None
+        return _Partial(memoryview(frame)[sent:])
+
+    def _send_blocking(self, frame: Any) -> None:
+        sock = self.sock
+        if type(frame) is tuple:
+            parts = list(frame)
+            while parts:
+                sent = sock.sendmsg(parts)
+                self.stat_bytes += sent
+                rest = _advance(parts, sent)
+                parts = list(rest.parts) if rest is not None else []
+        elif type(frame) is _Partial:
+            parts = frame.parts
+            for part in parts:
+                sock.sendall(part)
+                self.stat_bytes += len(part)
+            self.stat_msgs += 1
+            return
+        else:
+            sock.sendall(frame)
+            self.stat_bytes += len(frame)
+        self.stat_msgs += 1
+
+    def _writer(self) -> None:
+        cond = self.cond
+        while True:
+            with cond:
+                self.busy = False
+                while not self.queue and not self.done:
+                    cond.wait()
+                if self.done:
+                    return
+                batch = list(self.queue)
+                self.queue.clear()
+                self.busy = True
+            try:
+                if len(batch) > 1 and all(type(f) is bytes for f in batch):
+                    # many small frames: one system call for the lot
+                    joined = b"".join(batch)
+                    self.sock.sendall(joined)
+                    self.stat_bytes += len(joined)
+                    self.stat_msgs += len(batch)
+                else:
+                    for frame in batch:
+                        self._send_blocking(frame)
+            except OSError as exc:
+                with cond:
+                    self._fail(exc)
+                return
+
+    def _watch_close(self) -> None:
+        try:
+            while not self.done:
+                try:
+                    data = self.sock.recv(4096)
+                except TimeoutError:  # a synchronous publisher's socket has a send timeout
+                    continue
+                if not data:
+                    break
+        except OSError:
+            pass
+        if not self.done:
+            with self.cond:
+                self._fail(None)
+
+    def _fail(self, exc: BaseException | None) -> None:
+        """Called with ``cond`` held: the connection is dead, forget it."""
+        if self.done:
+            return
+        self.done = True
+        self.queue.clear()
+        self.cond.notify_all()
+        if exc is not None and not isinstance(exc, (BrokenPipeError, ConnectionResetError)):
+            _logger.info("publisher connection to [%s] on [%s] closed: %s",
+                         self.callerid, self.impl.resolved_name, exc)
+        _close_socket(self.sock)
+        threading.Thread(target=self.impl._remove_connection, args=(self,), daemon=True).start()
+
+    def close(self) -> None:
+        with self.cond:
+            if self.done:
+                return
+            self.done = True
+            self.queue.clear()
+            self.cond.notify_all()
+        _close_socket(self.sock)
+
+
+class _Partial:
+    """The unsent rest of a frame (after a partial non-blocking send)."""
+
+    __slots__ = ("parts",)
+
+    def __init__(self, *parts: Any) -> None:
+        self.parts = parts
+
+
+def _advance(parts: list, sent: int) -> _Partial | None:
+    rest = []
+    for part in parts:
+        n = len(part)
+        if sent >= n:
+            sent -= n
+            continue
+        rest.append(memoryview(part)[sent:] if sent else part)
+        sent = 0
+    return _Partial(*rest) if rest else None
+
+
+class _PublisherImpl:
+    """Shared state of all Publisher handles for one topic in this process."""
+
+    def __init__(self, name: str, resolved_name: str, data_class: Any) -> None:
+        self.name = name
+        self.resolved_name = resolved_name
+        self.data_class = data_class
+        self.type = data_class._type
+        self.md5sum = data_class._md5sum
+        self.connections: List[_PubConnection] = []
+        self.lock = threading.RLock()
+        self.listeners: List[Any] = []
+        self.headers: Dict[str, str] = {}
+        self.is_latch = False
+        self.latch: Any = None
+        self.latch_frame: Any = None
+        self.queue_size: int | None = None
+        self.queue_size_set = False
+        self.tcp_nodelay = False
+        self.seq = 0
+        self.message_data_sent = 0
+        self.ref_count = 0
+        self.closed = False
+
+    def reresolve(self) -> str:
+        self.resolved_name = _node_mod.resolve_name(self.name)
+        return self.resolved_name
+
+    # -- connections ---------------------------------------------------------------------
+
+    def accept_subscriber(self, sock: socket.socket, addr, header: Dict[str, str]) -> str | None:
+        """Inbound connection from a subscriber (called by the node's TCPROS server)."""
+        error = tcpros.publisher_header_error(
+            header, _node_mod.get_caller_id(), {self.resolved_name: (self.type, self.md5sum)})
+        if error is not None:
+            return error
+        if self.closed:
+            return f"Internal error processing topic [{self.resolved_name}]"
+        nodelay = header.get("tcp_nodelay", "").strip() == "1" if "tcp_nodelay" in header else self.tcp_nodelay
+        if nodelay:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        fields = {
+            "topic": self.resolved_name,
+            "type": self.type,
+            "latching": "1" if self.is_latch else "0",
+            "message_definition": self.data_class._full_text,
+            "md5sum": self.md5sum,
+            "callerid": _node_mod.get_caller_id(),
+        }
+        fields.update(self.headers)
+        sock.sendall(tcpros.encode_header(fields))
+        with self.lock:
+            conn = _PubConnection(self, sock, addr, header, self.queue_size)
+            self.connections = self.connections + [conn]
+            if self.is_latch and self.latch is not None:
+                frame = self._serialize(self.latch)
+                conn.write(frame)
+        for listener in list(self.listeners):
+            def publish_single(*args: Any, _conn: _PubConnection = conn, **kwds: Any) -> None:
+                msg = args_kwds_to_message(self.data_class, args, kwds)
+                with self.lock:
+                    _conn.write(self._serialize(msg))
+            try:
+                listener.peer_subscribe(self.resolved_name, self._publish_any, publish_single)
+            except Exception:
+                _logger.error("peer_subscribe failed: %s", traceback.format_exc())
+        return None
+
+    def _publish_any(self, *args: Any, **kwds: Any) -> None:
+        self.publish(args_kwds_to_message(self.data_class, args, kwds))
+
+    def _remove_connection(self, conn: _PubConnection) -> None:
+        with self.lock:
+            if conn not in self.connections:
+                return
+            self.connections = [c for c in self.connections if c is not conn]
+            remaining = len(self.connections)
+        for listener in list(self.listeners):
+            try:
+                listener.peer_unsubscribe(self.resolved_name, remaining)
+            except Exception:
+                _logger.error("peer_unsubscribe failed: %s", traceback.format_exc())
+
+    # -- publishing ----------------------------------------------------------------------
+
+    def _serialize(self, msg: Any) -> Any:
+        """Called with the lock held: Header.seq auto-fill, then one serialization."""
+        self.seq += 1
+        if getattr(msg, "_has_header", False):
+            header = msg.header
+            header.seq = self.seq
+            if header.frame_id is None:
+                header.frame_id = "0"
+        frame = serialize_frame(msg)
+        self.message_data_sent += _frame_len(frame) - 4
+        return frame
+
+    def publish(self, msg: Any) -> None:
+        with self.lock:
+            if self.closed:
+                if _node_mod.is_shutdown():
+                    return
+                raise ROSException("publish() to a closed topic")
+            if self.is_latch:
+                self.latch = msg
+            conns = self.connections
+            if not conns:
+                return
+            frame = self._serialize(msg)
+            for conn in conns:
+                conn.write(frame)
+
+    # -- bookkeeping ---------------------------------------------------------------------
+
+    def get_stats(self) -> list:
+        return [self.resolved_name, self.message_data_sent,
+                [[c.id, c.stat_bytes, c.stat_msgs, not c.done] for c in self.connections]]
+
+    def get_stats_info(self) -> list:
+        return [[c.id, c.callerid, "o", "TCPROS", self.resolved_name, True, c.info()]
+                for c in self.connections]
+
+    def close(self) -> None:
+        with self.lock:
+            self.closed = True
+            conns, self.connections = self.connections, []
+        for conn in conns:
+            conn.close()
+
+
+# ---------------------------------------------------------------------------------------------
+# subscriber side
+
+
+class _SubConnection:
+    """Our connection to one publisher of a subscribed topic (runs in its own thread)."""
+
+    def __init__(self, impl: _SubscriberImpl, pub_uri: str) -> None:
+        self.id = _next_conn_id()
+        self.impl = impl
+        self.pub_uri = pub_uri
+        self.sock: socket.socket | None = None
+        self.header: Dict[str, str] = {}
+        self.latch: Any = None
+        self.done = False
+        self.connected = False
+        self.stat_bytes = 0
+        self.stat_msgs = 0
+        self.local: Tuple[Any, ...] = ("", 0)
+        self.remote: Tuple[Any, ...] = ("", 0)
+        self.fileno = -1
+        self.gen = 0
+        self.reader: tcpros.FrameReader | None = None
+        self.pending: list = []
+        self.thread = threading.Thread(target=self._run, daemon=True,
+                                       name=f"minros-sub:{impl.resolved_name}")
+
+    def info(self) -> str:
+        return (f"TCPROS connection on port {self.local[1]} to [{self.remote[0]}:{self.remote[1]}"
+                f" on socket {self.fileno}]")
+
+    def close(self) -> None:
+        self.done = True
+        sock = self.sock
+        if sock is not None:
+            _close_socket(sock)
+
+    # -- connection life ---------------------------------------------------------------------
+
+    def _run(self) -> None:
+        interval = 0.5
+        try:
+            while not self.done and not _node_mod.is_shutdown():
+                try:
+                    address = self._request_topic()
+                except OSError as exc:
+                    if _is_refused(exc):
+                        _logger.debug("publisher %s is gone: %s", self.pub_uri, exc)
+                        return
+                    address = None
+                    _logger.debug("requestTopic to %s failed: %s", self.pub_uri, exc)
+                except _GiveUp as exc:
+                    _logger.debug("not connecting to %s: %s", self.pub_uri, exc)
+                    return
+                if address is not None:
+                    try:
+                        if self._connect(*address):
+                            interval = 0.5
+                            self._receive_loop()
+                    except (OSError, tcpros.HeaderError, tcpros.FrameError, _Rejected) as exc:
+                        if not self.done and not _node_mod.is_shutdown_requested():
+                            _log_warn(f"[{self.impl.resolved_name}] connection to publisher "
+                                      f"[{self.pub_uri}] failed: {exc}")
+                    finally:
+                        self.connected = False
+                        if self.sock is not None:
+                            _close_socket(self.sock)
+                            self.sock = None
+                if self.done or _node_mod.is_shutdown_requested():
+                    return
+                if self.pub_uri not in self.impl.publisher_uris:
+                    return
+                if _node_mod.wait_for_shutdown(interval):
+                    return
+                interval = min(interval * 2, 8.0)
+        finally:
+            self.impl._connection_ended(self)
+
+    def _request_topic(self) -> Tuple[str, int] | None:
+        proxy = ServerProxy(self.pub_uri, timeout=5.0)
+        try:
+            code, msg, params = proxy.requestTopic(_node_mod.get_caller_id(), self.impl.resolved_name,
+                                                   [[tcpros.TCPROS]])
+        finally:
+            proxy.close()
+        if code != 1:
+            raise _GiveUp(f"requestTopic: {msg}")
+        if (not isinstance(params, list) or len(params) != 3 or params[0] != tcpros.TCPROS
+                or not isinstance(params[2], int)):
+            raise _GiveUp(f"publisher returned invalid protocol choice: {params}")
+        return params[1], params[2]
+
+    def _connect(self, host: str, port: int) -> bool:
+        impl = self.impl
+        sock = socket.create_connection((host, port), timeout=10.0)
+        self.sock = sock
+        if self.done:
+            return False
+        if impl.tcp_nodelay:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        data_class = impl.data_class
+        sock.sendall(tcpros.encode_header({
+            "topic": impl.resolved_name,
+            "message_definition": data_class._full_text,
+            "tcp_nodelay": "1" if impl.tcp_nodelay else "0",
+            "md5sum": data_class._md5sum,
+            "type": data_class._type,
+            "callerid": _node_mod.get_caller_id(),
+        }))
+        reader = tcpros.FrameReader(max_frame=tcpros.DEFAULT_MAX_HEADER,
+                                    buff_size=max(impl.buff_size, 4096))
+        frames: list = []
+        while not frames:
+            n = sock.recv_into(reader.recv_buffer())
+            if not n:
+                reader.eof()
+                raise tcpros.HeaderError("publisher closed the connection during the handshake")
+            reader.received(n)
+            frames = reader.frames()
+        header = tcpros.decode_header(frames[0])
+        error = tcpros.subscriber_header_error(header, impl.resolved_name, data_class._md5sum,
+                                               data_class._type)
+        if error is not None:
+            raise _Rejected(error)
+        sock.settimeout(None)
+        self.header = header
+        self.local = sock.getsockname()
+        self.remote = sock.getpeername()
+        self.fileno = sock.fileno()
+        self.reader = reader
+        reader.max_frame = tcpros.DEFAULT_MAX_FRAME
+        self.pending = frames[1:]
+        self.connected = True
+        return True
+
+    def _receive_loop(self) -> None:
+        impl = self.impl
+        reader = self.reader
+        sock = self.sock
+        header = self.header
+        latching = header.get("latching", "0") == "1"
+        data_class = impl.data_class
+        frames = self.pending + reader.frames()
+        recv_into = sock.recv_into
+        while True:
+            if frames:
+                queue_size = impl.queue_size
+                if queue_size is not None and len(frames) > queue_size:
+                    frames = frames[-queue_size:]  # older ones dropped, as in rospy
+                msgs = []
+                for frame in frames:
+                    self.stat_msgs += 1
+                    try:
+                        msg = data_class()
+                        msg.deserialize(frame)
+                    except Exception as exc:
+                        _log_error(f"[{impl.resolved_name}] error deserializing incoming message "
+                                   f"from [{self.pub_uri}]: {exc}")
+                        continue
+                    try:
+                        msg._connection_header = header
+                    except AttributeError:
+                        pass
+                    msgs.append(msg)
+                if msgs:
+                    if latching:
+                        self.latch = msgs[-1]
+                    if self.done:
+                        return
+                    impl.deliver(msgs)
+            if self.done:
+                return
+            n = recv_into(reader.recv_buffer())
+            if not n:
+                reader.eof()
+                return
+            self.stat_bytes += n
+            reader.received(n)
+            frames = reader.frames()
+
+
+class _GiveUp(Exception):
+    pass
+
+
+class _Rejected(Exception):
+    pass
+
+
+def _is_refused(exc: BaseException) -> bool:
+    return isinstance(exc, ConnectionRefusedError) or getattr(exc, "errno", None) == errno.ECONNREFUSED
+
+
+class _SubscriberImpl:
+    """Shared state of all Subscriber handles for one topic: one connection per publisher."""
+
+    def __init__(self, name: str, resolved_name: str, data_class: Any) -> None:
+        self.name = name
+        self.resolved_name = resolved_name
+        self.data_class = data_class
+        self.type = data_class._type
+        self.md5sum = data_class._md5sum
+        self.callbacks: List[Tuple[Callable, Any]] = []
+        self.queue_size: int | None = None
+        self.buff_size = DEFAULT_BUFF_SIZE
+        self.tcp_nodelay = False
+        self.connections: Dict[str, _SubConnection] = {}
+        self.publisher_uris: List[str] = []
+        self.update_gen = 0
+        self.lock = threading.RLock()
+        self.ref_count = 0
+        self.closed = False
+
+    def reresolve(self) -> str:
+        self.resolved_name = _node_mod.resolve_name(self.name)
+        return self.resolved_name
+
+    def publisher_update(self, uris: List[str]) -> None:
+        """The master's current publisher list: connect to the new ones."""
+        with self.lock:
+            if self.closed:
+                return
+            self.publisher_uris = list(uris)
+            self.update_gen += 1
+            fresh = []
+            for uri in uris:
+                if uri not in self.connections:
+                    conn = _SubConnection(self, uri)
+                    conn.gen = self.update_gen
+                    self.connections[uri] = conn
+                    fresh.append(conn)
+        for conn in fresh:
+            conn.thread.start()
+
+    def _connection_ended(self, conn: _SubConnection) -> None:
+        with self.lock:
+            if self.connections.get(conn.pub_uri) is conn:
+                del self.connections[conn.pub_uri]
+            again = (not self.closed and not conn.done and conn.pub_uri in self.publisher_uris
+                     and self.update_gen != conn.gen and not _node_mod.is_shutdown_requested())
+        if again:  # the publisher was announced again while this connection was ending
+            self.publisher_update(self.publisher_uris)
+
+    def add_callback(self, cb: Callable, cb_args: Any) -> None:
+        with self.lock:
+            self.callbacks = self.callbacks + [(cb, cb_args)]
+            latched = [c.latch for c in self.connections.values() if c.latch is not None]
+        for msg in latched:
+            self._invoke(msg, cb, cb_args)
+
+    def remove_callback(self, cb: Callable, cb_args: Any) -> None:
+        with self.lock:
+            for i, (c, a) in enumerate(self.callbacks):
+                if c == cb and a == cb_args:
+                    self.callbacks = self.callbacks[:i] + self.callbacks[i + 1:]
+                    return
+        raise KeyError("no matching cb")
+
+    def deliver(self, msgs: list) -> None:
+        callbacks = self.callbacks
+        for msg in msgs:
+            for cb, cb_args in callbacks:
+                try:
+                    if cb_args is not None:
+                        cb(msg, cb_args)
+                    else:
+                        cb(msg)
+                except Exception:
+                    if not _node_mod.is_shutdown():
+                        _log_error(f"bad callback: {cb}\n{traceback.format_exc()}")
+
+    @staticmethod
+    def _invoke(msg: Any, cb: Callable, cb_args: Any) -> None:
+        try:
+            if cb_args is not None:
+                cb(msg, cb_args)
+            else:
+                cb(msg)
+        except Exception:
+            _log_error(f"bad callback: {cb}\n{traceback.format_exc()}")
+
+    def get_stats(self) -> list:
+        return [self.resolved_name,
+                [[c.id, c.stat_bytes, c.stat_msgs, -1, c.connected]
+                 for c in list(self.connections.values())]]
+
+    def get_stats_info(self) -> list:
+        return [[c.id, c.pub_uri, "i", "TCPROS", self.resolved_name, True, c.info()]
+                for c in list(self.connections.values()) if c.connected]
+
+    def get_num_connections(self) -> int:
+        return sum(1 for c in list(self.connections.values()) if c.connected)
+
+    def close(self) -> None:
+        with self.lock:
+            self.closed = True
+            conns = list(self.connections.values())
+            self.connections = {}
+            self.callbacks = []
+        for conn in conns:
+            conn.close()
+
+
+# ---------------------------------------------------------------------------------------------
+# process-wide topic bookkeeping
+
+_impl_lock = threading.RLock()
+
+
+def _acquire(kind: str, name: str, data_class: Any) -> Any:
+    if not isinstance(name, str) or not name:
+        raise ValueError("topic name must be a non-empty string")
+    if data_class is None or not hasattr(data_class, "_md5sum"):
+        raise ValueError(f"data_class [{data_class}] is not a message data class")
+    resolved = _node_mod.resolve_name(name)
+    with _impl_lock:
+        if kind == "pub":
+            impl = _node_mod._get_publication(resolved)
+            if impl is None or impl.closed:
+                impl = _PublisherImpl(name, resolved, data_class)
+                impl.ref_count = 1
+                _node_mod._add_publication(impl)
+                return impl
+        else:
+            impl = _node_mod._get_subscription(resolved)
+            if impl is None or impl.closed:
+                impl = _SubscriberImpl(name, resolved, data_class)
+                impl.ref_count = 1
+                _node_mod._add_subscription(impl)
+                return impl
+        if impl.md5sum != data_class._md5sum and tcpros.ANYTYPE not in (impl.md5sum, data_class._md5sum):
+            raise ROSException(
+                f"{'publisher' if kind == 'pub' else 'subscriber'} for [{resolved}] already exists "
+                f"with a different type [{impl.type}]")
+        impl.ref_count += 1
+        return impl
+
+
+def _release(kind: str, impl: Any) -> None:
+    with _impl_lock:
+        impl.ref_count -= 1
+        if impl.ref_count > 0:
+            return
+        impl.close()
+        if kind == "pub":
+            _node_mod._remove_publication(impl)
+        else:
+            _node_mod._remove_subscription(impl)
+
+
+class Topic:
+    """Base of Publisher and Subscriber (rospy.topics.Topic)."""
+
+    _kind = ""
+
+    def __init__(self, name: str, data_class: Any) -> None:
+        self.impl = _acquire(self._kind, name, data_class)
+        self.name = self.impl.resolved_name
+        self.resolved_name = self.impl.resolved_name
+        self.data_class = data_class
+        self.type = data_class._type
+        self.md5sum = data_class._md5sum
+        self.reg_type = self._kind
+
+    def get_num_connections(self) -> int:
+        impl = self.impl
+        if impl is None:
+            return 0
+        if self._kind == "pub":
+            return sum(1 for c in impl.connections if not c.done)
+        return impl.get_num_connections()
+
+    def unregister(self) -> None:
+        impl, self.impl = self.impl, None
+        if impl is not None:
+            _release(self._kind, impl)
+
+
+class SubscribeListener:
+    """Notified when subscribers connect to or disconnect from a Publisher."""
+
+    def peer_subscribe(self, topic_name: str, topic_publish: Callable, peer_publish: Callable) -> None:
+        pass
+
+    def peer_unsubscribe(self, topic_name: str, num_peers: int) -> None:
+        pass
+
+
+class Publisher(Topic):
+    """Publish messages of ``data_class`` on topic ``name`` (rospy.Publisher)."""
+
+    _kind = "pub"
+
+    def __init__(self, name: str, data_class: Any, subscriber_listener: SubscribeListener | None = None,
+                 tcp_nodelay: bool = False, latch: bool = False, headers: Dict[str, str] | None = None,
+                 queue_size: int | None = None) -> None:
+        super().__init__(name, data_class)
+        impl = self.impl
+        if subscriber_listener:
+            impl.listeners.append(subscriber_listener)
+        if tcp_nodelay:
+            impl.tcp_nodelay = True
+        if latch:
+            impl.is_latch = True
+        if headers:
+            impl.headers.update({str(k): str(v) for k, v in headers.items()})
+        if queue_size is not None:
+            if not isinstance(queue_size, int) or queue_size < 0:
+                raise ROSException("queue_size must be a non-negative integer or None")
+            impl.queue_size = queue_size
+            impl.queue_size_set = True
+        else:
+            warnings.warn(
+                "The publisher should be created with an explicit keyword argument 'queue_size'. "
+                "Please see http://wiki.ros.org/rospy/Overview/Publishers%20and%20Subscribers "
+                "for more information.", SyntaxWarning, stacklevel=2)
+
+    def publish(self, *args: Any, **kwds: Any) -> None:
+        """Publish a message instance, or build one from positional or keyword fields."""
+        impl = self.impl
+        if impl is None:
+            raise ROSException("publish() to an unregistered() handle")
+        if not _node_mod.is_initialized():
+            raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
+        msg = args_kwds_to_message(self.data_class, args, kwds)
+        impl.publish(msg)
+
+
+class Subscriber(Topic):
+    """Receive messages of ``data_class`` on topic ``name`` (rospy.Subscriber)."""
+
+    _kind = "sub"
+
+    def __init__(self, name: str, data_class: Any, callback: Callable | None = None,
+                 callback_args: Any = None, queue_size: int | None = None,
+                 buff_size: int = DEFAULT_BUFF_SIZE, tcp_nodelay: bool = False) -> None:
+        super().__init__(name, data_class)
+        impl = self.impl
+        if queue_size is not None:
+            if queue_size == -1:
+                queue_size = None
+            elif queue_size == 0:
+                raise ROSException("queue size may not be set to zero")
+            elif type(queue_size) is not int:
+                raise ROSException("queue size must be an integer")
+            impl.queue_size = queue_size
+        if buff_size != DEFAULT_BUFF_SIZE:
+            if type(buff_size) is not int:
+                raise ROSException("buffer size must be an integer")
+            if buff_size <= 0:
+                raise ROSException("buffer size must be a positive integer")
+            impl.buff_size = buff_size
+        if tcp_nodelay:
+            impl.tcp_nodelay = True
+        self.callback = callback
+        self.callback_args = callback_args
+        if callback is not None:
+            impl.add_callback(callback, callback_args)
+
+    def unregister(self) -> None:
+        impl = self.impl
+        if impl is not None and self.callback is not None:
+            try:
+                impl.remove_callback(self.callback, self.callback_args)
+            except KeyError:
+                pass
+        self.callback = self.callback_args = None
+        super().unregister()
+
+
+# ---------------------------------------------------------------------------------------------
+# helpers
+
+
+def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) -> Any:
+    """Subscribe to ``topic`` and return its next message (rospy.wait_for_message)."""
+    received: list = []
+    event = threading.Event()
+
+    def callback(msg: Any) -> None:
+        if not received:
+            received.append(msg)
+            event.set()
+
+    sub = Subscriber(topic, topic_type, callback)
+    try:
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while not event.is_set():
+            if _node_mod.is_shutdown():
+                raise ROSInterruptException("rospy shutdown")
+            remaining = 0.01 if deadline is None else min(0.01, deadline - time.monotonic())
+            if remaining <= 0:
+                raise ROSException(f"timeout exceeded while waiting for message on topic {topic}")
+            event.wait(remaining)
+        return received[0]
+    finally:
+        sub.unregister()
+
+
+def get_published_topics(namespace: str = "/") -> List[List[str]]:
+    """[[topic, type], ...] published in ``namespace`` (master getPublishedTopics)."""
+    code, msg, value = _node_mod.master_call("getPublishedTopics", namespace)
+    if code != 1:
+        raise ROSException(f"unable to get published topics: {msg}")
+    return value
+
+
+def _close_socket(sock: socket.socket) -> None:
+    try:
+        sock.shutdown(socket.SHUT_RDWR)
+    except OSError:
+        pass
+    try:
+        sock.close()
+    except OSError:
+        pass

@@ -1,0 +1,20 @@
+"""rospy stand-in: the rospy API served by minros, so unmodified rospy scripts run on minros."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import minros
+from minros import __all__ as __all__  # noqa: PLC0414 - rospy's public names are minros's
+
+# the submodules scripts reach through the package (rospy.timer.TimerEvent, rospy.exceptions...)
+from rospy import client, core, exceptions, impl, msg, names, rostime, service, timer, topics  # noqa: F401
+
+# Bind every public name now (as rospy's own __init__ does), except the message classes,
+# which are imported on first use like in the minros facade.
+globals().update({name: getattr(minros, name) for name in __all__
+                  if name not in ("Header", "Message")})
+
+
+def __getattr__(name: str) -> Any:
+    return getattr(minros, name)

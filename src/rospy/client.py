@@ -1,0 +1,10 @@
+"""rospy.client: node life-cycle functions (minros.node and minros.topics)."""
+
+from minros.node import (  # noqa: F401
+    get_master,
+    init_node,
+    myargv,
+    on_shutdown,
+    spin,
+)
+from minros.topics import get_published_topics, wait_for_message  # noqa: F401

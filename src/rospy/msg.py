@@ -1,0 +1,3 @@
+"""rospy.msg: AnyMsg and the publish-argument convention (minros.topics)."""
+
+from minros.topics import AnyMsg, args_kwds_to_message  # noqa: F401

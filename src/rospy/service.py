@@ -1,0 +1,3 @@
+"""rospy.service: ServiceException (minros.services)."""
+
+from minros.exceptions import ServiceException  # noqa: F401
