@@ -1,0 +1,1 @@
+"""actionlib_msgs: message package stand-in provided by minros."""

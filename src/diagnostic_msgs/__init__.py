@@ -1,0 +1,1 @@
+"""diagnostic_msgs: message package stand-in provided by minros."""

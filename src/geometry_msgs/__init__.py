@@ -1,0 +1,1 @@
+"""geometry_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,466 @@
+"""Generate readable Python source for a message class from its spec.
+
+One class per message type, compiled once. Nested message fields are expanded in place (as
+genpy does), so consecutive fixed-size fields - across nesting levels, including the length
+prefix of the string or array that follows them - are packed and unpacked by one precompiled
+``struct.Struct``. Deserialization works on a ``memoryview`` with offsets (no intermediate
+copies) and checks every length and count against the bytes that remain before using it.
+"""
+
+from __future__ import annotations
+
+import keyword
+import struct
+from typing import Callable, Dict, List, Tuple
+
+from .spec import MsgSpec
+
+#: struct codes for writing each primitive
+SER_CODE = {
+    "int8": "b", "byte": "b", "uint8": "B", "char": "B", "int16": "h", "uint16": "H",
+    "int32": "i", "uint32": "I", "int64": "q", "uint64": "Q", "float32": "f", "float64": "d",
+    "bool": "B",
+}
+#: struct codes for reading: bool reads with '?' so any non-zero byte becomes True (genpy: bool())
+DESER_CODE = dict(SER_CODE, bool="?")
+_SIZE = {c: struct.calcsize("<" + c) for c in "bBhHiIqQfd?"}
+_DEFAULTS = {"float32": "0.0", "float64": "0.0", "string": "''", "bool": "False",
+             "time": "Time()", "duration": "Duration()"}
+
+GetSpec = Callable[[str], MsgSpec]
+
+
+def python_name(field_name: str) -> str:
+    """The attribute name of a field (genpy appends '_' to Python keywords)."""
+    return field_name + "_" if keyword.iskeyword(field_name) else field_name
+
+
+def dep_name(type_name: str) -> str:
+    """The module-level name bound to the class of embedded type ``pkg/Type``."""
+    return type_name.replace("/", "_")
+
+
+def _compress(run: List[Tuple[int, str]]) -> str:
+    merged: List[List] = []
+    for count, code in run:
+        if merged and merged[-1][1] == code:
+            merged[-1][0] += count
+        else:
+            merged.append([count, code])
+    return "".join((str(n) if n != 1 else "") + c for n, c in merged)
+
+
+def _struct_name(fmt: str) -> str:
+    return "S_" + fmt.replace("?", "Bool")
+
+
+def min_size(spec: MsgSpec, get_spec: GetSpec) -> int:
+    """The fewest bytes any instance of ``spec`` takes on the wire."""
+    total = 0
+    for f in spec.fields:
+        if f.base_type in SER_CODE:
+            one = _SIZE[SER_CODE[f.base_type]]
+        elif f.base_type in ("time", "duration"):
+            one = 8
+        elif f.base_type == "string":
+            one = 4
+        else:
+            one = min_size(get_spec(f.base_type), get_spec)
+        if f.is_array:
+            total += 4 if f.array_len is None else one * f.array_len
+        else:
+            total += one
+    return total
+
+
+class _Writer:
+    """Collects indented source lines and the Structs they use."""
+
+    def __init__(self, structs: Dict[str, str]) -> None:
+        self.lines: List[str] = []
+        self.structs = structs
+        self.counter = 0
+
+    def emit(self, indent: int, line: str) -> None:
+        self.lines.append("    " * indent + line)
+
+    def tmp(self, prefix: str) -> str:
+        self.counter += 1
+        return f"{prefix}{self.counter}"
+
+    def struct(self, fmt: str) -> str:
+        name = _struct_name(fmt)
+        self.structs[fmt] = name
+        return name
+
+
+class _SerializerGen(_Writer):
+    def __init__(self, structs: Dict[str, str], get_spec: GetSpec) -> None:
+        super().__init__(structs)
+        self.get_spec = get_spec
+        self.run: List[Tuple[int, str, str]] = []  # (count, code, expression)
+
+    def flush(self, ind: int) -> None:
+        if not self.run:
+            return
+        fmt = _compress([(n, c) for n, c, _ in self.run])
+        name = self.struct(fmt)
+        self.emit(ind, f"append({name}.pack({', '.join(e for _, _, e in self.run)}))")
+        self.run = []
+
+    def string(self, ind: int, expr: str) -> None:
+        var = self.tmp("_s")
+        self.emit(ind, f"{var} = {expr}")
+        self.emit(ind, f"if {var}.__class__ is str:")
+        self.emit(ind + 1, f"{var} = {var}.encode()")
+        self.run.append((1, "I", f"len({var})"))
+        self.flush(ind)
+        self.emit(ind, f"append({var})")
+
+    def fields(self, spec: MsgSpec, obj: str, path: str, ind: int) -> None:
+        for f in spec.fields:
+            attr = python_name(f.name)
+            expr = f"{obj}.{attr}"
+            fpath = path + attr
+            bt = f.base_type
+            if not f.is_array:
+                if bt in SER_CODE:
+                    self.run.append((1, SER_CODE[bt], expr))
+                elif bt in ("time", "duration"):
+                    code = "I" if bt == "time" else "i"
+                    var = self.tmp("_t")
+                    self.emit(ind, f"{var} = {expr}")
+                    self.run.append((1, code, f"{var}.secs"))
+                    self.run.append((1, code, f"{var}.nsecs"))
+                elif bt == "string":
+                    self.string(ind, expr)
+                else:
+                    var = self.tmp("_m")
+                    self.emit(ind, f"{var} = {expr}")
+                    self.fields(self.get_spec(bt), var, fpath + ".", ind)
+                continue
+            n = f.array_len
+            if bt in ("uint8", "char"):
+                var = self.tmp("_b")
+                self.emit(ind, f"{var} = {expr}")
+                self.emit(ind, f"if {var}.__class__ is not bytes:")
+                self.emit(ind + 1, f"{var} = as_bytes({var})")
+                if n is None:
+                    self.run.append((1, "I", f"len({var})"))
+                else:
+                    self.emit(ind, f"if len({var}) != {n}:")
+                    self.emit(ind + 1, f"raise bad_length({fpath!r}, {n}, len({var}))")
+                self.flush(ind)
+                self.emit(ind, f"append({var})")
+            elif bt in SER_CODE:
+                code = SER_CODE[bt]
+                if n is None:
+                    self.flush(ind)
+                    self.emit(ind, f"put_array(append, {code!r}, {expr})")
+                elif n > 0:
+                    var = self.tmp("_a")
+                    self.emit(ind, f"{var} = {expr}")
+                    self.emit(ind, f"if {var}.__class__ is not list and {var}.__class__ is not tuple:")
+                    self.emit(ind + 1, f"{var} = as_list({var}, {n}, {fpath!r})")
+                    self.emit(ind, f"if len({var}) != {n}:")
+                    self.emit(ind + 1, f"raise bad_length({fpath!r}, {n}, len({var}))")
+                    self.run.append((n, code, f"*{var}"))
+            else:
+                var = self.tmp("_a")
+                self.emit(ind, f"{var} = {expr}")
+                if n is None:
+                    self.run.append((1, "I", f"len({var})"))
+                else:
+                    self.emit(ind, f"if len({var}) != {n}:")
+                    self.emit(ind + 1, f"raise bad_length({fpath!r}, {n}, len({var}))")
+                self.flush(ind)
+                item = self.tmp("_e")
+                self.emit(ind, f"for {item} in {var}:")
+                if bt == "string":
+                    self.string(ind + 1, item)
+                elif bt in ("time", "duration"):
+                    code = "I" if bt == "time" else "i"
+                    self.run.append((1, code, f"{item}.secs"))
+                    self.run.append((1, code, f"{item}.nsecs"))
+                else:
+                    self.fields(self.get_spec(bt), item, fpath + "[].", ind + 1)
+                self.flush(ind + 1)
+                if len(self.lines) and self.lines[-1].endswith(":"):
+                    self.emit(ind + 1, "pass")
+
+
+class _DeserializerGen(_Writer):
+    def __init__(self, structs: Dict[str, str], get_spec: GetSpec, type_name: str,
+                 numpy: bool) -> None:
+        super().__init__(structs)
+        self.get_spec = get_spec
+        self.type_name = type_name
+        self.numpy = numpy
+        self.run: List[Tuple[int, str, str]] = []  # (count, code, target)
+        self.post: List[str] = []
+
+    def flush(self, ind: int) -> None:
+        if not self.run:
+            return
+        run = [(n, c) for n, c, _ in self.run]
+        fmt = _compress(run)
+        size = struct.calcsize("<" + fmt)
+        name = self.struct(fmt)
+        targets = ", ".join(t for _, _, t in self.run)
+        if len(self.run) == 1:
+            targets += ","
+        self.emit(ind, f"{targets} = {name}.unpack_from(view, end)")
+        self.emit(ind, f"end += {size}")
+        for line in self.post:
+            self.emit(ind, line)
+        self.run = []
+        self.post = []
+
+    def tval(self, ind: int, var: str, bt: str) -> None:
+        code = "I" if bt == "time" else "i"
+        self.run.append((1, code, f"{var}.secs"))
+        self.run.append((1, code, f"{var}.nsecs"))
+        if bt == "time":
+            self.post.append(f"if {var}.nsecs >= 1000000000:")
+        else:
+            self.post.append(f"if not 0 <= {var}.nsecs < 1000000000:")
+        self.post.append(f"    {var}.canon()")
+
+    def length(self, ind: int) -> str:
+        """Read a uint32 length/count as part of the current run; returns its variable."""
+        var = self.tmp("_n")
+        self.run.append((1, "I", var))
+        self.flush(ind)
+        return var
+
+    def string_body(self, ind: int, target: str, length: str, fpath: str) -> None:
+        self.emit(ind, f"if {length} > len(view) - end:")
+        self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {length}, len(view) - end)")
+        self.emit(ind, f"{target} = str(view[end:end + {length}], 'utf-8', 'replace')")
+        self.emit(ind, f"end += {length}")
+
+    def fields(self, spec: MsgSpec, obj: str, path: str, ind: int) -> None:
+        for f in spec.fields:
+            attr = python_name(f.name)
+            target = f"{obj}.{attr}"
+            fpath = path + attr
+            bt = f.base_type
+            if not f.is_array:
+                if bt in DESER_CODE:
+                    self.run.append((1, DESER_CODE[bt], target))
+                elif bt in ("time", "duration"):
+                    var = self.tmp("_t")
+                    cls = "Time" if bt == "time" else "Duration"
+                    self.emit(ind, f"{var} = {target} = new({cls})")
+                    self.tval(ind, var, bt)
+                elif bt == "string":
+                    n = self.length(ind)
+                    self.string_body(ind, target, n, fpath)
+                else:
+                    var = self.tmp("_m")
+                    self.emit(ind, f"{var} = {target} = new({dep_name(bt)})")
+                    self.fields(self.get_spec(bt), var, fpath + ".", ind)
+                continue
+            n = f.array_len
+            if bt in ("uint8", "char"):
+                if n is None:
+                    count = self.length(ind)
+                    self.emit(ind, f"if {count} > len(view) - end:")
+                    self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
+                    if self.numpy:
+                        self.emit(ind, f"{target} = numpy_view('B', {count}, view, end)")
+                    else:
+                        self.emit(ind, f"{target} = view[end:end + {count}].tobytes()")
+                    self.emit(ind, f"end += {count}")
+                else:
+                    self.flush(ind)
+                    if self.numpy:
+                        self.emit(ind, f"if {n} > len(view) - end:")
+                        self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {n}, len(view) - end)")
+                        self.emit(ind, f"{target} = numpy_view('B', {n}, view, end)")
+                    else:
+                        name = self.struct(f"{n}s")
+                        self.emit(ind, f"{target}, = {name}.unpack_from(view, end)")
+                    self.emit(ind, f"end += {n}")
+            elif bt in DESER_CODE:
+                code = DESER_CODE[bt]
+                size = _SIZE[code]
+                if n is None:
+                    count = self.length(ind)
+                    nbytes = self.tmp("_k")
+                    self.emit(ind, f"{nbytes} = {count} * {size}" if size != 1 else f"{nbytes} = {count}")
+                    self.emit(ind, f"if {nbytes} > len(view) - end:")
+                    self.emit(ind + 1, f"raise too_many({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
+                    self._numeric_array(ind, target, code, count, bt)
+                    self.emit(ind, f"end += {nbytes}")
+                else:
+                    self.flush(ind)
+                    if self.numpy and bt != "bool":
+                        self.emit(ind, f"if {n * size} > len(view) - end:")
+                        self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {n * size}, len(view) - end)")
+                        self.emit(ind, f"{target} = numpy_view({code!r}, {n}, view, end)")
+                    else:
+                        name = self.struct(f"{n}{code}")
+                        if bt == "bool":
+                            self.emit(ind, f"{target} = list({name}.unpack_from(view, end))")
+                        else:
+                            self.emit(ind, f"{target} = {name}.unpack_from(view, end)")
+                    self.emit(ind, f"end += {n * size}")
+            else:
+                if n is None:
+                    count = self.length(ind)
+                    if bt == "string":
+                        least = 4
+                    elif bt in ("time", "duration"):
+                        least = 8
+                    else:
+                        least = min_size(self.get_spec(bt), self.get_spec)
+                    if least:
+                        self.emit(ind, f"if {count} * {least} > len(view) - end:")
+                    else:
+                        self.emit(ind, f"if {count} > MAX_EMPTY_ELEMENTS:")
+                    self.emit(ind + 1, f"raise too_many({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
+                else:
+                    self.flush(ind)
+                    count = str(n)
+                items = self.tmp("_l")
+                self.emit(ind, f"{items} = {target} = []")
+                self.emit(ind, f"for _ in range({count}):")
+                if bt == "string":
+                    length = self.length(ind + 1)
+                    var = self.tmp("_v")
+                    self.string_body(ind + 1, var, length, fpath + "[]")
+                    self.emit(ind + 1, f"{items}.append({var})")
+                elif bt in ("time", "duration"):
+                    var = self.tmp("_t")
+                    cls = "Time" if bt == "time" else "Duration"
+                    self.emit(ind + 1, f"{var} = new({cls})")
+                    self.emit(ind + 1, f"{items}.append({var})")
+                    self.tval(ind + 1, var, bt)
+                else:
+                    var = self.tmp("_e")
+                    self.emit(ind + 1, f"{var} = new({dep_name(bt)})")
+                    self.emit(ind + 1, f"{items}.append({var})")
+                    self.fields(self.get_spec(bt), var, fpath + "[].", ind + 1)
+                self.flush(ind + 1)
+
+    def _numeric_array(self, ind: int, target: str, code: str, count: str, bt: str) -> None:
+        if bt == "bool":
+            self.emit(ind, f"{target} = list(unpack_array('?', {count}, view, end))")
+        elif self.numpy:
+            self.emit(ind, f"{target} = numpy_view({code!r}, {count}, view, end)")
+        else:
+            self.emit(ind, f"{target} = unpack_array({code!r}, {count}, view, end)")
+
+
+def default_value(type_: str, base_type: str, is_array: bool, array_len: int | None) -> str:
+    """Python expression for a field's default value (genpy's defaults)."""
+    if not is_array:
+        if base_type in _DEFAULTS:
+            return _DEFAULTS[base_type]
+        if base_type in SER_CODE:
+            return "0"
+        return f"{dep_name(base_type)}()"
+    if base_type in ("uint8", "char"):
+        return "b''" if array_len is None else f"b'\\x00' * {array_len}"
+    if array_len is None:
+        return "[]"
+    item = default_value(base_type, base_type, False, None)
+    if base_type in SER_CODE or base_type == "string":
+        return f"[{item}] * {array_len}"
+    return f"[{item} for _ in range({array_len})]"
+
+
+def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: str,
+                    module: str | None = None, numpy: bool = False) -> str:
+    """Python source defining the class for ``spec`` (named as its short name).
+
+    The module needs ``load(type_name) -> class`` in its globals for embedded types; with
+    ``numpy=True`` it also needs ``base_class`` and defines a subclass whose numeric arrays
+    deserialize as numpy views.
+    """
+    name = spec.short_name
+    structs: Dict[str, str] = {}
+    deps = []
+    for f in spec.fields:
+        if not f.is_builtin:
+            _collect_deps(f.base_type, get_spec, deps)
+    attrs = [python_name(f.name) for f in spec.fields]
+
+    ser = _SerializerGen(structs, get_spec)
+    ser.fields(spec, "self", "", 2)
+    ser.flush(2)
+    de = _DeserializerGen(structs, get_spec, spec.full_name, numpy)
+    de.fields(spec, "self", "", 2)
+    de.flush(2)
+
+    out: List[str] = []
+    origin = spec.filename or "a message definition"
+    out.append(f"# Message class for {spec.full_name}, generated by minros.msgs from {origin}.")
+    out.append("from minros.msgs.runtime import *  # noqa: F401,F403")
+    if deps:
+        out.append("")
+        out.append("# classes of the embedded message types")
+        for d in deps:
+            out.append(f"{dep_name(d)} = load({d!r})")
+    if structs:
+        out.append("")
+        out.append("# fixed-size runs of fields, packed/unpacked in one call")
+        for fmt, sname in sorted(structs.items(), key=lambda kv: kv[1]):
+            out.append(f"{sname} = Struct({'<' + fmt!r})")
+    out.append("")
+    out.append("")
+    if numpy:
+        out.append(f"class {name}(base_class):")
+        out.append(f'    """{spec.full_name} whose numeric arrays are numpy views of the received bytes."""')
+        out.append("")
+        out.append("    __slots__ = []")
+    else:
+        out.append(f"class {name}(Message):")
+        out.append(f'    """{spec.full_name} (md5sum {md5sum})."""')
+        out.append("")
+        out.append(f"    __slots__ = {attrs!r}")
+        out.append(f"    _type = {spec.full_name!r}")
+        out.append(f"    _md5sum = {md5sum!r}")
+        out.append(f"    _has_header = {spec.has_header!r}")
+        out.append(f"    _full_text = {full_text!r}")
+        out.append(f"    _slot_types = {spec.types!r}")
+        if module:
+            out.append(f"    __module__ = {module!r}")
+        if spec.constants:
+            out.append("")
+            for c in spec.constants:
+                out.append(f"    {c.name} = {c.value!r}")
+        out.append("")
+        out.append("    def __init__(self, *args, **kwds):")
+        if spec.fields:
+            out.append("        if args or kwds:")
+            out.append("            init_fields(self, args, kwds)")
+            for f, attr in zip(spec.fields, attrs):
+                out.append(f"            if self.{attr} is None:")
+                out.append(f"                self.{attr} = {default_value(f.type, f.base_type, f.is_array, f.array_len)}")
+            out.append("        else:")
+            for f, attr in zip(spec.fields, attrs):
+                out.append(f"            self.{attr} = {default_value(f.type, f.base_type, f.is_array, f.array_len)}")
+        else:
+            out.append("        init_fields(self, args, kwds)")
+        out.append("")
+        out.append("    def _serialize_parts(self, append):")
+        out.append('        """Append the wire form of this message, in pieces, with ``append``."""')
+        out.extend(ser.lines or ["        pass"])
+    out.append("")
+    out.append("    def _deserialize_from(self, view, end):")
+    out.append('        """Fill this message from ``view[end:]``; returns the offset after it."""')
+    out.extend(de.lines)
+    out.append("        return end")
+    out.append("")
+    return "\n".join(out)
+
+
+def _collect_deps(type_name: str, get_spec: GetSpec, out: List[str]) -> None:
+    if type_name in out:
+        return
+    out.append(type_name)
+    for f in get_spec(type_name).fields:
+        if not f.is_builtin:
+            _collect_deps(f.base_type, get_spec, out)

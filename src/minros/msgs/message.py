@@ -1,0 +1,355 @@
+"""The ``Message`` base class (genpy's contract) and the helpers generated code calls.
+
+Generated classes (see :mod:`minros.msgs.codegen`) provide ``_serialize_parts(append)`` and
+``_deserialize_from(view, offset) -> end``; this base turns them into genpy's public
+``serialize(buff)`` / ``deserialize(data)`` with one clear error on bad data or values.
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from typing import Any, Callable, Iterable, List
+
+from minros.exceptions import DeserializationError, SerializationError
+
+from .tval import Duration, Time, TVal
+
+__all__ = [
+    "Message", "strify_message", "check_type", "DeserializationError", "SerializationError",
+]
+
+#: Largest element count accepted for arrays whose elements occupy no bytes on the wire
+#: (e.g. ``std_msgs/Empty[]``): the count cannot be checked against the data, so bound it.
+MAX_EMPTY_ELEMENTS = 1 << 20
+
+_INT_WIDTHS = {
+    "byte": (8, True), "int8": (8, True), "int16": (16, True), "int32": (32, True),
+    "int64": (64, True), "char": (8, False), "uint8": (8, False), "uint16": (16, False),
+    "uint32": (32, False), "uint64": (64, False),
+}
+_SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
+                     UnicodeError, IndexError)
+
+
+class Message:
+    """Base class of all message classes (genpy.Message contract)."""
+
+    __slots__ = ("_connection_header",)
+    _type = ""
+    _md5sum = ""
+    _full_text = ""
+    _has_header = False
+    _slot_types: List[str] = []
+
+    def __init__(self, *args: Any, **kwds: Any) -> None:
+        # Generated classes override this; kept for hand-written subclasses.
+        _init_fields(self, args, kwds)
+
+    # -- genpy API ---------------------------------------------------------------------------
+    def _get_types(self) -> List[str]:
+        return self._slot_types
+
+    def _check_types(self, exc: BaseException | None = None) -> None:
+        """Type-check every field; raise :class:`SerializationError` naming the bad one."""
+        for name, type_ in zip(self.__slots__, self._slot_types):
+            check_type(name, type_, getattr(self, name, None))
+        if exc is not None:
+            raise SerializationError(f"{self._type}: {exc}")
+
+    def serialize(self, buff: Any) -> None:
+        """Write the wire form of this message to ``buff`` (anything with ``.write``)."""
+        parts: List[Any] = []
+        try:
+            self._serialize_parts(parts.append)
+            data = b"".join(parts)
+        except _SERIALIZE_ERRORS as exc:
+            raise _serialization_error(self, exc) from None
+        buff.write(data)
+
+    def serialize_to_bytes(self) -> bytes:
+        """The wire form of this message as ``bytes``."""
+        parts: List[Any] = []
+        try:
+            self._serialize_parts(parts.append)
+            return b"".join(parts)
+        except _SERIALIZE_ERRORS as exc:
+            raise _serialization_error(self, exc) from None
+
+    def deserialize(self, data: Any) -> Message:
+        """Fill this message from ``data`` (bytes, bytearray, memoryview); returns self.
+
+        The data must hold exactly one message: truncated data, lengths pointing past the end
+        and trailing bytes raise :class:`DeserializationError`.
+        """
+        view = data if type(data) is memoryview else memoryview(data)
+        if view.format != "B" or view.ndim != 1:
+            view = view.cast("B")
+        try:
+            end = self._deserialize_from(view, 0)
+        except struct.error:
+            raise DeserializationError(
+                f"{self._type}: message truncated ({len(view)} bytes do not hold a whole message)"
+            ) from None
+        if end != len(view):
+            raise DeserializationError(
+                f"{self._type}: {len(view) - end} unexpected bytes after the message "
+                f"({end} of {len(view)} bytes used)")
+        return self
+
+    def _serialize_parts(self, append: Callable[[Any], None]) -> None:  # pragma: no cover
+        raise NotImplementedError
+
+    def _deserialize_from(self, view: memoryview, end: int) -> int:  # pragma: no cover
+        raise NotImplementedError
+
+    # -- Python protocol ---------------------------------------------------------------------
+    def __getstate__(self) -> list:
+        return [getattr(self, name) for name in self.__slots__]
+
+    def __setstate__(self, state: list) -> None:
+        for name, value in zip(self.__slots__, state):
+            setattr(self, name, value)
+
+    def __repr__(self) -> str:
+        return strify_message(self)
+
+    def __str__(self) -> str:
+        return strify_message(self)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, self.__class__) and not isinstance(self, other.__class__):
+            return False
+        if getattr(other, "_type", None) != self._type:
+            return False
+        for name in self.__slots__:
+            try:
+                if not _values_equal(getattr(self, name), getattr(other, name)):
+                    return False
+            except AttributeError:
+                return False
+        return True
+
+    def __ne__(self, other: object) -> bool:
+        return not self == other
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, like genpy messages
+
+
+def _values_equal(a: Any, b: Any) -> bool:
+    if type(a) in (list, tuple) and type(b) in (list, tuple):
+        return len(a) == len(b) and all(_values_equal(x, y) for x, y in zip(a, b))
+    if hasattr(a, "__array__") or hasattr(b, "__array__"):
+        import numpy
+
+        return bool(numpy.array_equal(numpy.asarray(a), numpy.asarray(b)))
+    return bool(a == b)
+
+
+def _init_fields(msg: Message, args: tuple, kwds: dict) -> None:
+    """genpy's constructor rules: all fields positionally, or any subset by keyword."""
+    slots = msg.__slots__
+    if args and kwds:
+        raise TypeError("Message constructor may only use args OR keywords, not both")
+    if args:
+        if len(args) != len(slots):
+            raise TypeError(f"Invalid number of arguments, args should be {list(slots)} args are {args}")
+        for name, value in zip(slots, args):
+            setattr(msg, name, value)
+        return
+    for key in kwds:
+        if key not in slots:
+            raise AttributeError(f"{key} is not an attribute of {type(msg).__name__}")
+    for name in slots:
+        setattr(msg, name, kwds.get(name))
+
+
+# ---------------------------------------------------------------------------------------------
+# type checking (diagnosis of serialization failures)
+
+def check_type(field_name: str, field_type: str, value: Any) -> None:
+    """Raise :class:`SerializationError` if ``value`` cannot be written as ``field_type``."""
+    if field_type in _INT_WIDTHS:
+        bits, signed = _INT_WIDTHS[field_type]
+        if isinstance(value, bool) or not isinstance(value, int):
+            if not _is_numpy_integer(value):
+                raise SerializationError(
+                    f"field {field_name} must be an integer ({field_type}), not {type(value).__name__}")
+            value = int(value)
+        lower, upper = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
+        if not lower <= value <= upper:
+            raise SerializationError(
+                f"field {field_name} value {value} exceeds the range of {field_type} [{lower}, {upper}]")
+    elif field_type in ("float32", "float64"):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            if not _is_numpy_number(value):
+                raise SerializationError(
+                    f"field {field_name} must be a float ({field_type}), not {type(value).__name__}")
+        if field_type == "float32" and isinstance(value, (int, float)) and math.isfinite(value):
+            try:
+                struct.pack("<f", value)
+            except (OverflowError, struct.error):
+                raise SerializationError(
+                    f"field {field_name} value {value} is out of range for float32") from None
+    elif field_type == "bool":
+        if value not in (True, False, 0, 1):
+            raise SerializationError(f"field {field_name} is not a bool: {value!r}")
+    elif field_type == "string":
+        if isinstance(value, str):
+            try:
+                value.encode("utf-8")
+            except UnicodeEncodeError as exc:
+                raise SerializationError(f"field {field_name} cannot be encoded as UTF-8: {exc}") from None
+        elif not isinstance(value, (bytes, bytearray)):
+            raise SerializationError(f"field {field_name} must be a str, not {type(value).__name__}")
+    elif field_type == "time":
+        if not isinstance(value, Time):
+            raise SerializationError(f"field {field_name} must be a Time, not {type(value).__name__}")
+        _check_tval(field_name, value, 0, (1 << 32) - 1)
+    elif field_type == "duration":
+        if not isinstance(value, Duration):
+            raise SerializationError(f"field {field_name} must be a Duration, not {type(value).__name__}")
+        _check_tval(field_name, value, -(1 << 31), (1 << 31) - 1)
+    elif field_type.endswith("]"):
+        base, _, rest = field_type.partition("[")
+        length = int(rest[:-1]) if rest[:-1] else None
+        if base in ("uint8", "char") and _is_bytes_like(value):
+            size = len(memoryview(value).cast("B")) if not isinstance(value, (bytes, bytearray)) else len(value)
+            if length is not None and size != length:
+                raise SerializationError(
+                    f"field {field_name} must have exactly {length} bytes, not {size}")
+            return
+        if isinstance(value, (str, bytes, bytearray)) or not _is_sequence(value):
+            raise SerializationError(
+                f"field {field_name} must be a list or tuple ({field_type}), not {type(value).__name__}")
+        if length is not None and len(value) != length:
+            raise SerializationError(
+                f"field {field_name} must have exactly {length} elements, not {len(value)}")
+        for index, item in enumerate(value):
+            check_type(f"{field_name}[{index}]", base, item)
+    else:
+        if not isinstance(value, Message):
+            raise SerializationError(
+                f"field {field_name} must be a {field_type} message, not {type(value).__name__}")
+        if value._type != field_type and not (
+                field_type == "std_msgs/Header" and value._type == "roslib/Header"):
+            raise SerializationError(
+                f"field {field_name} must be a {field_type}, not a {value._type}")
+        for name, type_ in zip(value.__slots__, value._slot_types):
+            check_type(f"{field_name}.{name}", type_, getattr(value, name, None))
+
+
+def _check_tval(field_name: str, value: TVal, lower: int, upper: int) -> None:
+    for part in ("secs", "nsecs"):
+        item = getattr(value, part)
+        if not isinstance(item, int) or not lower <= item <= upper:
+            raise SerializationError(
+                f"field {field_name}.{part} value {item!r} does not fit the wire format")
+
+
+def _is_numpy_integer(value: Any) -> bool:
+    kind = getattr(getattr(value, "dtype", None), "kind", None)
+    return kind in ("i", "u") and getattr(value, "ndim", 1) == 0
+
+
+def _is_numpy_number(value: Any) -> bool:
+    kind = getattr(getattr(value, "dtype", None), "kind", None)
+    return kind in ("i", "u", "f") and getattr(value, "ndim", 1) == 0
+
+
+def _is_bytes_like(value: Any) -> bool:
+    if isinstance(value, (bytes, bytearray, memoryview)):
+        return True
+    return hasattr(value, "__array_interface__") and getattr(value, "dtype", None) is not None \
+        and value.dtype.kind in ("u", "i") and value.dtype.itemsize == 1
+
+
+def _is_sequence(value: Any) -> bool:
+    return isinstance(value, (list, tuple)) or hasattr(value, "__array_interface__")
+
+
+def _serialization_error(msg: Message, exc: BaseException) -> SerializationError:
+    """Find the field that made serialization fail and say so."""
+    try:
+        msg._check_types()
+    except SerializationError as found:
+        return SerializationError(f"{msg._type}: {found}")
+    return SerializationError(f"{msg._type}: cannot serialize: {type(exc).__name__}: {exc}")
+
+
+# ---------------------------------------------------------------------------------------------
+# YAML-like text (genpy.strify_message)
+
+def _yaml_quote(text: str) -> str:
+    import yaml  # only when printing: keeps message import fast
+
+    return yaml.dump(text, default_style='"').rstrip("\n")
+
+
+def strify_message(val: Any, indent: str = "", time_offset: Time | None = None,
+                   current_time: Time | None = None, field_filter: Callable | None = None,
+                   fixed_numeric_width: int | None = None) -> str:
+    """YAML-like text of a message or value, formatted exactly as genpy does."""
+    type_ = type(val)
+    if type_ in (int, float) and fixed_numeric_width is not None:
+        if type_ is float:
+            num_str = ("%." + str(fixed_numeric_width) + "f") % val
+            return num_str[:max(num_str.find("."), fixed_numeric_width)]
+        return ("%" + str(fixed_numeric_width) + "d") % val
+    if type_ in (int, float, bool):
+        return str(val)
+    if isinstance(val, str):
+        if not val:
+            return "''"
+        return _yaml_quote(val)
+    if isinstance(val, TVal):
+        if time_offset is not None and isinstance(val, Time):
+            val = val - time_offset
+        if fixed_numeric_width is not None:
+            fmt = "%" + str(fixed_numeric_width) + "d"
+            return f"\n{indent}secs: " + (fmt % val.secs) + f"\n{indent}nsecs: " + (fmt % val.nsecs)
+        return f"\n{indent}secs: {val.secs}\n{indent}nsecs: {val.nsecs:9d}"
+    if type_ in (list, tuple):
+        if len(val) == 0:
+            return "[]"
+        val0 = val[0]
+        if type(val0) in (int, float) and fixed_numeric_width is not None:
+            return "[" + ", ".join(strify_message(v, indent, time_offset, current_time, field_filter,
+                                                   fixed_numeric_width) for v in val) + "]"
+        if isinstance(val0, str):
+            import yaml
+
+            text = yaml.dump(list(val)).rstrip("\n")
+            if text[0] == "[":
+                return text
+            return "\n" + "\n".join(indent + line for line in text.splitlines())
+        if type(val0) in (int, float, bool):
+            return str(list(val))
+        pref = indent + "- "
+        indent = indent + "  "
+        return "\n" + "\n".join(pref + strify_message(v, indent, time_offset, current_time,
+                                                      field_filter, fixed_numeric_width) for v in val)
+    if isinstance(val, Message):
+        fields: Iterable[str] = list(field_filter(val)) if field_filter is not None else val.__slots__
+        sub_indent = "  " + indent
+        lines = [
+            "{}{}: {}".format(indent, name, strify_message(_convert_getattr(val, name, type_name), sub_indent,
+                                                      time_offset, current_time, field_filter,
+                                                      fixed_numeric_width))
+            for name, type_name in zip(val.__slots__, val._slot_types) if name in fields
+        ]
+        text = "\n".join(lines)
+        return "\n" + text if indent else text
+    if hasattr(val, "__array_interface__") and hasattr(val, "tolist"):
+        return strify_message(val.tolist(), indent, time_offset, current_time, field_filter,
+                              fixed_numeric_width)
+    return str(val)
+
+
+def _convert_getattr(msg: Message, name: str, type_name: str) -> Any:
+    value = getattr(msg, name)
+    if "uint8[" in type_name and isinstance(value, (bytes, bytearray, memoryview)):
+        return list(bytes(value))
+    if "uint8[" in type_name and isinstance(value, str):
+        return [ord(c) for c in value]
+    return value

@@ -1,0 +1,330 @@
+"""The message registry: finds definitions, computes md5 sums and full texts, builds classes.
+
+A :class:`MsgContext` holds parsed specs and the classes generated from them. The global
+context (:data:`REGISTRY`) loads ``pkg/msg/Type.msg`` and ``pkg/srv/Type.srv`` on demand from
+the packages :func:`minros.packages.find_package` finds (ROS_PACKAGE_PATH, then the ones
+minros ships); :func:`generate_dynamic` uses a private context filled from a
+``message_definition`` text instead.
+"""
+
+from __future__ import annotations
+
+import linecache
+import threading
+from pathlib import Path
+from typing import Any, Dict, List, Tuple
+
+from . import runtime
+from .codegen import generate_source
+from .message import Message
+from .spec import (
+    HEADER,
+    HEADER_FULL_NAME,
+    MsgSpec,
+    MsgSpecError,
+    SrvSpec,
+    compute_full_text,
+    compute_md5_text,
+    md5_hex,
+    parse_msg,
+    parse_srv,
+    split_full_text,
+)
+
+_RUNTIME_NAMES = {name: getattr(runtime, name) for name in runtime.__all__}
+
+
+class UnknownTypeError(LookupError):
+    """A message or service type could not be found; the text says where minros looked."""
+
+    def __init__(self, type_name: str, reason: str) -> None:
+        self.type_name = type_name
+        super().__init__(reason)
+
+
+class ServiceDefinition:
+    """Base of service classes: ``_type``, ``_md5sum``, ``_request_class``, ``_response_class``."""
+
+    __slots__ = ()
+    _type = ""
+    _md5sum = ""
+    _request_class: type = Message
+    _response_class: type = Message
+
+
+def normalize_type(type_name: str) -> str:
+    """'Header' -> 'std_msgs/Header'; 'pkg/msg/Type' (ROS 2/rosbags style) -> 'pkg/Type'."""
+    name = type_name.strip()
+    if name == HEADER:
+        return HEADER_FULL_NAME
+    parts = name.split("/")
+    if len(parts) == 3 and parts[1] in ("msg", "srv"):
+        return f"{parts[0]}/{parts[2]}"
+    return name
+
+
+def _split_type(type_name: str, kind: str) -> Tuple[str, str]:
+    package, sep, short = type_name.partition("/")
+    if not sep or not package or not short or "/" in short:
+        raise UnknownTypeError(type_name, f"invalid {kind} type [{type_name}]: expected 'package/Type'")
+    return package, short
+
+
+class MsgContext:
+    """Specs, md5 sums, full texts and classes of a set of message types."""
+
+    def __init__(self, search: bool = True, module_name: str | None = None) -> None:
+        self._search = search
+        self._module_name = module_name
+        self._lock = threading.RLock()
+        self._specs: Dict[str, MsgSpec] = {}
+        self._srv_specs: Dict[str, SrvSpec] = {}
+        self._from_srv: Dict[str, str] = {}  # Request/Response type -> service type
+        self._md5: Dict[str, str] = {}
+        self._classes: Dict[str, type] = {}
+        self._numpy_classes: Dict[type, type] = {}
+        self._srv_classes: Dict[str, type] = {}
+
+    # -- specs -------------------------------------------------------------------------------
+    def add_spec(self, spec: MsgSpec) -> None:
+        with self._lock:
+            self._specs[spec.full_name] = spec
+
+    def _find_file(self, type_name: str, kind: str) -> Path:
+        from minros.packages import BUILTIN_SHARE_DIRS, find_package, ros_package_path
+
+        package, short = _split_type(type_name, "service" if kind == "srv" else "message")
+        if not self._search:
+            raise UnknownTypeError(type_name, f"Cannot locate message [{type_name}]: "
+                                              f"it is not part of the message definition")
+        package_dir = find_package(package)
+        if package_dir is None:
+            where = [str(p) for p in ros_package_path()] + [str(p) for p in BUILTIN_SHARE_DIRS]
+            raise UnknownTypeError(
+                type_name, f"Cannot locate {'service' if kind == 'srv' else 'message'} "
+                           f"[{type_name}]: package [{package}] not found (searched ROS_PACKAGE_PATH "
+                           f"and minros's bundled packages: {', '.join(where) or 'nothing'})")
+        path = package_dir / kind / f"{short}.{kind}"
+        if not path.is_file():
+            raise UnknownTypeError(
+                type_name, f"Cannot locate {'service' if kind == 'srv' else 'message'} "
+                           f"[{type_name}]: no file {kind}/{short}.{kind} in package "
+                           f"[{package}] ({package_dir})")
+        return path
+
+    def get_spec(self, type_name: str) -> MsgSpec:
+        """The spec of message type ``type_name`` (loads it on first use)."""
+        type_name = normalize_type(type_name)
+        spec = self._specs.get(type_name)
+        if spec is not None:
+            return spec
+        with self._lock:
+            spec = self._specs.get(type_name)
+            if spec is not None:
+                return spec
+            try:
+                path = self._find_file(type_name, "msg")
+            except UnknownTypeError:
+                for suffix in ("Request", "Response"):
+                    if type_name.endswith(suffix) and len(type_name) > len(suffix):
+                        try:
+                            srv = self.get_srv_spec(type_name[:-len(suffix)])
+                        except UnknownTypeError:
+                            break
+                        return srv.request if suffix == "Request" else srv.response
+                raise
+            text = _read_text(path)
+            spec = parse_msg(text, type_name, str(path))
+            self._specs[type_name] = spec
+            return spec
+
+    def get_srv_spec(self, type_name: str) -> SrvSpec:
+        """The spec of service type ``type_name``."""
+        type_name = normalize_type(type_name)
+        spec = self._srv_specs.get(type_name)
+        if spec is not None:
+            return spec
+        with self._lock:
+            spec = self._srv_specs.get(type_name)
+            if spec is not None:
+                return spec
+            path = self._find_file(type_name, "srv")
+            spec = parse_srv(_read_text(path), type_name, str(path))
+            self._srv_specs[type_name] = spec
+            for part in (spec.request, spec.response):
+                self._specs[part.full_name] = part
+                self._from_srv[part.full_name] = type_name
+            return spec
+
+    # -- derived texts -------------------------------------------------------------------------
+    def md5_text(self, type_name: str) -> str:
+        return compute_md5_text(self.get_spec(type_name), self.md5sum)
+
+    def md5sum(self, type_name: str) -> str:
+        """genmsg's md5 sum of message type ``type_name``."""
+        type_name = normalize_type(type_name)
+        value = self._md5.get(type_name)
+        if value is None:
+            with self._lock:
+                spec = self.get_spec(type_name)
+                self._check_acyclic(spec)
+                value = md5_hex(compute_md5_text(spec, self.md5sum))
+                self._md5[type_name] = value
+        return value
+
+    def srv_md5sum(self, type_name: str) -> str:
+        """md5 sum of service type ``type_name`` (request text + response text)."""
+        spec = self.get_srv_spec(type_name)
+        return md5_hex(compute_md5_text(spec.request, self.md5sum)
+                       + compute_md5_text(spec.response, self.md5sum))
+
+    def full_text(self, type_name: str) -> str:
+        """The ``message_definition`` of message type ``type_name``."""
+        return compute_full_text(self.get_spec(type_name), self.get_spec)
+
+    def _check_acyclic(self, spec: MsgSpec) -> None:
+        from .spec import all_dependencies
+
+        all_dependencies(spec, self.get_spec)
+
+    # -- classes -------------------------------------------------------------------------------
+    def source(self, type_name: str, numpy: bool = False) -> str:
+        """The generated Python source of the class for ``type_name``."""
+        type_name = normalize_type(type_name)
+        spec = self.get_spec(type_name)
+        return generate_source(spec, self.get_spec, self.md5sum(type_name),
+                               self.full_text(type_name), self._module_for(type_name), numpy)
+
+    def _module_for(self, type_name: str) -> str | None:
+        if self._module_name is not None:
+            return self._module_name
+        package = type_name.partition("/")[0]
+        return f"{package}.srv" if type_name in self._from_srv else f"{package}.msg"
+
+    def get_class(self, type_name: str) -> type:
+        """The message class of ``type_name`` (generated and compiled once)."""
+        cls = self._classes.get(type_name)
+        if cls is not None:
+            return cls
+        type_name = normalize_type(type_name)
+        with self._lock:
+            cls = self._classes.get(type_name)
+            if cls is None:
+                cls = self._compile(type_name, self.source(type_name), None)
+                self._classes[type_name] = cls
+            return cls
+
+    def get_numpy_class(self, cls: type) -> type:
+        """The ``numpy_msg`` variant of message class ``cls``."""
+        found = self._numpy_classes.get(cls)
+        if found is not None:
+            return found
+        with self._lock:
+            found = self._numpy_classes.get(cls)
+            if found is None:
+                found = self._compile(cls._type, self.source(cls._type, numpy=True), cls)
+                self._numpy_classes[cls] = found
+            return found
+
+    def _compile(self, type_name: str, source: str, base_class: type | None) -> type:
+        filename = f"<minros msg {type_name}{' numpy' if base_class else ''}>"
+        linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
+        namespace: Dict[str, Any] = dict(_RUNTIME_NAMES)
+        namespace["load"] = self.get_class
+        namespace["__name__"] = self._module_for(type_name) or "minros.msgs.generated"
+        if base_class is not None:
+            namespace["base_class"] = base_class
+        exec(compile(source, filename, "exec"), namespace)
+        cls = namespace[type_name.rpartition("/")[2]]
+        cls._context = self  # numpy_msg() and tools find the registry a class came from
+        return cls
+
+    def get_service_class(self, type_name: str) -> type:
+        """The service class of ``type_name`` with its request and response classes."""
+        type_name = normalize_type(type_name)
+        cls = self._srv_classes.get(type_name)
+        if cls is not None:
+            return cls
+        with self._lock:
+            cls = self._srv_classes.get(type_name)
+            if cls is not None:
+                return cls
+            spec = self.get_srv_spec(type_name)
+            request = self.get_class(spec.request.full_name)
+            response = self.get_class(spec.response.full_name)
+            cls = type(spec.short_name, (ServiceDefinition,), {
+                "__slots__": (),
+                "__module__": f"{spec.package}.srv",
+                "__doc__": f"{type_name} (md5sum {self.srv_md5sum(type_name)}).",
+                "_type": type_name,
+                "_md5sum": self.srv_md5sum(type_name),
+                "_request_class": request,
+                "_response_class": response,
+            })
+            self._srv_classes[type_name] = cls
+            return cls
+
+
+def _read_text(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MsgSpecError(f"cannot read: {exc}", str(path)) from None
+
+
+#: The process-wide registry of message and service types.
+REGISTRY = MsgContext()
+
+
+def get_message_class(type_name: str) -> type:
+    """The class of message type ``type_name`` ('pkg/Type'); raises :class:`UnknownTypeError`."""
+    return REGISTRY.get_class(type_name)
+
+
+def get_service_class(type_name: str) -> type:
+    """The class of service type ``type_name``; raises :class:`UnknownTypeError`."""
+    return REGISTRY.get_service_class(type_name)
+
+
+def numpy_msg(cls: type) -> type:
+    """The variant of message class ``cls`` whose numeric arrays deserialize as numpy views."""
+    context = getattr(cls, "_context", None) or REGISTRY
+    return context.get_numpy_class(cls)
+
+
+_dynamic_cache: Dict[Tuple[str, str], Dict[str, type]] = {}
+_dynamic_lock = threading.Lock()
+
+
+def generate_dynamic(core_type: str, full_text: str) -> Dict[str, type]:
+    """Classes for ``core_type`` and every type in its ``message_definition`` text.
+
+    The equivalent of genpy.dynamic.generate_dynamic (what rostopic echo and rosbag use):
+    the text is split on the 80-'=' lines and ``MSG: pkg/Type`` headers; the result maps
+    each type name to a fresh class (not registered globally).
+    """
+    key = (core_type, full_text)
+    with _dynamic_lock:
+        found = _dynamic_cache.get(key)
+    if found is not None:
+        return dict(found)
+    context = MsgContext(search=False, module_name="minros.msgs.dynamic")
+    core_type = normalize_type(core_type)
+    blocks = split_full_text(full_text)
+    types: List[str] = []
+    for block_type, text in blocks:
+        name = core_type if block_type is None else normalize_type(block_type)
+        context.add_spec(parse_msg(text, name, f"<message_definition of {core_type}: {name}>"))
+        types.append(name)
+    classes = {name: context.get_class(name) for name in types}
+    with _dynamic_lock:
+        if len(_dynamic_cache) > 256:
+            _dynamic_cache.clear()
+        _dynamic_cache[key] = classes
+    return dict(classes)
+
+
+def message_sources(type_name: str) -> str:
+    """The generated source of ``type_name``'s class (for ``minros msg gen``)."""
+    return REGISTRY.source(type_name)
+

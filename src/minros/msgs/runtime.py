@@ -1,0 +1,137 @@
+"""Names the generated message code uses (imported by every generated module).
+
+Kept small and explicit so the printed source of a message class (``minros msg gen``) reads
+like ordinary Python: ``from minros.msgs.runtime import *`` brings exactly these.
+"""
+
+from __future__ import annotations
+
+import struct
+from struct import Struct
+from typing import Any, Callable
+
+from minros.exceptions import DeserializationError, SerializationError
+
+from .message import MAX_EMPTY_ELEMENTS, Message, _init_fields
+from .tval import Duration, Time
+
+__all__ = [
+    "Struct", "Message", "Time", "Duration", "new", "S_I", "overrun", "too_many",
+    "put_array", "put_fixed_array", "put_bytes", "put_fixed_bytes", "unpack_array",
+    "numpy_view", "bad_length", "MAX_EMPTY_ELEMENTS", "DeserializationError",
+    "SerializationError", "as_bytes", "as_list", "init_fields",
+]
+
+#: genpy's constructor rules (all fields positionally, or any by keyword)
+init_fields = _init_fields
+
+#: ``new(Cls)`` makes an instance without running ``__init__`` (deserialization fills it).
+new = object.__new__
+#: the uint32 used for every length and count prefix
+S_I = Struct("<I")
+
+_ITEM_SIZE = {"b": 1, "B": 1, "?": 1, "h": 2, "H": 2, "i": 4, "I": 4, "q": 8, "Q": 8,
+              "f": 4, "d": 8}
+_NUMPY_DTYPE = {"b": "<i1", "B": "<u1", "?": "bool", "h": "<i2", "H": "<u2", "i": "<i4",
+                "I": "<u4", "q": "<i8", "Q": "<u8", "f": "<f4", "d": "<f8"}
+
+
+def overrun(type_: str, field: str, need: int, have: int) -> DeserializationError:
+    """The error for a length field that points past the end of the data."""
+    return DeserializationError(
+        f"{type_}: field {field} needs {need} bytes but only {have} remain (truncated data "
+        f"or a bad length)")
+
+
+def too_many(type_: str, field: str, count: int, have: int) -> DeserializationError:
+    """The error for an element count the remaining data cannot hold."""
+    return DeserializationError(
+        f"{type_}: field {field} claims {count} elements but only {have} bytes remain")
+
+
+def bad_length(field: str, want: int, got: int) -> SerializationError:
+    return SerializationError(f"field {field} must have exactly {want} elements, not {got}")
+
+
+def _numpy_bytes(code: str, value: Any) -> memoryview:
+    import numpy
+
+    array = numpy.ascontiguousarray(value, dtype=_NUMPY_DTYPE[code]).reshape(-1)
+    return memoryview(array).cast("B")
+
+
+def put_array(append: Callable[[Any], None], code: str, value: Any) -> None:
+    """Append a variable-length numeric array: uint32 count, then the items."""
+    if value.__class__ is list or value.__class__ is tuple:
+        count = len(value)
+        append(S_I.pack(count))
+        append(struct.pack(f"<{count}{code}", *value))
+        return
+    if isinstance(value, (str, bytes, bytearray)):
+        raise TypeError(f"expected a sequence of numbers, got {type(value).__name__}")
+    data = _numpy_bytes(code, value)
+    append(S_I.pack(len(data) // _ITEM_SIZE[code]))
+    append(data)
+
+
+def put_fixed_array(append: Callable[[Any], None], code: str, length: int, value: Any,
+                    field: str) -> None:
+    """Append a fixed-length numeric array (no count on the wire)."""
+    if value.__class__ is list or value.__class__ is tuple:
+        if len(value) != length:
+            raise bad_length(field, length, len(value))
+        append(struct.pack(f"<{length}{code}", *value))
+        return
+    if isinstance(value, (str, bytes, bytearray)):
+        raise TypeError(f"expected a sequence of numbers, got {type(value).__name__}")
+    data = _numpy_bytes(code, value)
+    if len(data) != length * _ITEM_SIZE[code]:
+        raise bad_length(field, length, len(data) // _ITEM_SIZE[code])
+    append(data)
+
+
+def as_bytes(value: Any) -> Any:
+    """A ``uint8[]`` value (bytes, list of ints, numpy array, ...) as a bytes-like object."""
+    cls = value.__class__
+    if cls is bytes or cls is bytearray:
+        return value
+    if cls is list or cls is tuple:
+        return bytes(value)
+    if cls is str:  # genpy (py2 heritage) accepts a str of latin-1 characters
+        return value.encode("latin-1")
+    view = memoryview(value)
+    return view if view.format == "B" and view.ndim == 1 else view.cast("B")
+
+
+def put_bytes(append: Callable[[Any], None], value: Any) -> None:
+    """Append a ``uint8[]``/``char[]``: uint32 length then the raw bytes."""
+    data = as_bytes(value)
+    append(S_I.pack(len(data)))
+    append(data)
+
+
+def put_fixed_bytes(append: Callable[[Any], None], length: int, value: Any, field: str) -> None:
+    """Append a ``uint8[N]``/``char[N]``: exactly N raw bytes."""
+    data = as_bytes(value)
+    if len(data) != length:
+        raise bad_length(field, length, len(data))
+    append(data)
+
+
+def unpack_array(code: str, count: int, view: memoryview, offset: int) -> tuple:
+    """Unpack ``count`` numeric items (the caller checked the size)."""
+    return struct.unpack_from(f"<{count}{code}", view, offset)
+
+
+def numpy_view(code: str, count: int, view: memoryview, offset: int) -> Any:
+    """A numpy array over the received bytes (no copy), for ``numpy_msg`` classes."""
+    import numpy
+
+    return numpy.frombuffer(view, dtype=_NUMPY_DTYPE[code], count=count, offset=offset)
+
+
+def as_list(value: Any, length: int, field: str) -> list:
+    """A fixed-length array value that is not a list/tuple (e.g. a numpy array) as a list."""
+    if isinstance(value, (str, bytes, bytearray)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"field {field} must be a sequence, not {type(value).__name__}")
+    return list(value)

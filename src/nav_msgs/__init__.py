@@ -1,0 +1,1 @@
+"""nav_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""roscpp: message package stand-in provided by minros."""

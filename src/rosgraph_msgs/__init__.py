@@ -1,0 +1,1 @@
+"""rosgraph_msgs: message package stand-in provided by minros."""

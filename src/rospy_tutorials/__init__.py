@@ -1,0 +1,1 @@
+"""rospy_tutorials: message package stand-in provided by minros."""

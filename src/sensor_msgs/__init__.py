@@ -1,0 +1,1 @@
+"""sensor_msgs: message package stand-in provided by minros."""

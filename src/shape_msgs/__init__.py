@@ -1,0 +1,1 @@
+"""shape_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""std_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""std_srvs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""stereo_msgs: message package stand-in provided by minros."""

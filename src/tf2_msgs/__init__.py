@@ -1,0 +1,1 @@
+"""tf2_msgs: message package stand-in provided by minros."""

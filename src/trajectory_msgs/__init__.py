@@ -1,0 +1,1 @@
+"""trajectory_msgs: message package stand-in provided by minros."""

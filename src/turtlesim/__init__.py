@@ -1,0 +1,1 @@
+"""turtlesim: message package stand-in provided by minros."""

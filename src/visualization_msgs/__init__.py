@@ -1,0 +1,1 @@
+"""visualization_msgs: message package stand-in provided by minros."""
