@@ -1,0 +1,1 @@
+"""roslaunch for minros: XML loader, substitution args, process monitor."""
