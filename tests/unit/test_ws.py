@@ -152,3 +152,25 @@ def test_env_sh_runs_command_in_workspace(tmp_path: Path):
     out = subprocess.run([str(ws / "devel" / "env.sh"), "sh", "-c", "echo $ROS_PACKAGE_PATH"],
                          env={"PATH": "/usr/bin:/bin"}, capture_output=True, text=True, timeout=30)
     assert out.stdout.strip() == str(ws / "src")
+
+
+def test_make_generates_importable_messages_and_rejects_malformed(tmp_path: Path):
+    ws = tmp_path / "ws"
+    (ws / "src").mkdir(parents=True)
+    pkg = catkin.create_package("ws_msgs_pkg", ["rospy", "std_msgs"], ws / "src", out=lambda s: None)
+    (pkg / "msg").mkdir()
+    (pkg / "msg" / "Num.msg").write_text("int64 num\nstring label\n")
+    (pkg / "srv").mkdir()
+    (pkg / "srv" / "AddTwo.srv").write_text("int64 a\nint64 b\n---\nint64 sum\n")
+    lines, out = _collect()
+    catkin.make_workspace(ws, out=out)
+    assert "-- ws_msgs_pkg: 1 messages, 1 services" in lines
+    printed = _bash(
+        "source devel/setup.bash && cd / && python -c '"
+        "from ws_msgs_pkg.msg import Num; from ws_msgs_pkg.srv import AddTwo, AddTwoRequest; "
+        "m = Num(num=7, label=\"x\"); print(m._type, m.num, m.label, AddTwoRequest(1, 2).b)'",
+        ws, {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)})
+    assert printed.split() == ["ws_msgs_pkg/Num", "7", "x", "2"]
+    (pkg / "msg" / "Broken.msg").write_text("int64 num\nnot_a_type@ x\n")
+    with pytest.raises(WorkspaceError, match=r"Broken.msg: "):
+        catkin.make_workspace(ws, out=lambda s: None)

@@ -12,6 +12,7 @@ user sees it (``catkin_create_pkg``) and catkin_make's shape elsewhere.
 from __future__ import annotations
 
 import getpass
+import os
 import re
 import shlex
 import sys
@@ -375,19 +376,32 @@ def _interface_counts(pkg: Path) -> Dict[str, int]:
     return {kind: len(list((pkg / kind).glob(f"*.{kind}"))) for kind in ("msg", "srv", "action")}
 
 
-def _write_message_stubs(name: str, dist_packages: Path) -> None:
-    """Generate ``<name>.msg`` / ``<name>.srv`` modules in the devel space (helper A's writer)."""
+def _write_message_stubs(manifest: Manifest, dist_packages: Path, src: Path) -> None:
+    """Check the package's .msg/.srv files and write its ``<pkg>.msg``/``<pkg>.srv`` stubs.
+
+    The stubs (helper A's writer) generate classes on first use from the package's files, found
+    on ROS_PACKAGE_PATH; here the workspace's src is put in front for the check, so a malformed
+    definition fails the build, as genmsg would, instead of the first node that imports it.
+    """
     from minros import msgs  # imported late: only packages with messages need it
 
-    writer = getattr(msgs, "write_stub_package", None)
-    if writer is None:
-        raise WorkspaceError("this minros cannot generate message modules (minros.msgs.write_stub_package missing)")
+    name = manifest.name
+    previous = os.environ.get("ROS_PACKAGE_PATH")
+    os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join([str(src)] + ([previous] if previous else []))
     try:
-        writer(name, dist_packages)
-    except WorkspaceError:
-        raise
-    except Exception as exc:  # a malformed .msg: one line naming it
-        raise WorkspaceError(f"{name}: message generation failed: {exc}") from None
+        for kind, getter in (("msg", msgs.get_message_class), ("srv", msgs.get_service_class)):
+            for path in sorted((manifest.path / kind).glob(f"*.{kind}")):
+                try:
+                    getter(f"{name}/{path.stem}")
+                except Exception as exc:  # a malformed definition: one line naming the file
+                    text = str(exc).replace("\n", " ")
+                    raise WorkspaceError(f"{path}: {text}") from None
+        msgs.write_stub_package(name, dist_packages)
+    finally:
+        if previous is None:
+            os.environ.pop("ROS_PACKAGE_PATH", None)
+        else:
+            os.environ["ROS_PACKAGE_PATH"] = previous
 
 
 def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _print) -> List[Manifest]:
@@ -429,7 +443,7 @@ def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _pr
         counts = _interface_counts(m.path)
         if any(counts.values()):
             out(f"-- {m.name}: {counts['msg']} messages, {counts['srv']} services")
-            _write_message_stubs(m.name, dist)
+            _write_message_stubs(m, dist, src)
         module_src = m.path / "src" / m.name
         if (module_src / "__init__.py").is_file():
             init = dist / m.name / "__init__.py"
