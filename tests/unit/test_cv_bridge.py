@@ -1,0 +1,98 @@
+"""cv_bridge stand-in: encodings, zero-copy views, conversions, and agreement with Debian's."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from cv_bridge import CvBridge, CvBridgeError, getCvType
+from sensor_msgs.msg import CompressedImage, Image
+from support import REFERENCE_PYTHON, reference_env, require_reference
+
+ENCODINGS = ["rgb8", "rgba8", "rgb16", "rgba16", "bgr8", "bgra8", "bgr16", "bgra16", "mono8",
+             "mono16", "bayer_rggb8", "bayer_grbg16", "yuv422", "8UC1", "8UC3", "16SC2", "32FC1",
+             "64FC4", "32SC3", "8SC4"]
+
+
+def _roundtrip(msg: Image) -> Image:
+    buff = io.BytesIO()
+    msg.serialize(buff)
+    return Image().deserialize(buff.getvalue())
+
+
+def test_passthrough_is_a_view_onto_the_message_data():
+    bridge = CvBridge()
+    image = np.random.default_rng(1).integers(0, 255, (48, 64, 3), dtype=np.uint8)
+    msg = _roundtrip(bridge.cv2_to_imgmsg(image, "bgr8"))
+    assert (msg.encoding, msg.height, msg.width, msg.step) == ("bgr8", 48, 64, 192)
+    view = bridge.imgmsg_to_cv2(msg)
+    assert np.array_equal(view, image)
+    assert np.shares_memory(view, np.frombuffer(msg.data, dtype=np.uint8))
+
+
+def test_passthrough_encoding_names_the_opencv_type():
+    bridge = CvBridge()
+    assert bridge.cv2_to_imgmsg(np.zeros((2, 2, 3), np.uint8)).encoding == "8UC3"
+    assert bridge.cv2_to_imgmsg(np.zeros((2, 2), np.float32)).encoding == "32FC1"
+
+
+def test_colour_and_depth_conversions():
+    bridge = CvBridge()
+    bgr = np.zeros((2, 2, 3), np.uint8)
+    bgr[..., 0] = 255  # blue
+    msg = bridge.cv2_to_imgmsg(bgr, "bgr8")
+    assert bridge.imgmsg_to_cv2(msg, "rgb8")[0, 0].tolist() == [0, 0, 255]
+    assert bridge.imgmsg_to_cv2(msg, "mono8").shape == (2, 2)
+    as16 = bridge.imgmsg_to_cv2(msg, "bgr16")
+    assert as16.dtype == np.uint16 and as16[0, 0, 0] == 65535
+
+
+def test_bad_input_raises_cvbridgeerror():
+    bridge = CvBridge()
+    with pytest.raises(CvBridgeError, match="incompatible type"):
+        bridge.cv2_to_imgmsg(np.zeros((2, 2), np.uint8), "bgr8")
+    with pytest.raises(CvBridgeError, match="Unrecognized image encoding"):
+        bridge.imgmsg_to_cv2(Image(height=1, width=1, encoding="nonsense", data=b"\0"))
+    with pytest.raises(CvBridgeError, match="too short"):
+        bridge.imgmsg_to_cv2(Image(height=4, width=4, encoding="bgr8", step=12, data=b"\0" * 10))
+    with pytest.raises(TypeError):
+        bridge.cv2_to_imgmsg([[1, 2], [3, 4]])
+
+
+def test_compressed_roundtrip():
+    bridge = CvBridge()
+    image = np.full((16, 16, 3), 200, np.uint8)
+    msg = bridge.cv2_to_compressed_imgmsg(image, "png")
+    assert isinstance(msg, CompressedImage) and msg.format == "png"
+    assert np.array_equal(bridge.compressed_imgmsg_to_cv2(msg), image)
+
+
+def test_matches_debians_cv_bridge():
+    """getCvType and cv2_to_imgmsg fields agree with Debian's python3-cv-bridge."""
+    require_reference()
+    script = (
+        "import json, numpy as np\n"
+        "from cv_bridge import CvBridge\n"
+        "from cv_bridge.boost.cv_bridge_boost import getCvType\n"
+        f"encs = {ENCODINGS!r}\n"
+        "im = (np.arange(5*7*3) % 251).astype(np.uint8).reshape(5, 7, 3)\n"
+        "m = CvBridge().cv2_to_imgmsg(im, 'bgr8')\n"
+        "print(json.dumps({'types': [getCvType(e) for e in encs], 'msg': [m.height, m.width, "
+        "m.encoding, m.is_bigendian, m.step, m.data.hex()], "
+        "'rgb': CvBridge().imgmsg_to_cv2(m, 'rgb8').tobytes().hex()}))\n"
+    )
+    out = subprocess.run([REFERENCE_PYTHON, "-c", script], env=reference_env({}),
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    ref = json.loads(out.stdout)
+    assert [getCvType(e) for e in ENCODINGS] == ref["types"]
+    image = (np.arange(5 * 7 * 3) % 251).astype(np.uint8).reshape(5, 7, 3)
+    bridge = CvBridge()
+    msg = bridge.cv2_to_imgmsg(image, "bgr8")
+    assert [msg.height, msg.width, msg.encoding, msg.is_bigendian, msg.step,
+            msg.data.hex()] == ref["msg"]
+    assert bridge.imgmsg_to_cv2(msg, "rgb8").tobytes().hex() == ref["rgb"]
