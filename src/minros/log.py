@@ -181,6 +181,8 @@ def _install_console_handler() -> logging.Logger:
 
 
 _install_console_handler()
+# rospy's internal loggers ('rospy.*') stay silent unless the user configures logging
+logging.getLogger("rospy").addHandler(logging.NullHandler())
 
 
 # --------------------------------------------------------------------------- /rosout
@@ -220,9 +222,8 @@ class RosoutHandler(logging.Handler):
             return
         _rosout.local.busy = True
         try:
-            from rosgraph_msgs.msg import Log
-
             from minros import rostime
+            from rosgraph_msgs.msg import Log
 
             try:
                 disable_topics = _get_param_cached("/rosout_disable_topics_generation", False)
@@ -290,9 +291,8 @@ def _start_node_logging(caller_id: str, log_level: int | None, disable_rosout: b
         _rosout.handler = RosoutHandler()
         logger.addHandler(_rosout.handler)
     if not _rosout.services:
-        from roscpp.srv import GetLoggers, SetLoggerLevel
-
         from minros.services import Service
+        from roscpp.srv import GetLoggers, SetLoggerLevel
 
         _rosout.services = [
             Service("~get_loggers", GetLoggers, _get_loggers),

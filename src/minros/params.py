@@ -1,0 +1,311 @@
+"""The parameter server from a node: rospy's get/set/has/delete/search_param and friends.
+
+Names resolve like every other graph name (caller's namespace, ``~`` = the node's private
+namespace, remappings applied to the resolved name). ``get_param_cached`` subscribes to the key
+on the master (``subscribeParam``) and keeps a local tree fresh from the master's
+``paramUpdate`` calls; plain ``get_param`` answers from that tree too once a key is cached, and
+``set_param`` updates it, as rospy does.
+
+The first section holds the node context shared with ``minros.services``: both work before
+``init_node`` (caller id ``/unnamed``, master from ``__master:=`` or ``ROS_MASTER_URI``).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+import warnings
+from typing import Any, Dict, List
+
+from minros import names
+from minros.exceptions import ROSException
+
+__all__ = [
+    "delete_param",
+    "get_param",
+    "get_param_cached",
+    "get_param_names",
+    "has_param",
+    "search_param",
+    "set_param",
+]
+
+DEFAULT_MASTER_URI = "http://localhost:11311/"
+#: seconds to wait for the master to answer one XML-RPC call
+MASTER_TIMEOUT = 10.0
+
+
+# --------------------------------------------------------------------------- node context
+
+def _node_module():
+    try:
+        from minros import node
+    except ImportError:  # this layer is usable (and unit-testable) without the node runtime
+        return None
+    return node
+
+
+def _caller_id() -> str:
+    node = _node_module()
+    if node is not None and hasattr(node, "get_caller_id"):
+        return node.get_caller_id()
+    return names.ns_join(names.get_ros_namespace(), "unnamed")
+
+
+def _master_uri() -> str:
+    node = _node_module()
+    if node is not None and hasattr(node, "get_master_uri"):
+        uri = node.get_master_uri()
+        if uri:
+            return uri
+    for arg in sys.argv:
+        if arg.startswith("__master:="):
+            return arg[len("__master:="):]
+    return os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER_URI)
+
+
+def _node_uri() -> str | None:
+    node = _node_module()
+    if node is not None and hasattr(node, "get_node_uri"):
+        return node.get_node_uri()
+    return None
+
+
+def _mappings() -> Dict[str, str]:
+    node = _node_module()
+    if node is not None and hasattr(node, "get_mappings"):
+        return dict(node.get_mappings() or {})
+    return {}
+
+
+def _resolve(name: str) -> str:
+    """Resolve ``name`` against the caller id and apply the node's remappings (rospy rules)."""
+    node = _node_module()
+    if node is not None and hasattr(node, "resolve_name"):
+        return node.resolve_name(name)
+    return names.resolve_name(name, _caller_id(), _mappings())
+
+
+def _is_shutdown() -> bool:
+    node = _node_module()
+    if node is not None and hasattr(node, "is_shutdown"):
+        return bool(node.is_shutdown())
+    return False
+
+
+def _wait_for_shutdown(timeout: float) -> bool:
+    """Wait up to ``timeout`` seconds; True if the node shut down meanwhile."""
+    node = _node_module()
+    if node is not None and hasattr(node, "wait_for_shutdown"):
+        return bool(node.wait_for_shutdown(timeout))
+    import time
+
+    time.sleep(timeout)  # no node runtime at all: nothing can shut us down early
+    return False
+
+
+def _master(timeout: float = MASTER_TIMEOUT) -> Any:
+    """An XML-RPC proxy to the master with a bounded timeout per call."""
+    from minros.xmlrpc import ServerProxy
+
+    return ServerProxy(_master_uri(), timeout=timeout)
+
+
+def _call_master(method: str, *args: Any) -> List[Any]:
+    """``[code, msg, value]`` of one master call; OSError when the master is unreachable."""
+    proxy = _master()
+    try:
+        return getattr(proxy, method)(_caller_id(), *args)
+    finally:
+        proxy.close()
+
+
+# --------------------------------------------------------------------------- the cache
+
+class ParamCache:
+    """Local copy of the parameter keys this node subscribed to (a nested dict tree)."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.tree: Dict[str, Any] | None = None
+
+    @staticmethod
+    def _parts(key: str) -> List[str]:
+        return [p for p in key.split(names.SEP) if p]
+
+    def set(self, key: str, value: Any) -> None:
+        """Store ``value`` at ``key`` (the prerequisite of ``update``)."""
+        with self.lock:
+            parts = self._parts(key)
+            if not parts:
+                if not isinstance(value, dict):
+                    raise TypeError("cannot set root of parameter tree to non-dictionary")
+                self.tree = value
+                return
+            if self.tree is None:
+                self.tree = {}
+            d = self.tree
+            for part in parts[:-1]:
+                child = d.get(part)
+                if not isinstance(child, dict):
+                    child = d[part] = {}
+                d = child
+            d[parts[-1]] = value
+
+    def update(self, key: str, value: Any) -> None:
+        """Replace the value at an already cached ``key``; KeyError if it is not cached."""
+        with self.lock:
+            parts = self._parts(key)
+            d = self.tree
+            if d is None or not parts:
+                raise KeyError(key)
+            for part in parts[:-1]:
+                d = d.get(part) if isinstance(d, dict) else None
+                if d is None:
+                    raise KeyError(key)
+            if not isinstance(d, dict) or parts[-1] not in d:
+                raise KeyError(key)
+            d[parts[-1]] = value
+
+    def get(self, key: str) -> Any:
+        """The cached value; KeyError if absent or an empty namespace (= unset on the master)."""
+        with self.lock:
+            value: Any = self.tree
+            if value is None:
+                raise KeyError(key)
+            for part in self._parts(key):
+                if not isinstance(value, dict) or part not in value:
+                    raise KeyError(key)
+                value = value[part]
+            if isinstance(value, dict) and not value:
+                raise KeyError(key)
+            return value
+
+    def clear(self) -> None:
+        with self.lock:
+            self.tree = None
+
+
+_cache = ParamCache()
+_update_handler_installed = False
+_install_lock = threading.Lock()
+
+
+def _on_param_update(key: str, value: Any) -> bool:
+    """The slave's ``paramUpdate``: refresh a cached key; False if the key is not cached."""
+    try:
+        _cache.update(key, value)
+    except KeyError:
+        return False
+    return True
+
+
+def _install_update_handler() -> None:
+    global _update_handler_installed
+    with _install_lock:
+        if _update_handler_installed:
+            return
+        node = _node_module()
+        if node is not None and hasattr(node, "add_param_update_handler"):
+            node.add_param_update_handler(_on_param_update)
+            _update_handler_installed = True
+
+
+# --------------------------------------------------------------------------- public API
+
+class _Unspecified:
+    def __repr__(self) -> str:
+        return "<unspecified>"
+
+
+_unspecified: Any = _Unspecified()
+
+
+def get_param(param_name: str, default: Any = _unspecified) -> Any:
+    """The value of ``param_name``; ``default`` if unset, else KeyError(param_name)."""
+    resolved = _resolve(param_name)
+    try:
+        return _cache.get(resolved)
+    except KeyError:
+        pass
+    code, _msg, value = _call_master("getParam", resolved)
+    if code != 1:
+        if default is not _unspecified:
+            return default
+        raise KeyError(param_name)
+    return value
+
+
+def get_param_cached(param_name: str, default: Any = _unspecified) -> Any:
+    """Like ``get_param``, but subscribes to the key and answers locally from then on."""
+    resolved = _resolve(param_name)
+    try:
+        return _cache.get(resolved)
+    except KeyError:
+        pass
+    node = _node_module()
+    subscribe = getattr(node, "subscribe_param", None) if node is not None else None
+    if subscribe is None or not _node_uri():
+        # no node to receive paramUpdate: a plain lookup is the best we can do
+        return get_param(param_name, default)
+    _install_update_handler()
+    value = subscribe(resolved)
+    _cache.set(resolved, value)
+    if isinstance(value, dict) and not value:  # subscribeParam answers {} for an unset key
+        if default is not _unspecified:
+            return default
+        raise KeyError(param_name)
+    return value
+
+
+def set_param(param_name: str, param_value: Any) -> None:
+    """Set ``param_name``; a dict replaces the whole namespace below the name."""
+    if not names.is_legal_name(param_name):
+        warnings.warn(f"'{param_name}' is not a legal ROS graph resource name. This may cause problems with "
+                      "other ROS tools", stacklevel=2)
+    resolved = _resolve(param_name)
+    code, msg, _value = _call_master("setParam", resolved, param_value)
+    if code != 1:
+        raise ROSException(f"cannot set parameter: {msg}")
+    try:
+        _cache.update(resolved, param_value)
+    except KeyError:
+        pass
+
+
+def has_param(param_name: str) -> bool:
+    """Whether ``param_name`` is set (a key or a namespace)."""
+    code, msg, value = _call_master("hasParam", _resolve(param_name))
+    if code != 1:
+        raise ROSException(f"cannot check parameter on server: {msg}")
+    return bool(value)
+
+
+def delete_param(param_name: str) -> None:
+    """Delete ``param_name``; KeyError(param_name) if it is not set."""
+    code, msg, _value = _call_master("deleteParam", _resolve(param_name))
+    if code == -1:
+        raise KeyError(param_name)
+    if code != 1:
+        raise ROSException(f"cannot delete parameter: {msg}")
+
+
+def search_param(param_name: str) -> str | None:
+    """The closest key named ``param_name`` up the node's namespace, or None."""
+    mappings = _mappings()
+    key = mappings.get(param_name, param_name)  # rospy maps the unresolved key
+    code, msg, value = _call_master("searchParam", key)
+    if code == 1:
+        return value
+    if code == -1:
+        return None
+    raise ROSException(f"cannot search for parameter: {msg}")
+
+
+def get_param_names() -> List[str]:
+    """Every parameter key on the server."""
+    code, msg, value = _call_master("getParamNames")
+    if code != 1:
+        raise ROSException(f"Unable to retrieve parameter names: {msg}")
+    return value

@@ -1,0 +1,574 @@
+"""ROS services over TCPROS: Service (server), ServiceProxy (client), wait_for_service.
+
+Server side: ``Service`` registers with the master through ``minros.node.register_service``;
+the node's TCPROS server hands every inbound connection whose header names this service to
+:meth:`Service._handle_connection`, which runs the exchange on that socket in the connection's
+thread:
+
+    client -> header {service, md5sum, callerid[, persistent, probe, ...]}
+    server -> header {service, type, md5sum, callerid}   (or {error} and close)
+    client -> uint32 len + request            (nothing more for a probe)
+    server -> uint8 ok + uint32 len + response | error string
+    ... repeated while the connection is persistent
+
+Client side: ``ServiceProxy`` looks the service up on the master for every call (unless
+persistent), connects, exchanges headers, sends one request and reads one response. It works
+without ``init_node`` (caller id ``/unnamed``). All error texts are rospy's.
+
+The header codec, framing and response encoding are the pure functions of ``minros.tcpros``;
+this module only moves their bytes through sockets.
+"""
+
+from __future__ import annotations
+
+import collections
+import logging
+import socket
+import sys
+import threading
+import time
+import traceback
+import warnings
+from typing import Any, Callable, Dict, Tuple
+
+from minros import names, tcpros
+from minros.exceptions import (
+    ROSException,
+    ROSInterruptException,
+    ServiceException,
+    TransportException,
+    TransportInitError,
+    TransportTerminated,
+)
+from minros.params import _caller_id, _is_shutdown, _master, _resolve, _wait_for_shutdown
+
+__all__ = [
+    "Service",
+    "ServiceException",
+    "ServiceProxy",
+    "parse_rosrpc_uri",
+    "wait_for_service",
+]
+
+ROSRPC = "rosrpc://"
+DEFAULT_BUFF_SIZE = 65536
+#: how often wait_for_service retries (rospy's interval)
+WAIT_FOR_SERVICE_INTERVAL = 0.3
+#: connect timeout of a service call; the response itself may take as long as the handler
+CONNECT_TIMEOUT = 10.0
+#: sockets wake up this often to notice node shutdown while waiting for a peer
+_POLL = 1.0
+
+_logger = logging.getLogger("rospy.service")
+
+
+class ParameterInvalid(ValueError):
+    """An argument failed validation (rospy.impl.validators.ParameterInvalid)."""
+
+
+def parse_rosrpc_uri(uri: str) -> Tuple[str, int]:
+    """``rosrpc://host:port[/...]`` -> ``(host, port)``; ParameterInvalid otherwise."""
+    if not uri.startswith(ROSRPC):
+        raise ParameterInvalid(f"Invalid protocol for ROS service URL: {uri}")
+    rest = uri[len(ROSRPC):]
+    rest = rest.split("/", 1)[0]
+    try:
+        host, port_text = rest.split(":")
+        port = int(port_text)
+    except ValueError:
+        raise ParameterInvalid(f"ROS service URL is invalid: {uri}") from None
+    return host, port
+
+
+# --------------------------------------------------------------------------- socket helpers
+
+def _send_all(sock: socket.socket, data: bytes) -> None:
+    try:
+        sock.sendall(data)
+    except OSError as exc:
+        raise TransportTerminated(f"unable to send data: {exc}") from None
+
+
+def _recv_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER) -> Dict[str, str]:
+    """Read one connection header from ``sock`` (blocking, honours the socket timeout)."""
+    data = bytearray()
+    while True:
+        parsed = tcpros.read_header_block(data, max_size)
+        if parsed is not None:
+            fields, used = parsed
+            if used != len(data):  # a peer never sends anything before it has our header
+                raise TransportInitError("unexpected data after the connection header")
+            return fields
+        need = 4 - len(data) if len(data) < 4 else 4 + int.from_bytes(data[:4], "little") - len(data)
+        chunk = _recv_some(sock, min(need, 65536))
+        if not chunk:
+            raise TransportInitError("connection closed before the connection header was complete")
+        data += chunk
+
+
+def _recv_some(sock: socket.socket, size: int) -> bytes:
+    """One recv that keeps waiting through socket timeouts unless the node shuts down."""
+    while True:
+        try:
+            return sock.recv(size)
+        except socket.timeout:
+            if _is_shutdown():
+                raise TransportTerminated("node shutdown") from None
+        except OSError as exc:
+            raise TransportTerminated(f"unable to receive data from sender: {exc}") from None
+
+
+class _FrameSource:
+    """Frames from one socket, one at a time (FrameReader may parse several per recv)."""
+
+    def __init__(self, sock: socket.socket, reader: tcpros.FrameReader) -> None:
+        self.sock = sock
+        self.reader = reader
+        self.pending: collections.deque = collections.deque()
+
+    def next(self) -> Any:
+        """The next frame; None if the peer closed cleanly between frames."""
+        reader = self.reader
+        while not self.pending:
+            target = reader.recv_buffer()
+            while True:
+                try:
+                    n = self.sock.recv_into(target)
+                    break
+                except socket.timeout:
+                    if _is_shutdown():
+                        raise TransportTerminated("node shutdown") from None
+                except OSError as exc:
+                    raise TransportTerminated(f"unable to receive data from sender: {exc}") from None
+            if not n:
+                reader.eof()  # FrameError (a TransportException) when cut mid-frame
+                return None
+            reader.received(n)
+            self.pending.extend(reader.frames())
+        return self.pending.popleft()
+
+
+def _close(sock: socket.socket | None) -> None:
+    if sock is None:
+        return
+    try:
+        sock.shutdown(socket.SHUT_RDWR)
+    except OSError:
+        pass
+    sock.close()
+
+
+# --------------------------------------------------------------------------- server
+
+def _convert_return_to_response(response: Any, response_class: type) -> Any:
+    """Turn what a handler returned into a response message (rospy's rules and texts)."""
+    if getattr(response, "_type", None) == response_class._type and hasattr(response, "serialize"):
+        return response
+    if type(response) is dict:
+        try:
+            return response_class(**response)
+        except AttributeError as exc:
+            raise ServiceException(f"handler returned invalid value: {exc}") from None
+    if response is None:
+        raise ServiceException("service handler returned None")
+    if type(response) not in (list, tuple):
+        try:
+            return response_class(response)
+        except TypeError as exc:
+            raise ServiceException(f"handler returned invalid value: {exc}") from None
+    try:
+        return response_class(*response)
+    except TypeError as exc:
+        raise ServiceException(f"handler returned wrong number of values: {exc}") from None
+
+
+def _default_error_handler(exc: BaseException, exc_type, exc_value, tb) -> None:
+    from minros.log import logerr
+
+    logerr(f"Error processing request: {exc}\n{traceback.format_exception(exc_type, exc_value, tb)}")
+
+
+class Service:
+    """Serve ``service_class`` requests under ``name`` by calling ``handler(request)``.
+
+    The handler returns the response (or a dict of its fields, a tuple/list of its fields, or a
+    single field value). Returning None or raising sends an error to the client:
+    ``ServiceException`` -> "service cannot process request: ...", anything else ->
+    "error processing request: ..." (after ``error_handler(e, type, value, tb)`` ran).
+    """
+
+    def __init__(self, name: str, service_class: type, handler: Callable[[Any], Any],
+                 buff_size: int = DEFAULT_BUFF_SIZE,
+                 error_handler: Callable[..., None] | None = None) -> None:
+        if not name or not isinstance(name, str):
+            raise ValueError("service name is not a non-empty string")
+        if not names.is_legal_name(name):
+            warnings.warn(f"'{name}' is not a legal ROS graph resource name. This may cause problems "
+                          "with other ROS tools", stacklevel=2)
+        self.name = name
+        self.resolved_name = _resolve(name)
+        self.service_class = service_class
+        self.request_class = service_class._request_class
+        self.response_class = service_class._response_class
+        self.handler = handler
+        self.error_handler = error_handler or _default_error_handler
+        self.buff_size = buff_size
+        self.seq = 0
+        self.done = False
+        self._lock = threading.Lock()
+        from minros import node
+
+        node.register_service(self.resolved_name, self._handle_connection)
+        #: rosrpc:// URI the master knows us by (None until init_node started the node)
+        self.uri: str | None = None
+        try:
+            host, port = node.get_tcpros_address()
+            self.uri = f"{ROSRPC}{host}:{port}"
+        except ROSException:
+            pass
+
+    # -- lifecycle ---------------------------------------------------------------------------
+
+    def shutdown(self, reason: str = "") -> None:
+        """Stop serving and unregister from the master."""
+        if self.done:
+            return
+        self.done = True
+        from minros import node
+
+        try:
+            node.unregister_service(self.resolved_name)
+        except Exception as exc:
+            raise ServiceException(f"Unable to connect to master: {exc}") from None
+
+    def spin(self) -> None:
+        """Block until this service or the node shuts down."""
+        from minros import node
+
+        while not self.done and not node.wait_for_shutdown(0.5):
+            pass
+
+    # -- the TCPROS exchange ---------------------------------------------------------------------
+
+    def _header_fields(self) -> Dict[str, str]:
+        return {"service": self.resolved_name, "type": self.service_class._type,
+                "md5sum": self.service_class._md5sum, "callerid": _caller_id()}
+
+    def _handle_connection(self, sock: socket.socket, header: Dict[str, str]) -> None:
+        """Serve one inbound connection (called in the node's connection thread)."""
+        try:
+            self._serve(sock, header)
+        except TransportException as exc:
+            _logger.debug("service [%s]: connection ended: %s", self.resolved_name, exc)
+        finally:
+            _close(sock)
+
+    def _serve(self, sock: socket.socket, header: Dict[str, str]) -> None:
+        error = tcpros.service_header_error(header, self.resolved_name, self.service_class._md5sum)
+        if error is None and self.done:
+            error = f"[{_caller_id()}] is not a provider of  [{self.resolved_name}]"
+        if error is not None:
+            _send_all(sock, tcpros.encode_error_header(error))
+            from minros.log import logwarn
+
+            logwarn(f"Could not process inbound connection: {error}{header}")
+            return
+        _send_all(sock, tcpros.encode_header(self._header_fields()))
+        if header.get("probe") == "1":  # wait_for_service checking we are alive
+            return
+        persistent = header.get("persistent", "").lower() in ("1", "true")
+        sock.settimeout(_POLL)
+        source = _FrameSource(sock, tcpros.FrameReader(buff_size=max(self.buff_size, 16)))
+        while not self.done:
+            frame = source.next()
+            if frame is None:
+                if not persistent:
+                    from minros.log import logerr
+
+                    logerr("incoming connection failed: connection closed before the request")
+                return
+            request = self.request_class()
+            try:
+                request.deserialize(frame)
+            except Exception as exc:
+                from minros.log import logerr
+
+                logerr(f"[{self.resolved_name}] error deserializing incoming request: {exc}")
+                return
+            request._connection_header = header
+            _send_all(sock, self._respond(request))
+            if not persistent:
+                return
+
+    def _respond(self, request: Any) -> bytes:
+        """The bytes answering ``request``: ok + response, or not-ok + error text."""
+        try:
+            response = _convert_return_to_response(self.handler(request), self.response_class)
+            with self._lock:
+                self.seq += 1
+            buff = _Buffer()
+            response.serialize(buff)
+            return tcpros.encode_service_response(buff.getvalue())
+        except ServiceException as exc:
+            return tcpros.encode_service_error(f"service cannot process request: {exc}")
+        except Exception as exc:
+            exc_type, exc_value, tb = sys.exc_info()
+            try:
+                self.error_handler(exc, exc_type, exc_value, tb)
+            except Exception:  # a broken error handler must not kill the connection
+                _logger.exception("service [%s]: error handler failed", self.resolved_name)
+            return tcpros.encode_service_error(f"error processing request: {exc}")
+
+
+class _Buffer:
+    """The smallest ``write``-able sink for ``Message.serialize``: joins chunks once."""
+
+    __slots__ = ("_parts",)
+
+    def __init__(self) -> None:
+        self._parts: list = []
+
+    def write(self, data: Any) -> None:
+        self._parts.append(bytes(data))
+
+    def getvalue(self) -> bytes:
+        return b"".join(self._parts)
+
+
+# --------------------------------------------------------------------------- client
+
+def _args_kwds_to_request(request_class: type, args: tuple, kwds: dict) -> Any:
+    """A request from call arguments: one request instance, positional fields or keywords."""
+    if args and kwds:
+        raise TypeError("publish() can be called with arguments or keywords, but not both.")
+    if kwds:
+        return request_class(**kwds)
+    if len(args) == 1:
+        arg = args[0]
+        if getattr(arg, "_md5sum", None) == request_class._md5sum:
+            return arg
+        if hasattr(arg, "_type") and hasattr(arg, "_slot_types"):  # some other message
+            slot_types = request_class._slot_types
+            if not slot_types:
+                raise TypeError(f"expected [] but got [{arg._type}]")
+            if arg._type != slot_types[0]:
+                raise TypeError(f"expected [{slot_types[0]}] but got [{arg._type}]")
+    return request_class(*args)
+
+
+def _lookup_service(resolved_name: str) -> str:
+    """The ``rosrpc://`` URI of a service from the master (rospy's error texts)."""
+    try:
+        proxy = _master()
+        try:
+            code, msg, uri = proxy.lookupService(_caller_id(), resolved_name)
+        finally:
+            proxy.close()
+    except OSError:
+        raise ServiceException("unable to contact master") from None
+    if code != 1:
+        _logger.error("[%s]: lookup service failed with message [%s]", resolved_name, msg)
+        raise ServiceException(f"service [{resolved_name}] unavailable")
+    try:
+        parse_rosrpc_uri(uri)
+    except ParameterInvalid:
+        raise ServiceException(f"master returned invalid ROSRPC URI: {uri}") from None
+    return uri
+
+
+def _connect(host: str, port: int, timeout: float) -> socket.socket:
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    try:
+        infos = socket.getaddrinfo(host, port, 0, socket.SOCK_STREAM)
+        family, _, _, _, addr = infos[0]
+    except OSError:
+        addr = (host, port)
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    try:
+        sock.settimeout(timeout)
+        sock.connect(addr)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    except OSError:
+        sock.close()
+        raise
+    return sock
+
+
+class ServiceProxy:
+    """A callable handle on a remote service: ``proxy(1, 2)``, ``proxy(req)``, ``proxy(a=1, b=2)``."""
+
+    def __init__(self, name: str, service_class: type, persistent: bool = False,
+                 headers: Dict[str, str] | None = None) -> None:
+        self.name = name
+        self.resolved_name = _resolve(name)
+        self.service_class = service_class
+        self.request_class = service_class._request_class
+        self.response_class = service_class._response_class
+        self.persistent = persistent
+        self.headers: Dict[str, str] = dict(headers or {})
+        if persistent:
+            self.headers["persistent"] = "1"
+        self.uri: str | None = None
+        self.seq = 0
+        self.buff_size = DEFAULT_BUFF_SIZE
+        self._sock: socket.socket | None = None
+        self._source: _FrameSource | None = None
+        self._server_header: Dict[str, str] = {}
+        self._lock = threading.Lock()  # one call at a time on a persistent connection
+
+    def wait_for_service(self, timeout: float | None = None) -> None:
+        wait_for_service(self.resolved_name, timeout=timeout)
+
+    def __call__(self, *args: Any, **kwds: Any) -> Any:
+        return self.call(*args, **kwds)
+
+    def _header_fields(self) -> Dict[str, str]:
+        fields = {"service": self.resolved_name, "md5sum": self.service_class._md5sum,
+                  "callerid": _caller_id()}
+        fields.update({str(k): str(v) for k, v in self.headers.items()})  # user headers win, as in rospy
+        return fields
+
+    def _open(self) -> None:
+        """Look the service up, connect and exchange headers; ServiceException on failure."""
+        uri = _lookup_service(self.resolved_name)
+        self.uri = uri
+        host, port = parse_rosrpc_uri(uri)
+        try:
+            sock = _connect(host, port, CONNECT_TIMEOUT)
+        except OSError as exc:
+            raise ServiceException(f"unable to connect to service: {exc}") from None
+        try:
+            _send_all(sock, tcpros.encode_header(self._header_fields()))
+            header = _recv_header(sock)
+            if "error" in header:
+                raise TransportInitError("remote error reported: {}".format(header["error"]))
+            for required in ("md5sum", "type"):
+                if required not in header:
+                    raise TransportInitError(f"header missing required field [{required}]")
+        except (TransportException, OSError) as exc:
+            _close(sock)
+            raise ServiceException(f"unable to connect to service: {exc}") from None
+        sock.settimeout(_POLL)
+        self._sock = sock
+        self._server_header = header
+        self._source = _FrameSource(sock, tcpros.FrameReader(buff_size=self.buff_size, ok_byte=True))
+
+    def _drop(self) -> None:
+        sock, self._sock = self._sock, None
+        self._source = None
+        _close(sock)
+
+    def call(self, *args: Any, **kwds: Any) -> Any:
+        """Call the service; returns the response message.
+
+        Raises TypeError for a request of the wrong type, ServiceException when the service
+        is unavailable or its handler failed, ROSInterruptException when the node shuts down
+        during the call.
+        """
+        request = _args_kwds_to_request(self.request_class, args, kwds)
+        if getattr(request, "_type", None) != self.request_class._type:
+            raise TypeError(f"request object type [{request.__class__}] does not match service type [{self.request_class}]")
+        buff = _Buffer()
+        request.serialize(buff)
+        payload = buff.getvalue()
+        with self._lock:
+            if self._sock is None:
+                self._open()
+            try:
+                self.seq += 1
+                assert self._sock is not None and self._source is not None
+                _send_all(self._sock, tcpros.encode_frame(payload))
+                frame = self._source.next()
+                if frame is None:
+                    raise TransportTerminated("connection closed by the service before its response")
+            except TransportException as exc:
+                self._drop()
+                if _is_shutdown():
+                    raise ROSInterruptException("node shutdown interrupted service call") from None
+                raise ServiceException(f"transport error completing service call: {exc}") from None
+            except BaseException:
+                self._drop()
+                raise
+            header = self._server_header
+            if not self.persistent:
+                self._drop()
+        ok, data = frame
+        if not ok:
+            # rospy (Python 3) formats the raw bytes of the error string, so its text reads
+            # "... responded with an error: b'...'"; the same words here keep tools identical
+            text = str(bytes(data))
+            raise ServiceException(f"service [{self.resolved_name}] responded with an error: {text}")
+        response = self.response_class()
+        try:
+            response.deserialize(data)
+        except Exception as exc:
+            raise ServiceException(f"transport error completing service call: receive_once[{self.resolved_name}]: "
+                                   f"DeserializationError {exc}") from None
+        response._connection_header = header
+        return response
+
+    def close(self) -> None:
+        """Close a persistent connection (no effect otherwise)."""
+        with self._lock:
+            self._drop()
+
+
+def _probe_service(resolved_name: str, timeout: float) -> bool:
+    """Is the service registered and accepting connections? Sends a probe header and closes."""
+    try:
+        proxy = _master()
+        try:
+            code, _msg, uri = proxy.lookupService(_caller_id(), resolved_name)
+        finally:
+            proxy.close()
+    except OSError:
+        return False
+    if code != 1:
+        return False
+    host, port = parse_rosrpc_uri(uri)
+    sock = _connect(host, port, timeout)
+    try:
+        _send_all(sock, tcpros.encode_header({"probe": "1", "md5sum": "*", "callerid": _caller_id(),
+                                              "service": resolved_name}))
+    finally:
+        _close(sock)
+    return True
+
+
+def wait_for_service(service: str, timeout: float | None = None) -> None:
+    """Block until ``service`` is registered and accepts connections.
+
+    ``timeout`` (seconds or Duration) None waits forever; 0 is invalid (ValueError). Raises
+    ROSException("timeout exceeded while waiting for service ...") on timeout and
+    ROSInterruptException when the node shuts down meanwhile.
+    """
+    from minros.log import loginfo, logwarn_throttle
+
+    if timeout is not None and hasattr(timeout, "to_sec"):
+        timeout = timeout.to_sec()
+    if timeout == 0.0:
+        raise ValueError("timeout must be non-zero")
+    resolved_name = _resolve(service)
+    deadline = None if not timeout else time.monotonic() + timeout
+    contact_failed = False
+    while not _is_shutdown():
+        remaining = None if deadline is None else deadline - time.monotonic()
+        if remaining is not None and remaining <= 0:
+            break
+        try:
+            probe_timeout = 10.0 if remaining is None else max(0.01, remaining)
+            if _probe_service(resolved_name, probe_timeout):
+                if contact_failed:
+                    loginfo(f"wait_for_service({resolved_name}): finally were able to contact service")
+                return
+        except (OSError, ParameterInvalid, TransportException):
+            contact_failed = True
+            logwarn_throttle(10, f"wait_for_service({resolved_name}): failed to contact, will keep trying")
+        pause = WAIT_FOR_SERVICE_INTERVAL
+        if deadline is not None:
+            pause = min(pause, max(0.0, deadline - time.monotonic()))
+        if _wait_for_shutdown(pause):
+            break
+    if _is_shutdown():
+        raise ROSInterruptException("rospy shutdown")
+    raise ROSException(f"timeout exceeded while waiting for service {resolved_name}")
