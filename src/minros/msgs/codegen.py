@@ -25,7 +25,7 @@ SER_CODE = {
 DESER_CODE = dict(SER_CODE, bool="?")
 _SIZE = {c: struct.calcsize("<" + c) for c in "bBhHiIqQfd?"}
 _DEFAULTS = {"float32": "0.0", "float64": "0.0", "string": "''", "bool": "False",
-             "time": "Time()", "duration": "Duration()"}
+             "time": "_Time()", "duration": "_Duration()"}
 
 GetSpec = Callable[[str], MsgSpec]
 
@@ -37,7 +37,12 @@ def python_name(field_name: str) -> str:
 
 def dep_name(type_name: str) -> str:
     """The module-level name bound to the class of embedded type ``pkg/Type``."""
-    return type_name.replace("/", "_")
+    return "_" + type_name.replace("/", "_")
+
+
+def numpy_class_name(type_name: str) -> str:
+    """rospy's name for the numpy_msg class of ``type_name``: ``Numpy_pkg__Type``."""
+    return "Numpy_" + type_name.replace("/", "__")
 
 
 def _compress(run: List[Tuple[int, str]]) -> str:
@@ -51,7 +56,7 @@ def _compress(run: List[Tuple[int, str]]) -> str:
 
 
 def _struct_name(fmt: str) -> str:
-    return "S_" + fmt.replace("?", "Bool")
+    return "_S_" + fmt.replace("?", "Bool")
 
 
 def min_size(spec: MsgSpec, get_spec: GetSpec) -> int:
@@ -113,6 +118,8 @@ class _SerializerGen(_Writer):
         self.emit(ind, f"{var} = {expr}")
         self.emit(ind, f"if {var}.__class__ is str:")
         self.emit(ind + 1, f"{var} = {var}.encode()")
+        self.emit(ind, f"elif {var}.__class__ is not bytes:")
+        self.emit(ind + 1, f"{var} = _string_bytes({var})")
         self.run.append((1, "I", f"len({var})"))
         self.flush(ind)
         self.emit(ind, f"append({var})")
@@ -144,26 +151,26 @@ class _SerializerGen(_Writer):
                 var = self.tmp("_b")
                 self.emit(ind, f"{var} = {expr}")
                 self.emit(ind, f"if {var}.__class__ is not bytes:")
-                self.emit(ind + 1, f"{var} = as_bytes({var})")
+                self.emit(ind + 1, f"{var} = _as_bytes({var})")
                 if n is None:
                     self.run.append((1, "I", f"len({var})"))
                 else:
                     self.emit(ind, f"if len({var}) != {n}:")
-                    self.emit(ind + 1, f"raise bad_length({fpath!r}, {n}, len({var}))")
+                    self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
                 self.flush(ind)
                 self.emit(ind, f"append({var})")
             elif bt in SER_CODE:
                 code = SER_CODE[bt]
                 if n is None:
                     self.flush(ind)
-                    self.emit(ind, f"put_array(append, {code!r}, {expr})")
+                    self.emit(ind, f"_put_array(append, {code!r}, {expr})")
                 elif n > 0:
                     var = self.tmp("_a")
                     self.emit(ind, f"{var} = {expr}")
                     self.emit(ind, f"if {var}.__class__ is not list and {var}.__class__ is not tuple:")
-                    self.emit(ind + 1, f"{var} = as_list({var}, {n}, {fpath!r})")
+                    self.emit(ind + 1, f"{var} = _as_list({var}, {n}, {fpath!r})")
                     self.emit(ind, f"if len({var}) != {n}:")
-                    self.emit(ind + 1, f"raise bad_length({fpath!r}, {n}, len({var}))")
+                    self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
                     self.run.append((n, code, f"*{var}"))
             else:
                 var = self.tmp("_a")
@@ -172,7 +179,7 @@ class _SerializerGen(_Writer):
                     self.run.append((1, "I", f"len({var})"))
                 else:
                     self.emit(ind, f"if len({var}) != {n}:")
-                    self.emit(ind + 1, f"raise bad_length({fpath!r}, {n}, len({var}))")
+                    self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
                 self.flush(ind)
                 item = self.tmp("_e")
                 self.emit(ind, f"for {item} in {var}:")
@@ -235,7 +242,7 @@ class _DeserializerGen(_Writer):
 
     def string_body(self, ind: int, target: str, length: str, fpath: str) -> None:
         self.emit(ind, f"if {length} > len(view) - end:")
-        self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {length}, len(view) - end)")
+        self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {length}, len(view) - end)")
         self.emit(ind, f"{target} = str(view[end:end + {length}], 'utf-8', 'replace')")
         self.emit(ind, f"end += {length}")
 
@@ -250,15 +257,15 @@ class _DeserializerGen(_Writer):
                     self.run.append((1, DESER_CODE[bt], target))
                 elif bt in ("time", "duration"):
                     var = self.tmp("_t")
-                    cls = "Time" if bt == "time" else "Duration"
-                    self.emit(ind, f"{var} = {target} = new({cls})")
+                    cls = "_Time" if bt == "time" else "_Duration"
+                    self.emit(ind, f"{var} = {target} = _new({cls})")
                     self.tval(ind, var, bt)
                 elif bt == "string":
                     n = self.length(ind)
                     self.string_body(ind, target, n, fpath)
                 else:
                     var = self.tmp("_m")
-                    self.emit(ind, f"{var} = {target} = new({dep_name(bt)})")
+                    self.emit(ind, f"{var} = {target} = _new({dep_name(bt)})")
                     self.fields(self.get_spec(bt), var, fpath + ".", ind)
                 continue
             n = f.array_len
@@ -266,9 +273,9 @@ class _DeserializerGen(_Writer):
                 if n is None:
                     count = self.length(ind)
                     self.emit(ind, f"if {count} > len(view) - end:")
-                    self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
+                    self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
                     if self.numpy:
-                        self.emit(ind, f"{target} = numpy_view('B', {count}, view, end)")
+                        self.emit(ind, f"{target} = _numpy_view('B', {count}, view, end)")
                     else:
                         self.emit(ind, f"{target} = view[end:end + {count}].tobytes()")
                     self.emit(ind, f"end += {count}")
@@ -276,8 +283,8 @@ class _DeserializerGen(_Writer):
                     self.flush(ind)
                     if self.numpy:
                         self.emit(ind, f"if {n} > len(view) - end:")
-                        self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {n}, len(view) - end)")
-                        self.emit(ind, f"{target} = numpy_view('B', {n}, view, end)")
+                        self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {n}, len(view) - end)")
+                        self.emit(ind, f"{target} = _numpy_view('B', {n}, view, end)")
                     else:
                         name = self.struct(f"{n}s")
                         self.emit(ind, f"{target}, = {name}.unpack_from(view, end)")
@@ -290,15 +297,15 @@ class _DeserializerGen(_Writer):
                     nbytes = self.tmp("_k")
                     self.emit(ind, f"{nbytes} = {count} * {size}" if size != 1 else f"{nbytes} = {count}")
                     self.emit(ind, f"if {nbytes} > len(view) - end:")
-                    self.emit(ind + 1, f"raise too_many({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
+                    self.emit(ind + 1, f"raise _too_many({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
                     self._numeric_array(ind, target, code, count, bt)
                     self.emit(ind, f"end += {nbytes}")
                 else:
                     self.flush(ind)
                     if self.numpy and bt != "bool":
                         self.emit(ind, f"if {n * size} > len(view) - end:")
-                        self.emit(ind + 1, f"raise overrun({self.type_name!r}, {fpath!r}, {n * size}, len(view) - end)")
-                        self.emit(ind, f"{target} = numpy_view({code!r}, {n}, view, end)")
+                        self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {n * size}, len(view) - end)")
+                        self.emit(ind, f"{target} = _numpy_view({code!r}, {n}, view, end)")
                     else:
                         name = self.struct(f"{n}{code}")
                         if bt == "bool":
@@ -318,8 +325,8 @@ class _DeserializerGen(_Writer):
                     if least:
                         self.emit(ind, f"if {count} * {least} > len(view) - end:")
                     else:
-                        self.emit(ind, f"if {count} > MAX_EMPTY_ELEMENTS:")
-                    self.emit(ind + 1, f"raise too_many({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
+                        self.emit(ind, f"if {count} > _MAX_EMPTY_ELEMENTS:")
+                    self.emit(ind + 1, f"raise _too_many({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
                 else:
                     self.flush(ind)
                     count = str(n)
@@ -333,24 +340,24 @@ class _DeserializerGen(_Writer):
                     self.emit(ind + 1, f"{items}.append({var})")
                 elif bt in ("time", "duration"):
                     var = self.tmp("_t")
-                    cls = "Time" if bt == "time" else "Duration"
-                    self.emit(ind + 1, f"{var} = new({cls})")
+                    cls = "_Time" if bt == "time" else "_Duration"
+                    self.emit(ind + 1, f"{var} = _new({cls})")
                     self.emit(ind + 1, f"{items}.append({var})")
                     self.tval(ind + 1, var, bt)
                 else:
                     var = self.tmp("_e")
-                    self.emit(ind + 1, f"{var} = new({dep_name(bt)})")
+                    self.emit(ind + 1, f"{var} = _new({dep_name(bt)})")
                     self.emit(ind + 1, f"{items}.append({var})")
                     self.fields(self.get_spec(bt), var, fpath + "[].", ind + 1)
                 self.flush(ind + 1)
 
     def _numeric_array(self, ind: int, target: str, code: str, count: str, bt: str) -> None:
         if bt == "bool":
-            self.emit(ind, f"{target} = list(unpack_array('?', {count}, view, end))")
+            self.emit(ind, f"{target} = list(_unpack_array('?', {count}, view, end))")
         elif self.numpy:
-            self.emit(ind, f"{target} = numpy_view({code!r}, {count}, view, end)")
+            self.emit(ind, f"{target} = _numpy_view({code!r}, {count}, view, end)")
         else:
-            self.emit(ind, f"{target} = unpack_array({code!r}, {count}, view, end)")
+            self.emit(ind, f"{target} = _unpack_array({code!r}, {count}, view, end)")
 
 
 def default_value(type_: str, base_type: str, is_array: bool, array_len: int | None) -> str:
@@ -375,8 +382,8 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
                     module: str | None = None, numpy: bool = False) -> str:
     """Python source defining the class for ``spec`` (named as its short name).
 
-    The module needs ``load(type_name) -> class`` in its globals for embedded types; with
-    ``numpy=True`` it also needs ``base_class`` and defines a subclass whose numeric arrays
+    The module needs ``_load(type_name) -> class`` in its globals for embedded types; with
+    ``numpy=True`` it also needs ``_base_class`` and defines a subclass whose numeric arrays
     deserialize as numpy views.
     """
     name = spec.short_name
@@ -397,26 +404,26 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
     out: List[str] = []
     origin = spec.filename or "a message definition"
     out.append(f"# Message class for {spec.full_name}, generated by minros.msgs from {origin}.")
-    out.append("from minros.msgs.runtime import *  # noqa: F401,F403")
+    out.append("from minros.msgs.runtime import *  # noqa: F401,F403  (_Message, _Time, _new, _S_I, ...)")
     if deps:
         out.append("")
         out.append("# classes of the embedded message types")
         for d in deps:
-            out.append(f"{dep_name(d)} = load({d!r})")
+            out.append(f"{dep_name(d)} = _load({d!r})")
     if structs:
         out.append("")
         out.append("# fixed-size runs of fields, packed/unpacked in one call")
         for fmt, sname in sorted(structs.items(), key=lambda kv: kv[1]):
-            out.append(f"{sname} = Struct({'<' + fmt!r})")
+            out.append(f"{sname} = _Struct({'<' + fmt!r})")
     out.append("")
     out.append("")
     if numpy:
-        out.append(f"class {name}(base_class):")
+        out.append(f"class {numpy_class_name(spec.full_name)}(_base_class):")
         out.append(f'    """{spec.full_name} whose numeric arrays are numpy views of the received bytes."""')
         out.append("")
-        out.append("    __slots__ = []")
+        out.append(f"    __slots__ = {attrs!r}  # as rospy's numpy_msg: same fields, re-declared")
     else:
-        out.append(f"class {name}(Message):")
+        out.append(f"class {name}(_Message):")
         out.append(f'    """{spec.full_name} (md5sum {md5sum})."""')
         out.append("")
         out.append(f"    __slots__ = {attrs!r}")
@@ -435,7 +442,7 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
         out.append("    def __init__(self, *args, **kwds):")
         if spec.fields:
             out.append("        if args or kwds:")
-            out.append("            init_fields(self, args, kwds)")
+            out.append("            _init_fields(self, args, kwds)")
             for f, attr in zip(spec.fields, attrs):
                 out.append(f"            if self.{attr} is None:")
                 out.append(f"                self.{attr} = {default_value(f.type, f.base_type, f.is_array, f.array_len)}")
@@ -443,7 +450,7 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
             for f, attr in zip(spec.fields, attrs):
                 out.append(f"            self.{attr} = {default_value(f.type, f.base_type, f.is_array, f.array_len)}")
         else:
-            out.append("        init_fields(self, args, kwds)")
+            out.append("        _init_fields(self, args, kwds)")
         out.append("")
         out.append("    def _serialize_parts(self, append):")
         out.append('        """Append the wire form of this message, in pieces, with ``append``."""')

@@ -28,6 +28,8 @@ _INT_WIDTHS = {
     "int64": (64, True), "char": (8, False), "uint8": (8, False), "uint16": (16, False),
     "uint32": (32, False), "uint64": (64, False),
 }
+#: messages up to this size are joined into one ``bytes`` before ``buff.write``
+_JOIN_LIMIT = 65536
 _SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
                      UnicodeError, IndexError)
 
@@ -62,10 +64,17 @@ class Message:
         parts: List[Any] = []
         try:
             self._serialize_parts(parts.append)
-            data = b"".join(parts)
         except _SERIALIZE_ERRORS as exc:
             raise _serialization_error(self, exc) from None
-        buff.write(data)
+        if len(parts) == 1:
+            buff.write(parts[0])
+        elif sum(map(len, parts)) < _JOIN_LIMIT:
+            buff.write(b"".join(parts))
+        else:
+            # large payloads (images, point clouds): hand the pieces over without joining
+            # them, so a writer that gathers buffers (sendmsg) never copies the big ones
+            for part in parts:
+                buff.write(part)
 
     def serialize_to_bytes(self) -> bytes:
         """The wire form of this message as ``bytes``."""

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Tuple
 
 from . import runtime
-from .codegen import generate_source
+from .codegen import generate_source, numpy_class_name
 from .message import Message
 from .spec import (
     HEADER,
@@ -31,7 +31,7 @@ from .spec import (
     split_full_text,
 )
 
-_RUNTIME_NAMES = {name: getattr(runtime, name) for name in runtime.__all__}
+_RUNTIME_NAMES = dict(runtime.EXPORTS)
 
 
 class UnknownTypeError(LookupError):
@@ -230,12 +230,13 @@ class MsgContext:
         filename = f"<minros msg {type_name}{' numpy' if base_class else ''}>"
         linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
         namespace: Dict[str, Any] = dict(_RUNTIME_NAMES)
-        namespace["load"] = self.get_class
+        namespace["_load"] = self.get_class
         namespace["__name__"] = self._module_for(type_name) or "minros.msgs.generated"
         if base_class is not None:
-            namespace["base_class"] = base_class
+            namespace["_base_class"] = base_class
         exec(compile(source, filename, "exec"), namespace)
-        cls = namespace[type_name.rpartition("/")[2]]
+        name = numpy_class_name(type_name) if base_class is not None else type_name.rpartition("/")[2]
+        cls = namespace[name]
         cls._context = self  # numpy_msg() and tools find the registry a class came from
         return cls
 
@@ -328,3 +329,59 @@ def message_sources(type_name: str) -> str:
     """The generated source of ``type_name``'s class (for ``minros msg gen``)."""
     return REGISTRY.source(type_name)
 
+
+
+# ---------------------------------------------------------------------------------------------
+# text for people (rosmsg show / rossrv show)
+
+def spec_to_text(spec: MsgSpec, context: MsgContext | None = None, indent: str = "") -> str:
+    """rosmsg's expanded, comment-free view: constants, fields, embedded types indented."""
+    ctx = context or REGISTRY
+    lines: List[str] = []
+    for c in spec.constants:
+        lines.append(f"{indent}{c.type} {c.name}={c.val_text}\n")
+    for f in spec.fields:
+        lines.append(f"{indent}{f.type} {f.name}\n")
+        if not f.is_builtin:
+            lines.append(spec_to_text(ctx.get_spec(f.base_type), ctx, indent + "  "))
+    return "".join(lines)
+
+
+def message_text(type_name: str, raw: bool = False) -> str:
+    """What ``rosmsg show [-r] TYPE`` prints (without print's final newline)."""
+    spec = REGISTRY.get_spec(type_name)
+    REGISTRY.full_text(type_name)  # loads every embedded type: errors surface here
+    return spec.text if raw else spec_to_text(spec)
+
+
+def service_text(type_name: str, raw: bool = False) -> str:
+    """What ``rossrv show [-r] TYPE`` prints (without print's final newline)."""
+    spec = REGISTRY.get_srv_spec(type_name)
+    if raw:
+        return spec.text
+    REGISTRY.full_text(spec.request.full_name)
+    REGISTRY.full_text(spec.response.full_name)
+    return spec_to_text(spec.request) + "---\n" + spec_to_text(spec.response)
+
+
+def packages_with(kind: str) -> Dict[str, Path]:
+    """Packages holding a ``msg`` (or ``srv``) folder: ``{name: folder}``, sorted by name."""
+    from minros.packages import list_packages
+
+    found = {name: path / kind for name, path in list_packages(refresh=True).items()}
+    return {name: found[name] for name in sorted(found) if found[name].is_dir()}
+
+
+def list_types(package: str, kind: str = "msg") -> List[str]:
+    """``pkg/Type`` names of the ``.msg`` (or ``.srv``) files of ``package``, sorted."""
+    from minros.packages import find_package
+
+    package_dir = find_package(package)
+    if package_dir is None:
+        raise UnknownTypeError(package, f"package [{package}] not found")
+    folder = package_dir / kind
+    if not folder.is_dir():
+        return []
+    suffix = "." + kind
+    return [f"{package}/{p.name[:-len(suffix)]}" for p in sorted(folder.iterdir())
+            if p.name.endswith(suffix) and p.is_file()]

@@ -1,7 +1,8 @@
 """Names the generated message code uses (imported by every generated module).
 
 Kept small and explicit so the printed source of a message class (``minros msg gen``) reads
-like ordinary Python: ``from minros.msgs.runtime import *`` brings exactly these.
+like ordinary Python: ``from minros.msgs.runtime import *`` brings exactly :data:`EXPORTS`,
+all prefixed with ``_`` so they never clash with a message named ``Time`` or ``Struct``.
 """
 
 from __future__ import annotations
@@ -14,13 +15,6 @@ from minros.exceptions import DeserializationError, SerializationError
 
 from .message import MAX_EMPTY_ELEMENTS, Message, _init_fields
 from .tval import Duration, Time
-
-__all__ = [
-    "Struct", "Message", "Time", "Duration", "new", "S_I", "overrun", "too_many",
-    "put_array", "put_fixed_array", "put_bytes", "put_fixed_bytes", "unpack_array",
-    "numpy_view", "bad_length", "MAX_EMPTY_ELEMENTS", "DeserializationError",
-    "SerializationError", "as_bytes", "as_list", "init_fields",
-]
 
 #: genpy's constructor rules (all fields positionally, or any by keyword)
 init_fields = _init_fields
@@ -135,3 +129,22 @@ def as_list(value: Any, length: int, field: str) -> list:
     if isinstance(value, (str, bytes, bytearray)) or not hasattr(value, "__iter__"):
         raise TypeError(f"field {field} must be a sequence, not {type(value).__name__}")
     return list(value)
+
+
+def string_bytes(value: Any) -> bytes:
+    """A ``string`` field value that is not a ``str``: bytes-like objects are written as is."""
+    if isinstance(value, (bytes, bytearray)):
+        return bytes(value)
+    raise TypeError(f"a string field must be str or bytes, not {type(value).__name__}")
+
+
+#: what ``from minros.msgs.runtime import *`` gives generated code
+EXPORTS = {
+    "_Struct": Struct, "_Message": Message, "_Time": Time, "_Duration": Duration, "_new": new,
+    "_S_I": S_I, "_overrun": overrun, "_too_many": too_many, "_bad_length": bad_length,
+    "_put_array": put_array, "_unpack_array": unpack_array, "_numpy_view": numpy_view,
+    "_as_bytes": as_bytes, "_as_list": as_list, "_string_bytes": string_bytes,
+    "_init_fields": init_fields, "_MAX_EMPTY_ELEMENTS": MAX_EMPTY_ELEMENTS,
+}
+globals().update(EXPORTS)
+__all__ = list(EXPORTS)  # noqa: PLE0605

@@ -1,0 +1,254 @@
+"""Test helpers for message types: hypothesis strategies, plain-data conversion, a genpy oracle.
+
+Used by minros's own tests and benchmarks (and usable by anyone testing code that handles
+messages). Importing this module needs ``hypothesis`` only when a strategy is requested.
+
+The genpy oracle is a small script run by Debian's ``/usr/bin/python3``: it reads one JSON
+request per line (``{"op": "ser", "type": ..., "value": ...}`` or ``{"op": "de", "type": ...,
+"hex": ...}``) and answers one JSON line, so one long-lived process serves a whole test run.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import selectors
+import subprocess
+from typing import Any, Dict, List
+
+from .registry import REGISTRY, MsgContext
+from .spec import split_array
+from .tval import Duration, Time
+
+_INT_RANGES = {
+    "int8": (-(2 ** 7), 2 ** 7 - 1), "byte": (-(2 ** 7), 2 ** 7 - 1), "uint8": (0, 255),
+    "char": (0, 255), "int16": (-(2 ** 15), 2 ** 15 - 1), "uint16": (0, 2 ** 16 - 1),
+    "int32": (-(2 ** 31), 2 ** 31 - 1), "uint32": (0, 2 ** 32 - 1),
+    "int64": (-(2 ** 63), 2 ** 63 - 1), "uint64": (0, 2 ** 64 - 1),
+}
+
+
+def strategy_for(type_name: str, context: MsgContext | None = None, max_array: int = 3):
+    """A hypothesis strategy producing instances of message type ``type_name``."""
+    from hypothesis import strategies as st
+
+    ctx = context or REGISTRY
+    cache: Dict[str, Any] = {}
+
+    def field_strategy(type_: str):
+        base, is_array, length = split_array(type_)
+        if is_array:
+            if base in ("uint8", "char"):
+                if length is None:
+                    return st.binary(max_size=max_array * 4)
+                return st.binary(min_size=length, max_size=length)
+            item = field_strategy(base)
+            if length is None:
+                return st.lists(item, max_size=max_array)
+            return st.lists(item, min_size=length, max_size=length)
+        if base in _INT_RANGES:
+            lower, upper = _INT_RANGES[base]
+            return st.integers(lower, upper)
+        if base == "float64":
+            return st.floats(allow_nan=False)
+        if base == "float32":
+            return st.floats(allow_nan=False, width=32)
+        if base == "bool":
+            return st.booleans()
+        if base == "string":
+            return st.text(st.characters(blacklist_categories=("Cs",)), max_size=12)
+        if base == "time":
+            return st.builds(Time, st.integers(0, 2 ** 32 - 1), st.integers(0, 999999999))
+        if base == "duration":
+            return st.builds(Duration, st.integers(-(2 ** 31), 2 ** 31 - 1), st.integers(0, 999999999))
+        return message_strategy(base)
+
+    def message_strategy(name: str):
+        if name not in cache:
+            cls = ctx.get_class(name)
+            spec = ctx.get_spec(name)
+            fields = {attr: field_strategy(t) for attr, t in zip(cls.__slots__, spec.types)}
+            cache[name] = st.builds(cls, **fields)
+        return cache[name]
+
+    return message_strategy(type_name)
+
+
+def to_plain(value: Any) -> Any:
+    """JSON-able form of a message value: dicts, lists, ``[secs, nsecs]``, ``{"b": hex}``."""
+    if hasattr(value, "_slot_types") and hasattr(value, "_type"):
+        return {name: to_plain(getattr(value, name)) for name in value.__slots__}
+    if isinstance(value, (Time, Duration)):
+        return [value.secs, value.nsecs]
+    if isinstance(value, (bytes, bytearray, memoryview)):
+        return {"b": bytes(value).hex()}
+    if isinstance(value, (list, tuple)):
+        return [to_plain(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return {"f": repr(value)}
+    return value
+
+
+GENPY_ORACLE = r'''
+import importlib, json, math, sys, io, time
+import genpy
+
+def find_class(type_name):
+    pkg, name = type_name.split("/")
+    for kind in ("msg", "srv"):
+        try:
+            mod = importlib.import_module(pkg + "." + kind)
+        except ImportError:
+            continue
+        cls = getattr(mod, name, None)
+        if cls is not None and hasattr(cls, "_slot_types"):
+            return cls
+    raise KeyError(type_name)
+
+def build(cls, plain):
+    msg = cls()
+    for name, type_ in zip(cls.__slots__, cls._slot_types):
+        setattr(msg, name, value_of(type_, plain[name]))
+    return msg
+
+def value_of(type_, plain):
+    base = type_.split("[")[0]
+    if "[" in type_:
+        if base in ("uint8", "char"):
+            return bytes.fromhex(plain["b"])
+        return [value_of(base, v) for v in plain]
+    if base == "time":
+        return genpy.Time(*plain)
+    if base == "duration":
+        return genpy.Duration(*plain)
+    if isinstance(plain, dict) and "f" in plain:
+        return float(plain["f"])
+    if base in ("float32", "float64"):
+        return float(plain)
+    if isinstance(plain, dict):
+        if base == "Header":
+            base = "std_msgs/Header"
+        return build(find_class(base), plain)
+    return plain
+
+def plain_of(value):
+    if isinstance(value, genpy.Message):
+        return {n: plain_of(getattr(value, n)) for n in value.__slots__}
+    if isinstance(value, (genpy.Time, genpy.Duration)):
+        return [value.secs, value.nsecs]
+    if isinstance(value, bytes):
+        return {"b": value.hex()}
+    if isinstance(value, (list, tuple)):
+        return [plain_of(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return {"f": repr(value)}
+    return value
+
+for line in sys.stdin:
+    req = json.loads(line)
+    try:
+        cls = find_class(req["type"])
+        if req["op"] == "ser":
+            buf = io.BytesIO()
+            build(cls, req["value"]).serialize(buf)
+            out = {"hex": buf.getvalue().hex()}
+        elif req["op"] == "de":
+            out = {"value": plain_of(cls().deserialize(bytes.fromhex(req["hex"])))}
+        elif req["op"] == "bench":
+            msg = build(cls, req["value"])
+            buf = io.BytesIO(); msg.serialize(buf); data = buf.getvalue()
+            n = req["n"]
+            t0 = time.perf_counter()
+            for _ in range(n):
+                b = io.BytesIO(); msg.serialize(b)
+            t1 = time.perf_counter()
+            for _ in range(n):
+                cls().deserialize(data)
+            t2 = time.perf_counter()
+            out = {"ser": n / (t1 - t0), "de": n / (t2 - t1), "size": len(data)}
+        else:
+            out = {"error": "unknown op"}
+    except Exception as exc:
+        out = {"error": "%s: %s" % (type(exc).__name__, exc)}
+    sys.stdout.write(json.dumps(out) + "\n")
+    sys.stdout.flush()
+'''
+
+
+class GenpyOracle:
+    """One long-lived ``/usr/bin/python3`` process answering genpy (de)serialization requests."""
+
+    def __init__(self, python: str = "/usr/bin/python3", env: Dict[str, str] | None = None,
+                 timeout: float = 30.0) -> None:
+        self.timeout = timeout
+        self.proc = subprocess.Popen(
+            [python, "-c", GENPY_ORACLE], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL, env=env, text=True, bufsize=1)
+        self._selector = selectors.DefaultSelector()
+        self._selector.register(self.proc.stdout, selectors.EVENT_READ)
+
+    def request(self, **req: Any) -> Dict[str, Any]:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(json.dumps(req) + "\n")
+        self.proc.stdin.flush()
+        if not self._selector.select(self.timeout):
+            raise TimeoutError(f"genpy oracle did not answer within {self.timeout} s")
+        line = self.proc.stdout.readline()
+        if not line:
+            raise RuntimeError("genpy oracle exited")
+        return json.loads(line)
+
+    def serialize(self, type_name: str, msg: Any) -> bytes:
+        answer = self.request(op="ser", type=type_name, value=to_plain(msg))
+        if "error" in answer:
+            raise RuntimeError(f"genpy failed on {type_name}: {answer['error']}")
+        return bytes.fromhex(answer["hex"])
+
+    def deserialize(self, type_name: str, data: bytes) -> Any:
+        answer = self.request(op="de", type=type_name, hex=data.hex())
+        if "error" in answer:
+            raise RuntimeError(f"genpy failed on {type_name}: {answer['error']}")
+        return answer["value"]
+
+    def close(self) -> None:
+        try:
+            if self.proc.stdin:
+                self.proc.stdin.close()
+            self.proc.wait(5)
+        except (OSError, subprocess.TimeoutExpired):
+            self.proc.kill()
+            self.proc.wait(5)
+        self._selector.close()
+
+
+def bundled_types() -> List[str]:
+    """Every message type (including service request/response types) minros ships."""
+    from minros.packages import BUILTIN_SHARE_DIRS
+
+    names: List[str] = []
+    for root in BUILTIN_SHARE_DIRS:
+        for package in sorted(os.listdir(root)):
+            for kind in ("msg", "srv"):
+                folder = root / package / kind
+                if not folder.is_dir():
+                    continue
+                for file in sorted(os.listdir(folder)):
+                    stem, ext = os.path.splitext(file)
+                    if ext == ".msg" and kind == "msg":
+                        names.append(f"{package}/{stem}")
+                    elif ext == ".srv" and kind == "srv":
+                        names += [f"{package}/{stem}Request", f"{package}/{stem}Response"]
+    return names
+
+
+def bundled_services() -> List[str]:
+    from minros.packages import BUILTIN_SHARE_DIRS
+
+    names: List[str] = []
+    for root in BUILTIN_SHARE_DIRS:
+        for package in sorted(os.listdir(root)):
+            folder = root / package / "srv"
+            if folder.is_dir():
+                names += [f"{package}/{f[:-4]}" for f in sorted(os.listdir(folder)) if f.endswith(".srv")]
+    return names
