@@ -139,6 +139,7 @@ class Scope:
         self.args_passed: List[str] = []
         self.pass_all_args = False
         self._remaps: List[Tuple[str, str]] = []
+        self.arg_docs: Dict[str, Tuple[str | None, str | None]] = {}
 
     # -- tree
     def child(self, ns: str | None) -> Scope:
@@ -179,7 +180,8 @@ class Scope:
         self.params.append((key, value))
 
     # -- args
-    def add_arg(self, name: str, value: str | None, default: str | None) -> None:
+    def add_arg(self, name: str, value: str | None, default: str | None,
+                doc: str | None = None) -> None:
         if name in self.arg_names:
             if not self.pass_all_args:
                 raise ValueError(f"arg '{name}' has already been declared")
@@ -192,6 +194,8 @@ class Scope:
             target[name] = value
         elif default is not None and name not in target:
             target[name] = default
+        if value is None:  # what `roslaunch --ros-args` lists: settable args
+            self.arg_docs[name] = (doc, default)
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -265,8 +269,9 @@ class Loader:
 
     def __init__(self, env: Mapping[str, str] | None = None,
                  find: Callable[[str], Path | None] | None = None,
-                 run_commands: bool = True) -> None:
+                 run_commands: bool = True, args_only: bool = False) -> None:
         self.config = LaunchConfig()
+        self.args_only = args_only  # `roslaunch --ros-args`: read the <arg> declarations only
         self.env = os.environ if env is None else env
         self.find = find
         self.run_commands = run_commands
@@ -299,7 +304,7 @@ class Loader:
         finally:
             self._stack.pop()
             self._stack_names.pop()
-        self.config.arg_docs = {name: (None, None) for name in scope.arg_names}
+        self.config.arg_docs.update(scope.arg_docs)
         return self.config
 
     # -- generic helpers
@@ -355,6 +360,8 @@ class Loader:
         }
         for el in elements:
             handler = handlers.get(el.tag)
+            if self.args_only and el.tag != "arg":
+                continue
             if handler is None:
                 self._warn(scope, el, f"unrecognized tag {el.tag}")
                 continue
@@ -377,7 +384,7 @@ class Loader:
             raise self._err(scope, el, f"arg '{exc.name}' is not defined") from None
         if value is not None and default is not None:
             raise self._err(scope, el, "<arg> tag must have one and only one of value/default.")
-        scope.add_arg(name, value, default)
+        scope.add_arg(name, value, default, self._opt(el, scope, "doc"))
 
     def _ns_clear_params(self, el: Element, scope: Scope, node_name: str | None = None,
                          include_file: str | None = None) -> Scope:
