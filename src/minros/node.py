@@ -76,6 +76,8 @@ _node: Node | None = None
 _init_args: tuple | None = None
 _shutdown_event = threading.Event()  # set once shutdown is complete enough for is_shutdown()
 _shutdown_requested = False
+_shutdown_thread: threading.Thread | None = None
+_shutdown_done = threading.Event()  # set when the shutdown sequence has finished
 _client_hooks: List[Callable[[], Any]] = []
 _internal_hooks: List[Callable[[str], Any]] = []
 _argv_mappings: Dict[str, str] = names.load_mappings(sys.argv)
@@ -215,13 +217,30 @@ def add_shutdown_hook(hook: Callable[[str], Any]) -> None:
 
 def signal_shutdown(reason: str) -> None:
     """Shut the node down: client hooks, one unregistration multicall, close transports."""
-    global _shutdown_requested
+    global _shutdown_requested, _shutdown_thread
     with _state_lock:
         if _shutdown_requested:
-            return
-        _shutdown_requested = True
-        client_hooks = list(_client_hooks)
-        del _client_hooks[:]
+            in_progress_here = _shutdown_thread is threading.current_thread()
+            first = False
+        else:
+            _shutdown_requested = True
+            _shutdown_thread = threading.current_thread()
+            first = True
+            client_hooks = list(_client_hooks)
+            del _client_hooks[:]
+    if not first:
+        # e.g. atexit while a shutdown started by `rosnode kill` is still unregistering:
+        # let it finish, so the process does not exit halfway through the multicall
+        if not in_progress_here:
+            _shutdown_done.wait(5.0)
+        return
+    try:
+        _do_shutdown(reason, client_hooks)
+    finally:
+        _shutdown_done.set()
+
+
+def _do_shutdown(reason: str, client_hooks: List[Callable[[], Any]]) -> None:
     _logger.info("signal_shutdown [%s]", reason)
     for hook in client_hooks:
         try:
@@ -679,6 +698,8 @@ class SlaveApi:
         else:
             print("shutdown requst", flush=True)
         reason = f"external shutdown request from [{caller_id}]: [{msg}]"
+        # the reply must leave before the servers close: shut down from another thread
+        self._node._reply_grace = 0.2
         threading.Thread(target=signal_shutdown, args=(reason,), daemon=True).start()
         return 1, "shutdown", 0
 
@@ -801,6 +822,7 @@ class Node:
         self._done = threading.Event()
         self._inbound: set = set()
         self._warned_master = False
+        self._reply_grace = 0.0
 
     # -- XML-RPC -----------------------------------------------------------------------------
 
@@ -1032,6 +1054,8 @@ class Node:
         if self._tcpros_sock is not None:
             _close(self._tcpros_sock)
         if self._xmlrpc is not None:
+            if self._reply_grace:
+                time.sleep(self._reply_grace)
             try:
                 self._xmlrpc.shutdown()
             except Exception:

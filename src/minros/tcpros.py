@@ -248,7 +248,7 @@ class FrameReader:
     """
 
     __slots__ = ("_buf", "_view", "_start", "_end", "_big", "_big_len", "_big_fill",
-                 "_big_ok", "max_frame", "ok_byte", "_ready", "bytes_received")
+                 "_big_ok", "max_frame", "ok_byte", "_ready", "bytes_received", "_error")
 
     def __init__(self, max_frame: int = DEFAULT_MAX_FRAME, buff_size: int = DEFAULT_BUFF_SIZE,
                  ok_byte: bool = False) -> None:
@@ -266,11 +266,14 @@ class FrameReader:
         self.ok_byte = ok_byte
         self._ready: List = []
         self.bytes_received = 0
+        self._error: FrameError | None = None
 
     # -- I/O side --------------------------------------------------------------------------
 
     def recv_buffer(self) -> memoryview:
         """The writable region the next ``recv_into`` should fill (never empty)."""
+        if self._error is not None:
+            raise self._error
         big = self._big
         if big is not None:
             if self._big_fill == len(big):  # grow a big frame's buffer as its bytes arrive
@@ -290,13 +293,22 @@ class FrameReader:
                 self._finish_big()
             return
         self._end += n
-        self._parse()
+        try:
+            self._parse()
+        except FrameError as exc:
+            # the frames before the bad one are still good: frames() hands them out first
+            self._error = exc
 
     def frames(self) -> list:
-        """Pop the complete frames parsed so far (``bytes``/``bytearray``, or (ok, payload))."""
+        """Pop the complete frames parsed so far (``bytes``/``bytearray``, or (ok, payload)).
+
+        Raises FrameError once every good frame before a bad one has been handed out.
+        """
         ready = self._ready
         if ready:
             self._ready = []
+        elif self._error is not None:
+            raise self._error
         return ready
 
     def pending(self) -> int:
@@ -307,6 +319,8 @@ class FrameReader:
 
     def eof(self) -> None:
         """The peer closed the stream: an error if it stopped in the middle of a frame."""
+        if self._error is not None:
+            raise self._error
         pending = self.pending()
         if pending:
             raise FrameError(f"connection closed in the middle of a frame ({pending} bytes pending)")
@@ -314,7 +328,7 @@ class FrameReader:
     def feed(self, data: BytesLike) -> list:
         """Convenience for tests and non-socket users: push ``data`` and return new frames."""
         view = memoryview(data).cast("B")
-        while len(view):
+        while len(view) and self._error is None:
             target = self.recv_buffer()
             n = min(len(target), len(view))
             target[:n] = view[:n]

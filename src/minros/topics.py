@@ -630,8 +630,8 @@ class _SubConnection:
             "type": data_class._type,
             "callerid": _node_mod.get_caller_id(),
         }))
-        reader = tcpros.FrameReader(max_frame=tcpros.DEFAULT_MAX_HEADER,
-                                    buff_size=max(impl.buff_size, 4096))
+        # one reader for the header and the messages behind it (they may share a segment)
+        reader = tcpros.FrameReader(buff_size=max(impl.buff_size, 4096))
         frames: list = []
         while not frames:
             n = sock.recv_into(reader.recv_buffer())
@@ -640,6 +640,9 @@ class _SubConnection:
                 raise tcpros.HeaderError("publisher closed the connection during the handshake")
             reader.received(n)
             frames = reader.frames()
+        if len(frames[0]) > tcpros.DEFAULT_MAX_HEADER:
+            raise tcpros.HeaderError(f"connection header of {len(frames[0])} bytes exceeds the "
+                                     f"limit of {tcpros.DEFAULT_MAX_HEADER}")
         header = tcpros.decode_header(frames[0])
         error = tcpros.subscriber_header_error(header, impl.resolved_name, data_class._md5sum,
                                                data_class._type)
@@ -651,7 +654,6 @@ class _SubConnection:
         self.remote = sock.getpeername()
         self.fileno = sock.fileno()
         self.reader = reader
-        reader.max_frame = tcpros.DEFAULT_MAX_FRAME
         self.pending = frames[1:]
         self.connected = True
         return True
@@ -663,7 +665,7 @@ class _SubConnection:
         header = self.header
         latching = header.get("latching", "0") == "1"
         data_class = impl.data_class
-        frames = self.pending + reader.frames()
+        frames = self.pending
         recv_into = sock.recv_into
         while True:
             if frames:

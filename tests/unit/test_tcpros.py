@@ -262,3 +262,16 @@ def test_framing_garbage_only_raises_frame_error(data, buff_size):
         reader.eof()
     except FrameError:
         pass
+
+
+def test_good_frames_before_a_bad_one_are_delivered_first():
+    reader = FrameReader(max_frame=100)
+    data = frames_of(b"ok1", b"ok2") + struct.pack("<I", 101)
+    target = reader.recv_buffer()
+    target[:len(data)] = data
+    reader.received(len(data))  # does not raise: the good frames come out first
+    assert reader.frames() == [b"ok1", b"ok2"]
+    with pytest.raises(FrameError, match="exceeds the limit"):
+        reader.frames()
+    with pytest.raises(FrameError):
+        reader.recv_buffer()
