@@ -860,9 +860,15 @@ class Master:
     """A running master: handler, callback pool and XML-RPC server."""
 
     def __init__(self, port: int = DEFAULT_MASTER_PORT, host: str | None = None,
-                 workers: int = CALLBACK_WORKERS, callback_timeout: float = CALLBACK_TIMEOUT) -> None:
+                 workers: int = CALLBACK_WORKERS, callback_timeout: float = CALLBACK_TIMEOUT,
+                 hostname: str | None = None) -> None:
+        """``host``: address to bind (default: ROS's rule from ROS_IP/ROS_HOSTNAME);
+        ``hostname``: name advertised in the master URI (default: ROS_HOSTNAME/ROS_IP/host name)."""
         from minros import xmlrpc
 
+        self.hostname = hostname
+        if host is None and hostname is not None:
+            host = xmlrpc.get_bind_address(hostname)
         self.pool = CallbackPool(workers, callback_timeout)
         self.handler = MasterHandler(self.pool)
         # Stop a moment after the shutdown call so its reply still reaches the caller.
@@ -877,7 +883,10 @@ class Master:
         from minros import xmlrpc
 
         self.server.start()
-        self.uri = xmlrpc.create_local_xmlrpc_uri(self.server.port)
+        if self.hostname:
+            self.uri = f"http://{self.hostname}:{self.server.port}/"
+        else:
+            self.uri = xmlrpc.create_local_xmlrpc_uri(self.server.port)
         self.handler._set_uri(self.uri)
         return self
 
