@@ -31,7 +31,7 @@ _INT_WIDTHS = {
 #: messages up to this size are joined into one ``bytes`` before ``buff.write``
 _JOIN_LIMIT = 65536
 _SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
-                     UnicodeError, IndexError)
+                     UnicodeError, IndexError, SerializationError)
 
 
 class Message:

@@ -1,0 +1,99 @@
+"""User packages on ROS_PACKAGE_PATH import as <pkg>.msg / <pkg>.srv; stub packages on disk."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from minros.msgs import write_stub_package
+
+
+def _make_package(root: Path, name: str = "my_pkg") -> Path:
+    pkg = root / name
+    (pkg / "msg").mkdir(parents=True)
+    (pkg / "srv").mkdir()
+    (pkg / "package.xml").write_text(f"<package format='2'><name>{name}</name></package>\n")
+    (pkg / "msg" / "Num.msg").write_text("int64 num\nHeader header\ngeometry_msgs/Point[] pts\n")
+    (pkg / "msg" / "Pair.msg").write_text("Num a\nNum b\n")
+    (pkg / "srv" / "AddTwo.srv").write_text("int64 a\nint64 b\n---\nint64 sum\n")
+    return pkg
+
+
+def _run(code: str, env_extra: dict) -> subprocess.CompletedProcess:
+    env = dict(os.environ)
+    env.pop("PYTHONPATH", None)
+    env.update(env_extra)
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=60)
+
+
+def test_import_hook_finds_user_packages(tmp_path: Path) -> None:
+    _make_package(tmp_path / "src")
+    code = (
+        "import minros.msgs\n"
+        "from my_pkg.msg import Num, Pair\n"
+        "from my_pkg.srv import AddTwo, AddTwoRequest, AddTwoResponse\n"
+        "import my_pkg.msg as m\n"
+        "n = Num(num=5); n.pts = [__import__('geometry_msgs.msg').msg.Point(1, 2, 3)]\n"
+        "assert Num().deserialize(n.serialize_to_bytes()) == n\n"
+        "assert AddTwo._request_class is AddTwoRequest and AddTwoResponse(3).sum == 3\n"
+        "assert Pair._type == 'my_pkg/Pair' and sorted(m.__all__) == ['Num', 'Pair']\n"
+        "print(Num._type, AddTwo._md5sum)\n"
+    )
+    out = _run(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    assert out.returncode == 0, out.stderr
+    # same text as rospy_tutorials/AddTwoInts, so the same md5 sum
+    assert out.stdout.split() == ["my_pkg/Num", "6a2e34150c00229791cc89ff309fff21"]
+
+
+def test_import_hook_leaves_other_imports_alone(tmp_path: Path) -> None:
+    _make_package(tmp_path / "src")
+    code = (
+        "import minros.msgs, importlib\n"
+        "for name in ('no_such_module_xyz', 'my_pkg.nothing', 'std_msgs.msg.Nope'):\n"
+        "    try:\n"
+        "        importlib.import_module(name)\n"
+        "    except ImportError:\n"
+        "        pass\n"
+        "    else:\n"
+        "        raise SystemExit('imported ' + name)\n"
+        "try:\n"
+        "    from my_pkg.msg import Missing\n"
+        "except ImportError as exc:\n"
+        "    print('ok', exc)\n"
+    )
+    out = _run(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("ok cannot import name 'Missing'")
+
+
+def test_write_stub_package(tmp_path: Path) -> None:
+    _make_package(tmp_path / "src")
+    devel = tmp_path / "devel" / "lib" / "python3" / "dist-packages"
+    root = write_stub_package("my_pkg", devel)
+    assert (root / "__init__.py").is_file() and (root / "msg" / "__init__.py").is_file()
+    assert (root / "srv" / "__init__.py").is_file()
+    # a real module is never overwritten
+    (root / "srv" / "__init__.py").write_text("REAL = 1\n")
+    write_stub_package("my_pkg", devel)
+    assert (root / "srv" / "__init__.py").read_text() == "REAL = 1\n"
+    (root / "srv" / "__init__.py").unlink()
+    write_stub_package("my_pkg", devel)
+    # the stubs work without the import hook having been installed first
+    code = ("from my_pkg.msg import Num\nfrom my_pkg.srv import AddTwoRequest\n"
+            "print(Num.__module__, AddTwoRequest._type)\n")
+    out = _run(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src"), "PYTHONPATH": str(devel)})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["my_pkg.msg", "my_pkg/AddTwoRequest"]
+
+
+def test_bundled_stub_packages_import_without_ros() -> None:
+    code = ("from std_msgs.msg import String\nfrom std_srvs.srv import Empty, EmptyResponse\n"
+            "from turtlesim.srv import Spawn, SpawnRequest\nfrom rospy_tutorials.srv import AddTwoInts\n"
+            "from sensor_msgs.msg import Image\nfrom rosgraph_msgs.msg import Clock, Log\n"
+            "import io; b = io.BytesIO(); String('x').serialize(b); print(b.getvalue().hex())\n")
+    out = _run(code, {"ROS_PACKAGE_PATH": ""})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "0100000078"
