@@ -129,6 +129,25 @@ def resolve_name(name: str, caller_id: str | None = None) -> str:
     return mappings.get(resolved, resolved)
 
 
+def resolve_name_without_node_name(name: str) -> str:
+    """Resolve a topic/service name created before init_node (rospy semantics): relative to
+    the namespace, with the command-line remappings; ``~name`` is an error then."""
+    if names.is_private(name):
+        raise ValueError("~name topics cannot be created before init_node() has been called")
+    fake_caller_id = names.ns_join(names.get_ros_namespace(argv=sys.argv), "node")
+    resolved = names.resolve_name(name, fake_caller_id)
+    for src, dst in _argv_mappings.items():
+        if src.startswith("__"):
+            continue
+        if names.resolve_name(src, fake_caller_id) == resolved:
+            if names.is_private(dst):
+                raise ROSInitException(
+                    f"due to the way this node is written, {name} cannot be remapped to a ~name. \n"
+                    "The declaration of topics/services must be moved after the call to init_node()")
+            return names.resolve_name(dst, fake_caller_id)
+    return resolved
+
+
 def remap_name(name: str, caller_id: str | None = None, resolved: bool = True) -> str:
     """Remap ``name`` without otherwise resolving it (rospy.remap_name)."""
     if caller_id is None:
@@ -340,8 +359,6 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
     _caller_id = caller_id
     _resolved_mappings = names.resolve_mappings(
         {k: v for k, v in _argv_mappings.items() if not k.startswith("__")}, caller_id)
-    # topics created before init_node were resolved against '/unnamed': resolve them again
-    _reresolve_registrations()
 
     node = Node(caller_id, _default_master_uri(), xmlrpc_port=xmlrpc_port, tcpros_port=tcpros_port)
     _node = node
@@ -380,17 +397,6 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
             starter(caller_id, log_level, disable_rosout)
     except ImportError:
         pass
-
-
-def _reresolve_registrations() -> None:
-    """Publishers/subscribers made before init_node get their final names now."""
-    with _registry_lock:
-        for registry in (_publications, _subscriptions):
-            for old, impl in list(registry.items()):
-                fresh = impl.reresolve() if hasattr(impl, "reresolve") else old
-                if fresh != old:
-                    del registry[old]
-                    registry[fresh] = impl
 
 
 def get_master_uri() -> str:

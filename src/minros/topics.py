@@ -415,10 +415,6 @@ class _PublisherImpl:
         self.ref_count = 0
         self.closed = False
 
-    def reresolve(self) -> str:
-        self.resolved_name = _node_mod.resolve_name(self.name)
-        return self.resolved_name
-
     # -- connections ---------------------------------------------------------------------
 
     def accept_subscriber(self, sock: socket.socket, addr, header: Dict[str, str]) -> str | None:
@@ -736,10 +732,6 @@ class _SubscriberImpl:
         self.ref_count = 0
         self.closed = False
 
-    def reresolve(self) -> str:
-        self.resolved_name = _node_mod.resolve_name(self.name)
-        return self.resolved_name
-
     def publisher_update(self, uris: List[str]) -> None:
         """The master's current publisher list: connect to the new ones."""
         with self.lock:
@@ -837,7 +829,10 @@ def _acquire(kind: str, name: str, data_class: Any) -> Any:
         raise ValueError("topic name must be a non-empty string")
     if data_class is None or not hasattr(data_class, "_md5sum"):
         raise ValueError(f"data_class [{data_class}] is not a message data class")
-    resolved = _node_mod.resolve_name(name)
+    if _node_mod.is_initialized():
+        resolved = _node_mod.resolve_name(name)
+    else:
+        resolved = _node_mod.resolve_name_without_node_name(name)
     with _impl_lock:
         if kind == "pub":
             impl = _node_mod._get_publication(resolved)
