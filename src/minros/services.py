@@ -29,6 +29,7 @@ import threading
 import time
 import traceback
 import warnings
+import xmlrpc.client
 from typing import Any, Callable, Dict, Tuple
 
 from minros import names, tcpros
@@ -56,6 +57,8 @@ DEFAULT_BUFF_SIZE = 65536
 WAIT_FOR_SERVICE_INTERVAL = 0.3
 #: connect timeout of a service call; the response itself may take as long as the handler
 CONNECT_TIMEOUT = 10.0
+#: rospy's text when the peer closes the connection before a whole message arrived
+_PEER_GONE = "unable to receive data from sender, check sender's logs for details"
 #: sockets wake up this often to notice node shutdown while waiting for a peer
 _POLL = 1.0
 
@@ -218,6 +221,8 @@ class Service:
         self._lock = threading.Lock()
         from minros import node
 
+        if self.resolved_name in getattr(node, "_services", {}):
+            raise ServiceException(f"service [{self.resolved_name}] already registered")
         node.register_service(self.resolved_name, self._handle_connection)
         #: rosrpc:// URI the master knows us by (None until init_node started the node)
         self.uri: str | None = None
@@ -480,9 +485,11 @@ class ServiceProxy:
                 _send_all(self._sock, tcpros.encode_frame(payload))
                 frame = self._source.next()
                 if frame is None:
-                    raise TransportTerminated("connection closed by the service before its response")
+                    raise TransportTerminated(_PEER_GONE)
             except TransportException as exc:
                 self._drop()
+                if isinstance(exc, tcpros.FrameError) and "closed" in str(exc):
+                    exc = TransportTerminated(_PEER_GONE)  # rospy's words for a peer gone mid-reply
                 if _is_shutdown():
                     raise ROSInterruptException("node shutdown interrupted service call") from None
                 raise ServiceException(f"transport error completing service call: {exc}") from None
@@ -513,7 +520,7 @@ class ServiceProxy:
             self._drop()
 
 
-def _probe_service(resolved_name: str, timeout: float) -> bool:
+def _probe_service(resolved_name: str, timeout: float) -> str | None:
     """Is the service registered and accepting connections? Sends a probe header and closes."""
     try:
         proxy = _master()
@@ -521,10 +528,10 @@ def _probe_service(resolved_name: str, timeout: float) -> bool:
             code, _msg, uri = proxy.lookupService(_caller_id(), resolved_name)
         finally:
             proxy.close()
-    except OSError:
-        return False
+    except (xmlrpc.client.Error, ValueError) as exc:  # OSError (master down) goes to the caller
+        raise TransportInitError(f"master lookup failed: {exc}") from None
     if code != 1:
-        return False
+        return None
     host, port = parse_rosrpc_uri(uri)
     sock = _connect(host, port, timeout)
     try:
@@ -532,7 +539,7 @@ def _probe_service(resolved_name: str, timeout: float) -> bool:
                                               "service": resolved_name}))
     finally:
         _close(sock)
-    return True
+    return uri
 
 
 def wait_for_service(service: str, timeout: float | None = None) -> None:
@@ -557,9 +564,10 @@ def wait_for_service(service: str, timeout: float | None = None) -> None:
             break
         try:
             probe_timeout = 10.0 if remaining is None else max(0.01, remaining)
-            if _probe_service(resolved_name, probe_timeout):
+            uri = _probe_service(resolved_name, probe_timeout)
+            if uri:
                 if contact_failed:
-                    loginfo(f"wait_for_service({resolved_name}): finally were able to contact service")
+                    loginfo(f"wait_for_service({resolved_name}): finally were able to contact [{uri}]")
                 return
         except (OSError, ParameterInvalid, TransportException):
             contact_failed = True

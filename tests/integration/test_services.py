@@ -290,6 +290,10 @@ import rospy
 from std_srvs.srv import Empty, EmptyResponse
 rospy.init_node("shutter")
 target = rospy.Service("target", Empty, lambda req: EmptyResponse())
+try:
+    rospy.Service("/target", Empty, lambda req: EmptyResponse())
+except rospy.ServiceException as e:
+    print("DUPLICATE %s" % e, flush=True)
 def stop(req):
     target.shutdown("asked to")
     return EmptyResponse()
@@ -306,7 +310,8 @@ def test_service_shutdown_unregisters(master_env, tmp_path):
     script.write_text(SHUTDOWN_SERVER)
     proc = Proc([PYTHON, str(script)], master_env)
     try:
-        proc.read_until("READY", 30)
+        out = proc.read_until("READY", 30)
+        assert "DUPLICATE service [/target] already registered" in out
         minros.wait_for_service("/target", timeout=10)
         minros.ServiceProxy("/target", Empty)()
         minros.ServiceProxy("/stop_target", Empty)()
@@ -316,6 +321,35 @@ def test_service_shutdown_unregisters(master_env, tmp_path):
         code, _msg, _uri = master.lookupService("/tester", "/target")
         assert code == -1
         assert minros.ServiceProxy("/stop_target", Empty)() is not None
+    finally:
+        proc.stop()
+
+
+DYING_SERVER = r'''
+import os
+import rospy
+from std_srvs.srv import Empty
+rospy.init_node("dier")
+rospy.Service("die", Empty, lambda req: os._exit(0))
+print("READY", flush=True)
+rospy.spin()
+'''
+
+
+def test_server_dying_mid_call(master_env, tmp_path):
+    from std_srvs.srv import Empty
+
+    script = tmp_path / "dier.py"
+    script.write_text(DYING_SERVER)
+    proc = Proc([PYTHON, str(script)], master_env)
+    try:
+        proc.read_until("READY", 30)
+        minros.wait_for_service("/die", timeout=10)
+        with pytest.raises(ServiceException) as info:
+            minros.ServiceProxy("/die", Empty)()
+        # rospy's words, checked against Debian's rospy by hand
+        assert str(info.value) == ("transport error completing service call: unable to receive "
+                                   "data from sender, check sender's logs for details")
     finally:
         proc.stop()
 
