@@ -57,6 +57,8 @@ def handle(req):
         return req.a + req.b
     if req.a == 19:
         return (1, 2)
+    if req.a == 21:  # custom connection headers of the client reach the handler
+        return AddTwoIntsResponse(len(req._connection_header.get("cookies", "")))
     print("Returning [%s + %s = %s]" % (req.a, req.b, req.a + req.b), flush=True)
     return AddTwoIntsResponse(req.a + req.b)
 
@@ -86,6 +88,7 @@ for a in range(13, 21):
     except rospy.ServiceException as e:
         out[str(a)] = "ERR %s" % e
 out["call"] = proxy.call(AddTwoIntsRequest(2, 3)).sum
+out["cookies"] = rospy.ServiceProxy(name, AddTwoInts, headers={"cookies": "chocolate"})(21, 0).sum
 out["kw"] = proxy(a=4, b=5).sum
 resp = proxy(1, 1)
 out["header"] = sorted(resp._connection_header)

@@ -94,6 +94,18 @@ def test_same_answers_and_error_texts_in_all_four_combinations(env_for, scripts)
                 in wrong_arity), combo
         if combo != ("rospy", "rospy"):
             assert result == {k: v for k, v in oracle.items() if k != "19"}, combo
+    assert oracle["cookies"] == len("chocolate")
+    # the server side of an md5 mismatch: the same warning (after the timestamp) from both
+    warnings = {}
+    for impl, out in outputs.items():
+        warnings[impl] = sorted(line.split("]: ", 1)[1] for line in out.splitlines()
+                                if "Could not process inbound connection" in line)
+    assert len(warnings["rospy"]) == 2  # one per client implementation
+    expected = [w.replace("/rospy/", "/minros/") for w in warnings["rospy"]]
+    assert warnings["minros"] == expected
+    assert expected[0].startswith("Could not process inbound connection: request from [/unnamed]: "
+                                  "md5sums do not match: [60962375a49bd6746d7c85dff75ebb9c] vs. "
+                                  "[6a2e34150c00229791cc89ff309fff21]{")
     assert "error handler saw boom" in outputs["minros"]
     assert "Returning [20 + 1 = 21]" in outputs["minros"]
 
