@@ -98,7 +98,7 @@ def load_all(files: List[str], args: List[str]) -> LaunchConfig:
 
 def main(argv: List[str], prog: str | None = None) -> int:
     prog = prog or "minros launch"
-    options = _parser(prog).parse_args(argv)
+    options = _parser(prog).parse_intermixed_args(argv)
     try:
         return _main(options, prog)
     except LaunchError as exc:

@@ -89,8 +89,9 @@ class LaunchProcess:
 
     def __init__(self, name: str, argv: List[str], env: Dict[str, str], cwd: str,
                  spec: NodeSpec | None = None, log_dir: Path | None = None,
-                 screen: bool = True) -> None:
+                 screen: bool = True, log_stem: str | None = None) -> None:
         self.name = name
+        self.log_stem = log_stem
         self.argv = argv
         self.env = env
         self.cwd = cwd
@@ -112,7 +113,7 @@ class LaunchProcess:
         return bool(self.spec and self.spec.required)
 
     def log_name(self) -> str:
-        return self.name.replace("/", "-")
+        return self.log_stem or self.name.replace("/", "-")
 
     def start(self) -> int:
         stdout: Any = None
@@ -249,7 +250,9 @@ class LaunchRunner:
         if importlib.util.find_spec("minros.cli.core") is None:  # bare master until `core` exists
             argv = [sys.executable, "-m", "minros.master", "-p", str(port)]
         env = dict(self.env, ROS_MASTER_URI=self.master_uri)
-        self.master = LaunchProcess("master", argv, env, str(ros_home(self.env)), screen=True)
+        # the master's own console output goes to a log file, as roslaunch does with rosmaster's
+        self.master = LaunchProcess("master", argv, env, str(ros_home(self.env)), screen=False,
+                                    log_dir=log_root(self.env), log_stem=f"master-{port}")
         ros_home(self.env).mkdir(parents=True, exist_ok=True)
         pid = self.master.start()
         self.out(f"process[master]: started with pid [{pid}]")
