@@ -1,0 +1,348 @@
+"""``minros param`` / ``rosparam``: get, set, list, delete, dump and load parameters.
+
+Output and error texts follow Debian's rosparam (ros_comm 1.15): YAML via PyYAML, ``set``
+with a dictionary merges key by key (the master API would replace the namespace), ``load``
+reads one or more YAML documents from a file or stdin (``-``) with ``_ns`` support.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import xmlrpc.client
+from typing import Any, List, Tuple
+
+import yaml
+
+from minros import names
+from minros.tools.common import ToolError, dispatch, parser, resolve, run_tool
+from minros.tools.master import Master
+
+NAME = "rosparam"
+USAGE = """rosparam is a command-line tool for getting, setting, and deleting parameters from the ROS Parameter Server.
+
+Commands:
+\trosparam set\tset parameter
+\trosparam get\tget parameter
+\trosparam load\tload parameters from file
+\trosparam dump\tdump parameters to file
+\trosparam delete\tdelete parameter
+\trosparam list\tlist parameter names
+"""
+MAX_INT = 2 ** 31 - 1
+
+
+class _Dumper(yaml.Dumper):
+    """yaml.Dumper that writes XML-RPC Binary values as ``!!binary`` (as rosparam does)."""
+
+
+def _represent_binary(dumper: yaml.Dumper, data: xmlrpc.client.Binary) -> Any:
+    import base64
+
+    return dumper.represent_scalar("tag:yaml.org,2002:binary",
+                                   base64.b64encode(data.data).decode("ascii"), style="|")
+
+
+_Dumper.add_representer(xmlrpc.client.Binary, _represent_binary)
+
+
+def _loader() -> type:
+    from minros.launch.rosparam_yaml import RosparamLoader
+
+    return RosparamLoader
+
+
+def yaml_load(text: str) -> Any:
+    try:
+        return yaml.load(text, Loader=_loader())  # noqa: S506 - a SafeLoader subclass
+    except (yaml.YAMLError, ValueError) as exc:
+        raise ToolError(f"invalid YAML: {_one_line(exc)}") from None
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+def dump_yaml(value: Any) -> str:
+    return yaml.dump(value, Dumper=_Dumper)
+
+
+def _master() -> Master:
+    return Master(names.make_caller_id(f"rosparam-{os.getpid()}").rstrip("/"))
+
+
+# ---------------------------------------------------------------------------------------------
+# operations (library API too)
+
+def set_param_raw(master: Master, param: str, value: Any, verbose: bool = False) -> None:
+    """Set ``param``; dictionaries are merged key by key as rosparam does."""
+    if isinstance(value, dict):
+        for key, sub in value.items():
+            if not isinstance(key, str):
+                raise ToolError(f"YAML dictionaries must have string keys. Invalid dictionary is: {value}")
+            set_param_raw(master, names.ns_join(param, key), sub, verbose)
+        return
+    _check_xmlrpc_value(value)
+    master.setParam(param, value)
+    if verbose:
+        print(f"set parameter [{param}] to [{value}]")
+
+
+def _check_xmlrpc_value(value: Any) -> None:
+    if value is None:
+        raise ToolError("cannot set a parameter to an empty value (null is not an XML-RPC value)")
+    if isinstance(value, bool):
+        return
+    if isinstance(value, int):
+        if not -MAX_INT - 1 <= value <= MAX_INT:
+            raise ToolError("Overflow: Parameter Server integers must be 32-bit signed integers: "
+                            f"{-MAX_INT - 1} <= value <= {MAX_INT}")
+    elif isinstance(value, (list, tuple)):
+        for item in value:
+            _check_xmlrpc_value(item)
+    elif isinstance(value, dict):
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise ToolError(f"YAML dictionaries must have string keys. Invalid dictionary is: {value}")
+            _check_xmlrpc_value(item)
+    elif isinstance(value, (float, str, xmlrpc.client.Binary)):
+        return
+    elif hasattr(value, "isoformat"):
+        return
+    else:
+        raise ToolError(f"cannot store a value of type {type(value).__name__} on the parameter server")
+
+
+def list_params(master: Master, ns: str) -> List[str]:
+    ns = names.make_global_ns(ns)
+    return sorted(n for n in master.getParamNames() if n.startswith(ns))
+
+
+def load_documents(text: str, default_ns: str, verbose: bool = False) -> List[Tuple[Any, str]]:
+    try:
+        docs = list(yaml.load_all(text, Loader=_loader()))  # noqa: S506 - SafeLoader subclass
+    except (yaml.YAMLError, ValueError) as exc:
+        raise ToolError(f"invalid YAML: {_one_line(exc)}") from None
+    out = []
+    for doc in docs:
+        if doc is None:
+            continue
+        ns = default_ns
+        if isinstance(doc, dict) and "_ns" in doc:
+            ns = names.ns_join(default_ns, doc.pop("_ns"))
+            if verbose:
+                print(f"reading parameters into namespace [{ns}]")
+        out.append((doc, ns))
+    return out
+
+
+def print_params(params: Any, ns: str) -> None:
+    if isinstance(params, dict):
+        for key, value in params.items():
+            if isinstance(value, dict):
+                print_params(value, names.ns_join(ns, key))
+            else:
+                print(f"{names.ns_join(ns, key)}={value}")
+    else:
+        print(params)
+
+
+def _pretty_print(value: dict, indent: str = "") -> None:
+    for key in sorted(value):
+        item = value[key]
+        if isinstance(item, dict):
+            print(f"{indent}{key}:")
+            _pretty_print(item, indent + "  ")
+        elif isinstance(item, str):
+            if "\n" in item:
+                print(f"{indent}{key}: |")
+                for line in item.split("\n"):
+                    print(f"{indent}  {line}")
+            else:
+                print(f"{indent}{key}: {item}")
+        else:
+            text = dump_yaml(item)
+            if text.endswith("\n...\n"):
+                text = text[:-4]
+            sys.stdout.write(f"{indent}{key}: {text}")
+
+
+# ---------------------------------------------------------------------------------------------
+# commands
+
+def _cmd_get(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] parameter")
+    p.add_argument("-p", dest="pretty", action="store_true", help="pretty print. WARNING: not YAML-safe")
+    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
+    p.add_argument("parameter", nargs="?")
+    args = p.parse_args(argv)
+    if args.parameter is None:
+        p.error("invalid arguments. Please specify a parameter name")
+    name = resolve(NAME, args.parameter)
+    if args.verbose:
+        print(f"getting parameter [{name}]")
+    value = _master().getParam(name)
+    if args.pretty and isinstance(value, (dict, str)):
+        if isinstance(value, dict):
+            _pretty_print(value)
+        else:
+            print(value)
+    else:
+        text = dump_yaml(value)
+        if text.endswith("\n...\n"):
+            text = text[:-5]
+        sys.stdout.write(f"{text}\n")
+    return 0
+
+
+def _cmd_dump(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] file [namespace]")
+    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
+    p.add_argument("file", nargs="?")
+    p.add_argument("namespace", nargs="?", default="")
+    args = p.parse_args(argv)
+    if args.verbose:
+        print(f"dumping namespace [{args.namespace}] to file [{args.file}]")
+    ns = resolve(NAME, args.namespace)
+    tree = _master().getParam(ns)
+    if args.verbose:
+        print_params(tree, ns)
+    text = dump_yaml(tree)
+    if not args.file or args.file == "-":
+        sys.stdout.write(text)
+    else:
+        try:
+            with open(args.file, "w") as f:
+                f.write(text)
+        except OSError as exc:
+            raise ToolError(f"cannot write [{args.file}]: {exc.strerror}") from None
+    return 0
+
+
+def _split_set_args(argv: List[str]) -> Tuple[List[str], List[str]]:
+    """Negative numbers are values, not options (as rosparam's own parser does)."""
+    opts, positional = [], []
+    skip = False
+    for arg in argv:
+        if skip:
+            opts.append(arg)
+            skip = False
+        elif arg in ("-t", "--textfile", "-b", "--binfile"):
+            opts.append(arg)
+            skip = True
+        elif arg.startswith("-") and len(arg) > 1 and (arg[1].isdigit() or arg[1] == "."):
+            positional.append(arg)
+        elif arg.startswith("-") and len(arg) > 1:
+            opts.append(arg)
+        else:
+            positional.append(arg)
+    return opts, positional
+
+
+def _cmd_set(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] parameter value")
+    p.add_argument("-t", "--textfile", dest="text_file", metavar="TEXT_FILE",
+                   help="set parameters to contents of text file")
+    p.add_argument("-b", "--binfile", dest="bin_file", metavar="BINARY_FILE",
+                   help="set parameters to contents of binary file")
+    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
+    opts, positional = _split_set_args(argv)
+    args = p.parse_args(opts)
+    if args.text_file and args.bin_file:
+        p.error("you may only specify one of --textfile or --binfile")
+    if not positional:
+        p.error("invalid arguments. Please specify a parameter name")
+    if len(positional) > 2:
+        p.error("too many arguments")
+    if len(positional) == 1 and not (args.text_file or args.bin_file):
+        p.error("invalid arguments. Please specify a parameter value")
+    name = resolve(NAME, positional[0])
+    master = _master()
+    if args.text_file:
+        if not os.path.isfile(args.text_file):
+            p.error(f"file '{args.text_file}' does not exist")
+        with open(args.text_file) as f:
+            set_param_raw(master, name, f.read(), args.verbose)
+    elif args.bin_file:
+        try:
+            with open(args.bin_file, "rb") as f:
+                data = f.read()
+        except OSError as exc:
+            raise ToolError(f"cannot read [{args.bin_file}]: {exc.strerror}") from None
+        set_param_raw(master, name, xmlrpc.client.Binary(data), args.verbose)
+    else:
+        text = positional[1]
+        value = yaml_load(text) if text != "" else ""
+        set_param_raw(master, name, value, args.verbose)
+    return 0
+
+
+def _cmd_load(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] file [namespace]")
+    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
+    p.add_argument("file", nargs="?")
+    p.add_argument("namespace", nargs="?")
+    args = p.parse_args(argv)
+    if args.file is None:
+        p.error("invalid arguments. Please specify a file name or - for stdin")
+    default_ns = resolve(NAME, args.namespace) if args.namespace else names.get_ros_namespace()
+    if args.file == "-":
+        if args.verbose:
+            print("reading parameters from stdin")
+        text = sys.stdin.read()
+    else:
+        if not os.path.isfile(args.file):
+            raise ToolError(f"file [{args.file}] does not exist")
+        if args.verbose:
+            print(f"reading parameters from [{args.file}]")
+        with open(args.file) as f:
+            text = f.read()
+    master = _master()
+    for params, ns in load_documents(text, default_ns, args.verbose):
+        if ns == "/" and not isinstance(params, dict):
+            raise ToolError("global / can only be set to a dictionary")
+        if args.verbose:
+            print_params(params, ns)
+        set_param_raw(master, ns, params)
+    return 0
+
+
+def _cmd_delete(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] parameter")
+    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
+    p.add_argument("parameter", nargs="*")
+    args = p.parse_args(argv)
+    if not args.parameter:
+        p.error("invalid arguments. Please specify a parameter name")
+    if len(args.parameter) > 1:
+        p.error("too many arguments")
+    name = resolve(NAME, args.parameter[0])
+    master = _master()
+    if name == "/":
+        master.setParam("/", {})
+        if args.verbose:
+            print("deleted ENTIRE parameter server")
+    else:
+        master.deleteParam(name)
+        if args.verbose:
+            print(f"deleted parameter [{name}]")
+    return 0
+
+
+def _cmd_list(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [namespace]")
+    p.add_argument("namespace", nargs="*")
+    args = p.parse_args(argv)
+    if len(args.namespace) > 1:
+        p.error("too many arguments")
+    ns = resolve(NAME, args.namespace[0]) if args.namespace else "/"
+    print("\n".join(list_params(_master(), ns)))
+    return 0
+
+
+COMMANDS = {"get": _cmd_get, "set": _cmd_set, "load": _cmd_load, "dump": _cmd_dump,
+            "delete": _cmd_delete, "list": _cmd_list}
+
+
+def main(argv: List[str], prog: str = "rosparam") -> int:
+    return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE))

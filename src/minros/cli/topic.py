@@ -1,0 +1,927 @@
+"""``minros topic`` / ``rostopic``: list, info, type, find, echo, pub, hz, bw and delay.
+
+Texts and exit statuses follow Debian's rostopic (ros_comm 1.15). ``echo``, ``hz`` and ``bw``
+subscribe with md5 ``*`` and decode with the publisher's definition, so they work for types
+that are not installed locally.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import threading
+import time
+from typing import Any, Callable, Dict, List, Tuple
+from urllib.parse import urlparse
+
+import yaml
+
+from minros import names
+from minros.tools.common import ToolError, dispatch, flush_stdout, parser, resolve, run_tool
+from minros.tools.master import Master, MasterError
+
+NAME = "rostopic"
+USAGE = """rostopic is a command-line tool for printing information about ROS Topics.
+
+Commands:
+\trostopic bw\tdisplay bandwidth used by topic
+\trostopic delay\tdisplay delay of topic from timestamp in header
+\trostopic echo\tprint messages to screen
+\trostopic find\tfind topics by type
+\trostopic hz\tdisplay publishing rate of topic
+\trostopic info\tprint information about active topic
+\trostopic list\tlist active topics
+\trostopic pub\tpublish data to topic
+\trostopic type\tprint topic or field type
+
+Type rostopic <command> -h for more detailed usage, e.g. 'rostopic echo -h'
+"""
+ONCE_DELAY = 3.0
+SUBSCRIBER_TIMEOUT = 5.0
+
+
+def _master() -> Master:
+    return Master("/rostopic")
+
+
+def _check_master() -> Master:
+    master = _master()
+    master.getPid()
+    return master
+
+
+# ---------------------------------------------------------------------------------------------
+# graph queries
+
+def get_topic_list(master: Master) -> Tuple[list, list]:
+    pubs, subs, _srvs = master.system_state()
+    types = dict((t, ty) for t, ty in master.topic_types())
+    return ([(t, types.get(t, "unknown type"), nodes) for t, nodes in pubs],
+            [(t, types.get(t, "unknown type"), nodes) for t, nodes in subs])
+
+
+def _message_class(type_name: str) -> Any:
+    from minros.msgs import get_message_class
+
+    try:
+        return get_message_class(type_name)
+    except Exception:
+        return None
+
+
+def _nested_ok(cls: Any, path: str) -> bool:
+    obj = cls()
+    for part in path.split("/"):
+        try:
+            obj = getattr(obj, part)
+        except AttributeError:
+            return False
+    return True
+
+
+def topic_type(master: Master, topic: str) -> Tuple[str | None, str | None, str]:
+    """(type, real topic, field path) for ``topic`` which may name a field (``/pose/x``)."""
+    types = master.topic_types()
+    for name, type_name in types:
+        if name == topic:
+            return (None if type_name == names.ANYTYPE else type_name), name, ""
+    candidates = sorted(((t, ty) for t, ty in types if topic.startswith(t + "/")), reverse=True)
+    for name, type_name in candidates:
+        field = topic[len(name) + 1:].rstrip("/").split("[")[0]
+        cls = _message_class(type_name)
+        if cls is None or field == "":
+            break
+        if _nested_ok(cls, field):
+            if type_name == names.ANYTYPE:
+                return None, None, ""
+            return type_name, name, topic[len(name):]
+        continue
+    return None, None, ""
+
+
+def wait_topic_type(master: Master, topic: str) -> Tuple[str, str, str]:
+    found = topic_type(master, topic)
+    if found[0]:
+        return found  # type: ignore[return-value]
+    sys.stderr.write(f"WARNING: topic [{topic}] does not appear to be published yet\n")
+    sys.stderr.flush()
+    from minros import node
+
+    while not node.is_shutdown():
+        found = topic_type(master, topic)
+        if found[0]:
+            return found  # type: ignore[return-value]
+        if node.wait_for_shutdown(0.1):
+            break
+    raise KeyboardInterrupt
+
+
+def _init_node(disable_rosout: bool = False) -> None:
+    from minros import node
+
+    node.init_node(NAME, argv=[sys.argv[0]] + [a for a in sys.argv[1:] if ":=" in a],
+                   anonymous=True, disable_rosout=disable_rosout)
+
+
+def _spin_until(done: Callable[[], bool], step: float = 0.1) -> None:
+    from minros import node
+
+    while not done():
+        if node.wait_for_shutdown(step):
+            return
+
+
+# ---------------------------------------------------------------------------------------------
+# list / info / type / find
+
+def _print_list(master: Master, pubs: list, subs: list, pubs_only: bool, subs_only: bool,
+                verbose: bool, indent: str = "") -> None:
+    if verbose:
+        if not subs_only:
+            print(f"\n{indent}Published topics:")
+            for t, ty, nodes in pubs:
+                if len(nodes) > 1:
+                    print(f"{indent} * {t} [{ty}] {len(nodes)} publishers")
+                else:
+                    print(f"{indent} * {t} [{ty}] 1 publisher")
+        if not pubs_only:
+            print(indent)
+            print(f"{indent}Subscribed topics:")
+            for t, ty, nodes in subs:
+                if len(nodes) > 1:
+                    print(f"{indent} * {t} [{ty}] {len(nodes)} subscribers")
+                else:
+                    print(f"{indent} * {t} [{ty}] 1 subscriber")
+        print("")
+        return
+    if pubs_only:
+        topics = [t for t, _, _ in pubs]
+    elif subs_only:
+        topics = [t for t, _, _ in subs]
+    else:
+        topics = list({t for t, _, _ in pubs} | {t for t, _, _ in subs})
+    print("\n".join(f"{indent}{t}" for t in sorted(topics)))
+
+
+def _cmd_list(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [/namespace]")
+    p.add_argument("-v", "--verbose", action="store_true", help="list full details about each topic")
+    p.add_argument("-p", dest="publishers", action="store_true", help="list only publishers")
+    p.add_argument("-s", dest="subscribers", action="store_true", help="list only subscribers")
+    p.add_argument("--host", dest="hostname", action="store_true", help="group by host name")
+    p.add_argument("namespace", nargs="*")
+    args = p.parse_args(argv)
+    if len(args.namespace) > 1:
+        p.error("you may only specify one input topic")
+    if args.publishers and args.subscribers:
+        p.error("you may only specify one of -p, -s")
+    master = _master()
+    pubs, subs = get_topic_list(master)
+    if args.namespace:
+        topic = resolve(NAME, args.namespace[0])
+        ns = names.make_global_ns(topic)
+        pubs = [x for x in pubs if x[0] == topic or x[0].startswith(ns)]
+        subs = [x for x in subs if x[0] == topic or x[0].startswith(ns)]
+    if not args.hostname:
+        _print_list(master, pubs, subs, args.publishers, args.subscribers, args.verbose)
+        return 0
+    uris: Dict[str, str | None] = {}
+
+    def by_host(entries: list) -> Dict[str, list]:
+        out: Dict[str, list] = {}
+        for t, ty, nodes in entries:
+            for n in nodes:
+                uri = master.lookup_node_cached(uris, n)
+                host = urlparse(uri).hostname if uri else None
+                rows = out.setdefault(str(host), [])
+                match = [row for row in rows if row[0] == t]
+                if match:
+                    match[0][2].append(n)
+                else:
+                    rows.append((t, ty, [n]))
+        return out
+
+    host_pubs, host_subs = by_host(pubs), by_host(subs)
+    for host in sorted(set(host_pubs) | set(host_subs)):
+        hp, hs = host_pubs.get(host, []), host_subs.get(host, [])
+        if (hp and not args.subscribers) or (hs and not args.publishers):
+            print(f"Host [{host}]:")
+            _print_list(master, hp, hs, args.publishers, args.subscribers, args.verbose, indent="  ")
+    return 0
+
+
+def info_text(master: Master, topic: str) -> str:
+    pubs, subs = get_topic_list(master)
+    pubs = [x for x in pubs if x[0] == topic]
+    subs = [x for x in subs if x[0] == topic]
+    if not pubs and not subs:
+        raise ToolError(f"Unknown topic {topic}")
+    types = dict((t, ty) for t, ty in master.topic_types())
+    uris: Dict[str, str | None] = {}
+
+    def api(n: str) -> str:
+        return master.lookup_node_cached(uris, n) or f"unknown address {n}"
+
+    out = f"Type: {types.get(topic, 'unknown type')}\n\n"
+    if pubs:
+        out += "Publishers: \n" + "".join(f" * {n} ({api(n)})\n" for _, _, nodes in pubs for n in nodes)
+    else:
+        out += "Publishers: None\n"
+    out += "\n"
+    if subs:
+        out += "Subscribers: \n" + "".join(f" * {n} ({api(n)})\n" for _, _, nodes in subs for n in nodes)
+    else:
+        out += "Subscribers: None\n"
+    return out + "\n"
+
+
+def _one_topic(argv: List[str], prog: str, missing: str = "topic must be specified",
+               many: str = "you may only specify one input topic") -> str:
+    p = parser(prog, usage=f"{prog} /topic")
+    p.add_argument("topic", nargs="*")
+    args = p.parse_args(argv)
+    if not args.topic:
+        p.error(missing)
+    if len(args.topic) > 1:
+        p.error(many)
+    return resolve(NAME, args.topic[0])
+
+
+def _cmd_info(argv: List[str], prog: str) -> int:
+    topic = _one_topic(argv, prog, "you must specify a topic name", "you may only specify one topic name")
+    print(info_text(_master(), topic))
+    return 0
+
+
+def _cmd_type(argv: List[str], prog: str) -> int:
+    p = parser(prog)
+    p.add_argument("topic_or_field", help="Topic or field name")
+    args = p.parse_args(argv)
+    topic = resolve(NAME, args.topic_or_field)
+    type_name, real, _field = topic_type(_master(), topic)
+    if type_name is None:
+        sys.stderr.write(f"unknown topic type [{topic}]\n")
+        return 1
+    if topic == real:
+        print(type_name)
+        return 0
+    from minros.tools.echo import field_type
+
+    field = topic[len(real) + 1:]
+    cls = _message_class(type_name)
+    ftype = field_type(cls, field) if cls is not None else None
+    if ftype is None:
+        sys.stderr.write(f"unknown topic type [{topic}]\n")
+        return 1
+    print(f"{type_name} {field} {ftype}")
+    return 0
+
+
+def _cmd_find(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} msg-type")
+    p.add_argument("type", nargs="*")
+    args = p.parse_args(argv)
+    if not args.type:
+        p.error("please specify a message type")
+    if len(args.type) > 1:
+        p.error("you may only specify one message type")
+    print("\n".join(t for t, ty in _master().topic_types() if ty == args.type[0]))
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------
+# echo
+
+class _Echo:
+    """The echo callback: decode, filter, select a field, print; counts for ``-n``."""
+
+    def __init__(self, topic: str, field_path: str, options: Any, filter_fn: Callable | None) -> None:
+        from minros.tools.decode import Decoder
+        from minros.tools.echo import (
+            make_field_filter,
+            make_field_getter,
+            make_value_transform,
+        )
+
+        self.topic = topic
+        self.field_path = field_path
+        self.getter = make_field_getter(field_path) if field_path else None
+        self.decoder = Decoder()
+        self.plot = options.plot
+        self.offset = options.offset_time
+        self.width = options.fixed_numeric_width
+        self.prefix = "\033[2J\033[;H" if options.clear and not options.plot else ""
+        self.suffix = "" if options.plot else "\n---"
+        self.field_filter = make_field_filter(options.nostr, options.noarr) if options.plot else None
+        self.transform = None if options.plot else make_value_transform(options.nostr, options.noarr)
+        self.filter_fn = filter_fn
+        self.max_count = options.msg_count
+        self.count = 0
+        self.done = False
+        self.first = True
+        self.error: str | None = None
+        self.type_information: str | None = None
+        self._typed_class: Any = None
+        self.lock = threading.Lock()
+        self.out = sys.stdout
+
+    def __call__(self, raw: Any) -> None:
+        if self.done:
+            return
+        try:
+            msg = self.decoder.decode(raw)
+        except Exception as exc:
+            self.error = str(exc)
+            self.done = True
+            return
+        with self.lock:
+            if self.done:
+                return
+            try:
+                self._print(msg)
+            except (BrokenPipeError, OSError):
+                self.done = True
+            except Exception as exc:  # a bad --filter expression or field: report once and stop
+                self.error = f"{type(exc).__name__}: {exc}"
+                self.done = True
+
+    def _print(self, msg: Any) -> None:
+        from minros.tools.echo import field_type, plot_header, plot_line, yaml_text
+
+        if self.filter_fn is not None and not self.filter_fn(msg, self.topic):
+            return
+        if self.max_count is not None and self.count >= self.max_count:
+            self.done = True
+            return
+        data = msg
+        if self.getter is not None:
+            if type(msg) is not self._typed_class:
+                self._typed_class = type(msg)
+                self.type_information = field_type(type(msg), self.field_path)
+            data = self.getter(msg)
+        if data is None:
+            return
+        self.count += 1
+        now = _now()
+        offset = now if self.offset else None
+        if self.plot:
+            if self.first:
+                self.out.write(plot_header(data, self.field_filter) + "\n")
+                self.first = False
+            text = plot_line(data, now, offset, self.field_filter)
+        else:
+            text = yaml_text(data, self.type_information, offset, self.transform, self.width)
+        self.out.write(self.prefix + text + self.suffix + "\n")
+        self.out.flush()
+        if self.max_count is not None and self.count >= self.max_count:
+            self.done = True
+
+
+def _now() -> Any:
+    from minros.msgs import Time
+
+    try:
+        from minros import rostime
+
+        return rostime.get_rostime()
+    except Exception:
+        return Time.from_sec(time.time())
+
+
+def _compile_filter(expr: str | None) -> Callable | None:
+    if not expr:
+        return None
+    try:
+        code = compile(expr, "<filter>", "eval")
+    except SyntaxError as exc:
+        raise ToolError(f"invalid filter expression [{expr}]: {exc.msg}") from None
+
+    def fn(m: Any, topic: str) -> bool:
+        return bool(eval(code, {"__builtins__": __builtins__}, {"m": m, "topic": topic}))  # noqa: S307 - rostopic's documented --filter
+
+    return fn
+
+
+def _cmd_echo(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] /topic")
+    p.add_argument("-b", "--bag", dest="bag", metavar="BAGFILE", help="echo messages from .bag file")
+    p.add_argument("-p", dest="plot", action="store_true", help="echo in a plotting friendly format")
+    p.add_argument("-w", dest="fixed_numeric_width", metavar="NUM_WIDTH", help="fixed width for numeric values")
+    p.add_argument("--filter", dest="filter_expr", metavar="FILTER-EXPRESSION",
+                   help="Python expression to filter messages that are printed. Expression can use "
+                        "Python builtins as well as m (the message) and topic (the topic name).")
+    p.add_argument("--nostr", action="store_true", help="exclude string fields")
+    p.add_argument("--noarr", action="store_true", help="exclude arrays")
+    p.add_argument("-c", "--clear", action="store_true", help="clear screen before printing next message")
+    p.add_argument("-a", "--all", dest="all_topics", action="store_true",
+                   help="display all message in bag, only valid with -b option")
+    p.add_argument("-n", dest="msg_count", metavar="COUNT", help="number of messages to echo")
+    p.add_argument("--offset", dest="offset_time", action="store_true",
+                   help="display time as offsets from current time (in seconds)")
+    p.add_argument("topic", nargs="*")
+    args = p.parse_args(argv)
+    if len(args.topic) > 1:
+        p.error("you may only specify one input topic")
+    if args.bag:
+        raise ToolError("reading bag files is not supported by this rostopic; use 'minros bag'")
+    if args.all_topics:
+        p.error("Display all option is only valid when echoing from bag files")
+    if not args.topic:
+        p.error("topic must be specified")
+    try:
+        args.msg_count = int(args.msg_count) if args.msg_count else None
+    except ValueError:
+        p.error("COUNT must be an integer")
+    try:
+        width = int(args.fixed_numeric_width) if args.fixed_numeric_width else None
+    except ValueError:
+        p.error("NUM_WIDTH must be an integer")
+    if width is not None and width < 2:
+        p.error("Fixed width for numeric values must be at least 2")
+    args.fixed_numeric_width = width
+    topic = resolve(NAME, args.topic[0])
+    filter_fn = _compile_filter(args.filter_expr)
+    master = _check_master()
+    _init_node()
+    from minros.tools.echo import FieldError
+
+    _type, real_topic, field_path = wait_topic_type(master, topic)
+    try:
+        echo = _Echo(topic.rstrip("/"), field_path, args, filter_fn)
+    except FieldError as exc:
+        raise ToolError(str(exc)) from None
+    from minros.topics import AnyMsg, Subscriber
+
+    Subscriber(real_topic, AnyMsg, echo, queue_size=None)
+    _spin_until(lambda: echo.done)
+    if echo.error:
+        raise ToolError(echo.error)
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------
+# hz / bw / delay
+
+class HzStats:
+    """Message inter-arrival statistics over a window (rostopic hz)."""
+
+    def __init__(self, window_size: int = -1) -> None:
+        self.window = window_size if window_size >= 0 else 50000
+        self.lock = threading.Lock()
+        self.t0 = -1.0
+        self.tn = 0.0
+        self.last_printed = 0.0
+        self.times: List[float] = []
+
+    def tick(self, now: float) -> None:
+        with self.lock:
+            if self.t0 < 0 or self.t0 > now:
+                self.t0 = self.tn = now
+                self.times = []
+            else:
+                self.times.append(now - self.tn)
+                self.tn = now
+            if len(self.times) > self.window - 1:
+                del self.times[0:len(self.times) - max(self.window - 1, 0)]
+
+    def get(self) -> Tuple[float, float, float, float, int] | None:
+        with self.lock:
+            if not self.times or self.tn == self.last_printed:
+                return None
+            n = len(self.times)
+            mean = sum(self.times) / n
+            rate = 1.0 / mean if mean > 0.0 else 0.0
+            std = math.sqrt(sum((x - mean) ** 2 for x in self.times) / n)
+            self.last_printed = self.tn
+            return rate, min(self.times), max(self.times), std, n + 1
+
+
+def _ascii_table(header: List[str], cols: Dict[str, List[str]]) -> str:
+    widths = []
+    aligned = []
+    for h in header:
+        width = max(len(h), max(len(c) for c in cols[h]))
+        widths.append(width)
+        aligned.append(h.center(width))
+        cols[h] = [c.ljust(width) for c in cols[h]]
+    total = sum(widths) + 3 * (len(header) - 1)
+    rows = len(cols[header[0]])
+    body = "\n".join("   ".join(cols[h][i] for h in header) for i in range(rows))
+    return "{}\n{}\n{}\n".format("   ".join(aligned), "=" * total, body)
+
+
+def _use_sim_time(master: Master) -> bool:
+    try:
+        return bool(master.getParam("/use_sim_time"))
+    except MasterError:
+        return False
+
+
+def _cmd_hz(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] /topic_0 [/topic_1 [topic_2 [..]]]")
+    p.add_argument("-w", "--window", dest="window_size", default="-1", metavar="WINDOW",
+                   help="window size, in # of messages, for calculating rate")
+    p.add_argument("--filter", dest="filter_expr", metavar="EXPR",
+                   help="only measure messages matching the specified Python expression")
+    p.add_argument("--wall-time", dest="use_wtime", action="store_true",
+                   help="calculates rate using wall time which can be helpful when clock isn't published during simulation")
+    p.add_argument("--tcpnodelay", dest="tcp_nodelay", action="store_true",
+                   help="use the TCP_NODELAY transport hint when subscribing to topics")
+    p.add_argument("topics", nargs="*")
+    args = p.parse_args(argv)
+    if not args.topics:
+        p.error("topic must be specified")
+    try:
+        window = int(args.window_size)
+    except ValueError:
+        p.error("window size must be an integer")
+    topics = [resolve(NAME, t) for t in args.topics]
+    filter_fn = _compile_filter(args.filter_expr)
+    master = _check_master()
+    _init_node()
+    from minros.tools.decode import Decoder
+    from minros.topics import AnyMsg, Subscriber
+
+    sim = _use_sim_time(master) and not args.use_wtime
+    stats = {t: HzStats(window) for t in topics}
+    decoder = Decoder()
+    for topic in topics:
+        _type, real_topic, _field = wait_topic_type(master, topic)
+
+        def callback(raw: Any, topic: str = topic) -> None:
+            if filter_fn is not None:
+                try:
+                    if not filter_fn(decoder.decode(raw), topic):
+                        return
+                except Exception:
+                    return
+            stats[topic].tick(_now().to_sec() if sim else time.time())
+
+        Subscriber(real_topic, AnyMsg, callback, tcp_nodelay=args.tcp_nodelay)
+        print(f"subscribed to [{real_topic}]")
+    if sim:
+        sys.stderr.write("WARNING: may be using simulated time\n")
+    flush_stdout()
+    from minros import node
+
+    while not node.wait_for_shutdown(1.0):
+        if len(topics) == 1:
+            result = stats[topics[0]].get()
+            if result is None:
+                print("no new messages")
+            else:
+                rate, mn, mx, std, n = result
+                print(f"average rate: {rate:.3f}\n\tmin: {mn:.3f}s max: {mx:.3f}s std dev: {std:.5f}s window: {n}")
+        else:
+            header = ["topic", "rate", "min_delta", "max_delta", "std_dev", "window"]
+            cols: Dict[str, List[str]] = {h: [] for h in header}
+            for topic in topics:
+                result = stats[topic].get()
+                if result is None:
+                    continue
+                rate, mn, mx, std, n = result
+                cols["topic"].append(topic)
+                cols["rate"].append(f"{rate:.4}")
+                cols["min_delta"].append(f"{mn:.4}")
+                cols["max_delta"].append(f"{mx:.4}")
+                cols["std_dev"].append(f"{std:.4}")
+                cols["window"].append(str(n))
+            print(_ascii_table(header, cols) if cols["topic"] else "no new messages")
+        flush_stdout()
+    return 0
+
+
+def _format_bw(sizes: List[int], times: List[float], now: float) -> str | None:
+    n = len(times)
+    if n < 2:
+        return None
+    total = sum(sizes)
+    per_s = total / (now - times[0])
+    mean = total / n
+    values = [per_s, mean, min(sizes), max(sizes)]
+    if per_s < 1000:
+        bw, mean_s, min_s, max_s = [f"{v:.2f}B" for v in values]
+    elif per_s < 1000000:
+        bw, mean_s, min_s, max_s = ["%.2fKB" % (v / 1000) for v in values]
+    else:
+        bw, mean_s, min_s, max_s = ["%.2fMB" % (v / 1000000) for v in values]
+    return f"average: {bw}/s\n\tmean: {mean_s} min: {min_s} max: {max_s} window: {n}"
+
+
+def _cmd_bw(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} /topic")
+    p.add_argument("-w", "--window", dest="window_size", metavar="WINDOW",
+                   help="window size, in # of messages, for calculating rate")
+    p.add_argument("topic", nargs="*")
+    args = p.parse_args(argv)
+    if not args.topic:
+        p.error("topic must be specified")
+    if len(args.topic) > 1:
+        p.error("you may only specify one input topic")
+    try:
+        window = int(args.window_size) if args.window_size is not None else 100
+    except ValueError:
+        p.error("window size must be an integer")
+    window = window or 100
+    topic = resolve(NAME, args.topic[0])
+    master = _check_master()
+    _type, real_topic, _field = wait_topic_type(master, topic)
+    _init_node()
+    from minros.topics import AnyMsg, Subscriber
+
+    lock = threading.Lock()
+    sizes: List[int] = []
+    times: List[float] = []
+
+    def callback(raw: Any) -> None:
+        with lock:
+            times.append(time.time())
+            sizes.append(len(raw._buff))
+            if len(times) > window:
+                del times[0]
+                del sizes[0]
+
+    Subscriber(real_topic, AnyMsg, callback)
+    print(f"subscribed to [{real_topic}]")
+    flush_stdout()
+    from minros import node
+
+    while not node.wait_for_shutdown(1.0):
+        with lock:
+            text = _format_bw(list(sizes), list(times), time.time())
+        if text:
+            print(text)
+            flush_stdout()
+    return 0
+
+
+def _cmd_delay(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} [options] /topic")
+    p.add_argument("topic", help="topic name to be calcurated the delay")
+    p.add_argument("-w", "--window", dest="window_size", default=-1, type=int,
+                   help="window size, in # of messages, for calculating rate")
+    p.add_argument("--tcpnodelay", dest="tcp_nodelay", action="store_true",
+                   help="use the TCP_NODELAY transport hint when subscribing to topics")
+    args = p.parse_args(argv)
+    topic = resolve(NAME, args.topic)
+    master = _check_master()
+    _type, real_topic, _field = wait_topic_type(master, topic)
+    _init_node()
+    from minros.tools.decode import Decoder
+    from minros.topics import AnyMsg, Subscriber
+
+    decoder = Decoder()
+    window = args.window_size if args.window_size >= 0 else 50000
+    lock = threading.Lock()
+    delays: List[float] = []
+    state = {"t0": -1.0, "tn": 0.0, "last": 0.0, "warned": False}
+
+    def callback(raw: Any) -> None:
+        msg = decoder.decode(raw)
+        if not getattr(msg, "_has_header", False):
+            if not state["warned"]:
+                sys.stderr.write("msg does not have header\n")
+                state["warned"] = True
+            return
+        now = _now()
+        with lock:
+            cur = now.to_sec()
+            if state["t0"] < 0 or state["t0"] > cur:
+                state["t0"] = state["tn"] = cur
+                delays.clear()
+            else:
+                delays.append(cur - msg.header.stamp.to_sec())
+                state["tn"] = cur
+            if len(delays) > window - 1:
+                del delays[0]
+
+    Subscriber(real_topic, AnyMsg, callback, tcp_nodelay=args.tcp_nodelay)
+    print(f"subscribed to [{real_topic}]")
+    flush_stdout()
+    from minros import node
+
+    while not node.wait_for_shutdown(1.0):
+        with lock:
+            if not delays:
+                continue
+            if state["tn"] == state["last"]:
+                print("no new messages")
+                continue
+            n = len(delays)
+            mean = sum(delays) / n
+            std = math.sqrt(sum((x - mean) ** 2 for x in delays) / n)
+            state["last"] = state["tn"]
+            text = (f"average delay: {mean:.3f}\n\tmin: {min(delays):.3f}s max: {max(delays):.3f}s "
+                    f"std dev: {std:.5f}s window: {n + 1}")
+        print(text)
+        flush_stdout()
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------
+# pub
+
+def _fill(msg_class: Any, pub_args: list) -> Any:
+    from minros.exceptions import MessageException
+    from minros.tools.fill import fill_message_args, printable_message_args, substitution_keys
+
+    msg = msg_class()
+    try:
+        fill_message_args(msg, pub_args, substitution_keys(_now()))
+    except (MessageException, ValueError, TypeError) as exc:
+        raise ToolError(" ".join(str(exc).split()) + f" (Args are: [{printable_message_args(msg)}])") from None
+    try:
+        msg.serialize_to_bytes()
+    except MessageException as exc:
+        raise ToolError("Unable to publish message. One of the fields has an incorrect type: "
+                        + " ".join(str(exc).split())) from None
+    return msg
+
+
+def _file_documents(path: str) -> List[Any]:
+    if not os.path.isfile(path):
+        raise ToolError(f"file does not exist: {path}")
+    try:
+        with open(path) as f:
+            return [d for d in yaml.safe_load_all(f)]
+    except yaml.YAMLError as exc:
+        raise ToolError("invalid YAML in file: " + " ".join(str(exc).split())) from None
+
+
+def _stdin_documents() -> Any:
+    buff: List[str] = []
+    for line in sys.stdin:
+        if line.strip() == "---":
+            text = "".join(buff).rstrip()
+            buff = []
+            try:
+                loaded = yaml.safe_load(text)
+            except yaml.YAMLError as exc:
+                sys.stderr.write("Invalid YAML: " + " ".join(str(exc).split()) + "\n")
+                continue
+            if loaded is not None:
+                yield loaded
+        else:
+            buff.append(line)
+    text = "".join(buff).strip()
+    if text:
+        try:
+            loaded = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            sys.stderr.write("Invalid YAML: " + " ".join(str(exc).split()) + "\n")
+            return
+        if loaded is not None:
+            yield loaded
+
+
+def _cmd_pub(argv: List[str], prog: str) -> int:
+    p = parser(prog, usage=f"{prog} /topic type [args...]")
+    p.add_argument("-v", dest="verbose", action="store_true", help="print verbose output")
+    p.add_argument("-r", "--rate", dest="rate",
+                   help="publishing rate (hz).  For -f and stdin input, this defaults to 10.  Otherwise it is not set.")
+    p.add_argument("-1", "--once", dest="once", action="store_true", help="publish one message and exit")
+    p.add_argument("-f", "--file", dest="file", metavar="FILE", help="read args from YAML file (Bagy)")
+    p.add_argument("-l", "--latch", dest="latch", action="store_true",
+                   help="enable latching for -f, -r and piped input.  This latches the first message.")
+    p.add_argument("-s", "--substitute-keywords", dest="substitute_keywords", action="store_true",
+                   help="When publishing with a rate, performs keyword ('now' or 'auto') substitution for each message")
+    p.add_argument("--use-rostime", dest="use_rostime", action="store_true",
+                   help="use rostime for time stamps, else walltime is used")
+    # message values such as -1 or -0.5 are arguments, not options
+    options: List[str] = []
+    positional: List[str] = []
+    takes_value = {"-r", "--rate", "-f", "--file"}
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a == "--":
+            positional.extend(argv[i + 1:])
+            break
+        if len(positional) >= 2 or not a.startswith("-") or a == "-" or (a[1:2].isdigit() and a != "-1") or a[1:2] == ".":
+            positional.append(a)
+        else:
+            options.append(a)
+            if a in takes_value and i + 1 < len(argv):
+                options.append(argv[i + 1])
+                i += 1
+        i += 1
+    args = p.parse_args(options)
+    rate: float | None = None
+    if args.rate is not None:
+        if args.once:
+            p.error("You cannot select both -r and -1 (--once)")
+        try:
+            rate = float(args.rate)
+        except ValueError:
+            p.error("rate must be a number")
+        if rate <= 0:
+            p.error("rate must be greater than zero")
+    if not positional:
+        p.error("/topic must be specified")
+    if len(positional) == 1:
+        p.error("topic type must be specified")
+    if len(positional) > 2 and args.file:
+        p.error("args conflict with -f setting")
+    topic, type_name = resolve(NAME, positional[0]), positional[1]
+    pub_args = []
+    for text in positional[2:]:
+        try:
+            pub_args.append(yaml.safe_load(text))
+        except yaml.YAMLError as exc:
+            p.error("Argument error: " + " ".join(str(exc).split()))
+    from minros.msgs import UnknownTypeError, get_message_class
+
+    try:
+        msg_class = get_message_class(type_name)
+    except (UnknownTypeError, ValueError, LookupError):
+        pkg = type_name.split("/")[0] if "/" in type_name else None
+        raise ToolError(f"invalid message type: {type_name}. If this is a valid message type, "
+                        f"perhaps you need to type 'rosmake {pkg}'") from None
+    _check_master()
+    latch = rate is None or args.latch
+    msg: Any = None
+    if pub_args or not msg_class.__slots__:
+        msg = _fill(msg_class, pub_args)  # reject bad values before registering anything
+    elif not args.file and sys.stdin.isatty():
+        p.error("Please specify message values")
+    from minros import node
+    from minros.topics import Publisher
+
+    _init_node(disable_rosout=True)
+    pub = Publisher(topic, msg_class, latch=latch, queue_size=100)
+    if msg is not None:
+        _publish_args(pub, msg_class, msg, pub_args, rate, args)
+        return 0
+    # documents from -f FILE or stdin
+    if rate is None and not args.latch and not args.once:
+        rate = 10.0
+    docs = _file_documents(args.file) if args.file else None
+    deadline = time.time() + SUBSCRIBER_TIMEOUT
+    while pub.get_num_connections() == 0 and time.time() < deadline:
+        if node.wait_for_shutdown(0.01):
+            return 0
+    if docs is not None and len(docs) == 1 and rate is not None:
+        print("Got one message and a rate, publishing repeatedly")
+        doc = docs[0]
+        _publish_args(pub, msg_class, _fill(msg_class, doc if isinstance(doc, list) else [doc]),
+                      doc if isinstance(doc, list) else [doc], rate, args)
+        return 0
+    period = 1.0 / rate if rate else None
+    for doc in (docs if docs is not None else _stdin_documents()):
+        if node.is_shutdown():
+            break
+        if doc is None:
+            continue
+        doc_args = doc if isinstance(doc, list) else [doc]
+        m = _fill(msg_class, doc_args)
+        if args.verbose:
+            print(f"publishing {m}")
+        pub.publish(m)
+        if args.once:
+            break
+        if period and node.wait_for_shutdown(period):
+            break
+    if latch and not node.is_shutdown():
+        node.wait_for_shutdown(ONCE_DELAY if args.once else 0.5)
+    return 0
+
+
+def _publish_args(pub: Any, msg_class: Any, msg: Any, pub_args: list, rate: float | None, args: Any) -> None:
+    from minros import node
+
+    if rate is None:
+        text = f"publishing and latching [{msg}]" if args.verbose else "publishing and latching message"
+        text += f" for {ONCE_DELAY} seconds" if args.once else ". Press ctrl-C to terminate"
+        print(text)
+        flush_stdout()
+        pub.publish(msg)
+        if args.once:
+            node.wait_for_shutdown(ONCE_DELAY)
+        else:
+            node.wait_for_shutdown(None)
+        return
+    period = 1.0 / rate
+    next_time = time.monotonic()
+    while not node.is_shutdown():
+        if args.substitute_keywords:
+            msg = _fill(msg_class, pub_args)
+        if args.verbose:
+            print(f"publishing {msg}")
+            flush_stdout()
+        pub.publish(msg)
+        next_time += period
+        delay = next_time - time.monotonic()
+        if delay < -period:  # fell behind (slow consumer): do not burst to catch up
+            next_time = time.monotonic()
+            delay = 0
+        if node.wait_for_shutdown(max(delay, 0.0)):
+            break
+
+
+COMMANDS = {"list": _cmd_list, "info": _cmd_info, "type": _cmd_type, "find": _cmd_find,
+            "echo": _cmd_echo, "pub": _cmd_pub, "hz": _cmd_hz, "bw": _cmd_bw, "delay": _cmd_delay}
+
+
+def main(argv: List[str], prog: str = "rostopic") -> int:
+    return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE, usage_status=64))

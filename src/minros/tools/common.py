@@ -1,0 +1,92 @@
+"""Small pieces every command-line tool shares: error type, argument parsers, dispatch."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import Callable, Dict, List
+
+from minros import names
+
+
+class ToolError(Exception):
+    """An expected failure: printed as ``ERROR: <text>`` (one line) with ``status``."""
+
+    def __init__(self, text: str, status: int = 1, prefix: str = "ERROR: ") -> None:
+        super().__init__(text)
+        self.text = text
+        self.status = status
+        self.prefix = prefix
+
+
+class ArgParser(argparse.ArgumentParser):
+    """argparse that reports errors like optparse tools do, through :class:`ToolError`-free exit 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def parser(prog: str, usage: str | None = None, description: str | None = None) -> ArgParser:
+    return ArgParser(prog=prog, usage=usage, description=description)
+
+
+def strip_ros_args(argv: List[str]) -> List[str]:
+    """Remove remapping arguments (``__master:=...``) as rospy.myargv does."""
+    return names.strip_remapping_args(argv)
+
+
+def resolve(tool: str, name: str) -> str:
+    return names.script_resolve_name(tool, name)
+
+
+def dispatch(argv: List[str], prog: str, commands: Dict[str, Callable[[List[str], str], int]],
+             usage: str, usage_status: int = 0) -> int:
+    """Run ``commands[argv[0]]``; print ``usage`` for none/unknown/--help."""
+    argv = strip_ros_args(list(argv))
+    if argv and argv[0] in ("-h", "--help"):
+        print(usage)
+        return 0
+    if not argv or argv[0] not in commands:
+        # the ROS tools print their usage on stdout, with EX_USAGE (64) or 0 (rosparam)
+        print(usage)
+        return usage_status
+    command = argv[0]
+    return int(commands[command](argv[1:], f"{prog} {command}") or 0)
+
+
+def flush_stdout() -> None:
+    try:
+        sys.stdout.flush()
+    except (BrokenPipeError, ValueError):
+        pass
+
+
+def run_tool(fn: Callable[[], int], io_message: str = "Unable to communicate with master!",
+             io_status: int = 1) -> int:
+    """Run ``fn``; translate expected failures to one line on stderr and an exit status."""
+    from minros.tools.master import MasterError, MasterFailure, MasterIOError
+
+    try:
+        return int(fn() or 0)
+    except ToolError as exc:
+        flush_stdout()
+        print(f"{exc.prefix}{exc.text}", file=sys.stderr)
+        return exc.status
+    except MasterIOError:
+        flush_stdout()
+        print(f"ERROR: {io_message}", file=sys.stderr)
+        return io_status
+    except (MasterError, MasterFailure) as exc:
+        flush_stdout()
+        print(f"ERROR: {exc}", file=sys.stderr)
+        return io_status
+    except KeyboardInterrupt:
+        return 0
+    except BrokenPipeError:
+        try:
+            sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - swallow the final flush
+        except OSError:
+            pass
+        return 0

@@ -1,0 +1,138 @@
+"""A master client for command-line tools (rosgraph.Master semantics, bounded timeouts).
+
+``Master(caller_id).getParam('/x')`` returns the value of a SUCCESS triplet, raises
+:class:`MasterError` for code -1, :class:`MasterFailure` for code 0, and
+:class:`MasterIOError` (an ``OSError``) when the master cannot be reached at all.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import xmlrpc.client
+from typing import Any, Dict, List, Tuple
+from urllib.parse import urlparse
+
+from minros import names
+from minros.xmlrpc import ServerProxy
+
+DEFAULT_MASTER_URI = "http://localhost:11311/"
+#: seconds to wait for any single XML-RPC answer; a tool never hangs on a dead peer
+TOOL_TIMEOUT = 5.0
+
+
+class MasterException(Exception):
+    """Base of master call errors."""
+
+
+class MasterError(MasterException):
+    """The master answered code -1 (caller error: unknown name, unset parameter...)."""
+
+
+class MasterFailure(MasterException):
+    """The master answered code 0 (it tried and failed)."""
+
+
+class MasterIOError(OSError):
+    """The master could not be reached."""
+
+
+def get_master_uri(argv: List[str] | None = None) -> str:
+    """``__master:=`` beats ``ROS_MASTER_URI``; default ``http://localhost:11311/``."""
+    for arg in sys.argv if argv is None else argv:
+        if arg.startswith("__master:="):
+            return arg[len("__master:="):]
+    return os.environ.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+
+
+def call_node(uri: str, method: str, *args: Any, timeout: float = TOOL_TIMEOUT) -> list:
+    """Raw triplet of ``method`` on a node's XML-RPC API (OSError on network failure)."""
+    try:
+        proxy = ServerProxy(uri, timeout=timeout)
+    except ValueError as exc:
+        raise OSError(str(exc)) from None
+    try:
+        return getattr(proxy, method)(*args)
+    except (xmlrpc.client.Fault, xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError) as exc:
+        raise OSError(f"XML-RPC error from {uri}: {exc}") from None
+    finally:
+        proxy.close()
+
+
+class Master:
+    """Calls master methods with ``caller_id`` prepended; results unwrapped as rosgraph does."""
+
+    def __init__(self, caller_id: str, master_uri: str | None = None,
+                 timeout: float = TOOL_TIMEOUT) -> None:
+        self.caller_id = caller_id
+        self.uri = master_uri or get_master_uri()
+        self.timeout = timeout
+        self._proxy: ServerProxy | None = None
+
+    def _get_proxy(self) -> ServerProxy:
+        if self._proxy is None:
+            try:
+                self._proxy = ServerProxy(self.uri, timeout=self.timeout)
+            except ValueError:
+                raise MasterIOError(f"invalid ROS_MASTER_URI [{self.uri}]") from None
+        return self._proxy
+
+    def raw(self, method: str, *args: Any) -> list:
+        """The raw ``[code, msg, value]`` triplet."""
+        try:
+            return getattr(self._get_proxy(), method)(self.caller_id, *args)
+        except xmlrpc.client.Fault as exc:
+            raise MasterFailure(f"{method}: {exc.faultString}") from None
+        except (xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError) as exc:
+            raise MasterIOError(str(exc)) from None
+        except OSError as exc:
+            raise MasterIOError(str(exc)) from None
+
+    def call(self, method: str, *args: Any) -> Any:
+        result = self.raw(method, *args)
+        if not isinstance(result, (list, tuple)) or len(result) != 3:
+            raise MasterFailure(f"malformed result of {method}: {result!r}")
+        code, msg, value = result
+        if code == 1:
+            return value
+        if code == -1:
+            raise MasterError(str(msg))
+        raise MasterFailure(str(msg))
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        return lambda *args: self.call(name, *args)
+
+    def close(self) -> None:
+        if self._proxy is not None:
+            self._proxy.close()
+            self._proxy = None
+
+    # -- helpers used by several tools --------------------------------------------------------
+    def system_state(self) -> Tuple[list, list, list]:
+        pubs, subs, srvs = self.call("getSystemState")
+        return pubs, subs, srvs
+
+    def topic_types(self) -> List[List[str]]:
+        try:
+            return self.call("getTopicTypes")
+        except MasterFailure:
+            return self.call("getPublishedTopics", "/")
+
+    def lookup_node_cached(self, cache: Dict[str, str | None], node: str) -> str | None:
+        if node not in cache:
+            try:
+                cache[node] = self.call("lookupNode", node)
+            except MasterException:
+                cache[node] = None
+        return cache[node]
+
+
+def node_hostname(uri: str) -> str | None:
+    return urlparse(uri).hostname
+
+
+def tool_caller_id(tool: str) -> str:
+    """Caller id a tool uses for read-only master calls, e.g. ``/rostopic``."""
+    return names.SEP + tool
