@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import inspect
 import logging
+import logging.handlers
 import os
 import sys
 import threading
@@ -278,9 +279,62 @@ def _set_logger_level(request):
     return SetLoggerLevelResponse()
 
 
+#: rospy's log file line format (python_logging.conf's defaultFormatter)
+FILE_FORMAT = "[%(name)s][%(levelname)s] %(asctime)s: %(message)s"
+
+
+def node_log_filename(caller_id: str, mappings: Dict[str, str] | None = None,
+                      env: Dict[str, str] | None = None) -> str:
+    """Where rospy writes a node's log: ``__log:=FILE``, else ``$ROS_LOG_DIR/<node>.log``.
+
+    The node name has its slashes turned into underscores, without the leading one
+    (``/ns/talker`` -> ``ns_talker.log``); the log directory defaults to ``$ROS_HOME/log``
+    and then ``~/.ros/log``.
+    """
+    env = os.environ if env is None else env
+    if mappings and "__log" in mappings:
+        return os.path.abspath(mappings["__log"])
+    log_dir = env.get("ROS_LOG_DIR")
+    if not log_dir:
+        home = env.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+        log_dir = os.path.join(home, "log")
+    name = caller_id.replace("/", "_")
+    if name.startswith("_"):
+        name = name[1:]
+    return os.path.join(log_dir, name + ".log")
+
+
+def _start_file_logging(caller_id: str) -> None:
+    """rospy's logging config: every logger at INFO and above also goes to the node's file."""
+    try:
+        from minros import node
+
+        mappings = node.get_mappings()
+    except (ImportError, AttributeError):
+        mappings = {}
+    filename = node_log_filename(caller_id, mappings)
+    root = logging.getLogger()
+    if any(getattr(h, "_minros_node_log", False) for h in root.handlers):
+        return
+    try:
+        os.makedirs(os.path.dirname(filename), exist_ok=True)
+        handler = logging.handlers.RotatingFileHandler(filename, "a", 50000000, 4)
+    except OSError as exc:
+        # a node without a writable log directory still runs, as in rospy
+        sys.stderr.write(f"WARNING: cannot create log file [{filename}]: {exc}\n")
+        return
+    handler.setLevel(logging.DEBUG)
+    handler.setFormatter(logging.Formatter(FILE_FORMAT))
+    handler._minros_node_log = True  # type: ignore[attr-defined]
+    root.addHandler(handler)
+    if root.level == logging.WARNING:  # Python's default: rospy's config says INFO
+        root.setLevel(logging.INFO)
+
+
 def _start_node_logging(caller_id: str, log_level: int | None, disable_rosout: bool) -> None:
-    """Called by ``init_node``: level filter, /rosout publisher and the logger services."""
+    """Called by ``init_node``: level filter, log file, /rosout publisher, logger services."""
     logger = _install_console_handler()
+    _start_file_logging(caller_id)
     if log_level is not None:
         logger.setLevel(ROS_TO_LOGGING.get(log_level, logging.INFO))
     if not disable_rosout and _rosout.publisher is None:

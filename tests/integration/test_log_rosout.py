@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 from support import PYTHON, Proc, ros_env
@@ -27,6 +28,7 @@ while not rospy.is_shutdown():
 
 WATCHER = r'''
 import json
+import re
 import rospy
 from rosgraph_msgs.msg import Log
 def show(m):
@@ -78,3 +80,8 @@ def test_rosout_messages_reach_a_subscriber(minros_master: int, ros_home: Path, 
                for line in talker_out.splitlines())
     assert any(line.startswith("[WARN] [") and line.endswith("]: warning 0")
                for line in talker_out.splitlines())
+    # and the node's log file, as rospy writes it: $ROS_LOG_DIR/<node>.log
+    log_file = (ros_home / "log" / "log_talker.log").read_text()
+    assert re.search(r"^\[rosout\]\[INFO\] \d{4}-\d\d-\d\d [\d:,]+: hello 0$", log_file, re.M)
+    assert re.search(r"^\[rosout\]\[WARNING\] .*: warning 0$", log_file, re.M)
+    assert "debug is filtered" not in log_file

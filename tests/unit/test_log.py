@@ -237,3 +237,11 @@ def test_logger_services_handlers():
     assert logging.getLogger("minros.test.svc").level == logging.DEBUG
     response = log._get_loggers(GetLoggersRequest())
     assert {lg.name: lg.level for lg in response.loggers}["minros.test.svc"] == "debug"
+
+
+def test_node_log_filename_rules(tmp_path):
+    env = {"ROS_LOG_DIR": "/logs", "ROS_HOME": "/home"}
+    assert log.node_log_filename("/talker", {}, env) == "/logs/talker.log"
+    assert log.node_log_filename("/ns/sub/talker", {}, env) == "/logs/ns_sub_talker.log"
+    assert log.node_log_filename("/talker", {}, {"ROS_HOME": "/home"}) == "/home/log/talker.log"
+    assert log.node_log_filename("/t", {"__log": str(tmp_path / "x.log")}, env) == str(tmp_path / "x.log")
