@@ -94,6 +94,7 @@ class Proc:
             stderr=subprocess.STDOUT, start_new_session=True,
         )
         self._output: Optional[str] = None
+        self._pending = b""  # read by read_until() but not yet consumed
 
     @property
     def pid(self) -> int:
@@ -128,31 +129,42 @@ class Proc:
             except subprocess.TimeoutExpired:
                 self.popen.kill()
                 out, _ = self.popen.communicate(timeout=timeout)
-            self._output = (out or b"").decode("utf-8", "replace")
+            self._output = (self._pending + (out or b"")).decode("utf-8", "replace")
+            self._pending = b""
         return self._output
 
     def read_until(self, needle: str, timeout: float) -> str:
         """Read stdout lines until one contains ``needle``; fail after ``timeout`` seconds."""
-        import selectors
+        import select
 
         assert self.popen.stdout is not None
-        sel = selectors.DefaultSelector()
-        sel.register(self.popen.stdout, selectors.EVENT_READ)
+        # Read the pipe's file descriptor directly and split lines ourselves: a buffered
+        # readline() after select() can swallow several lines at once and then block on the
+        # next select() although the needle is already in the buffer.
+        fd = self.popen.stdout.fileno()
         seen: List[str] = []
         deadline = time.monotonic() + timeout
-        try:
-            while time.monotonic() < deadline:
-                if not sel.select(timeout=max(0.0, deadline - time.monotonic())):
-                    continue
-                line = self.popen.stdout.readline()
-                if not line:
-                    break
-                text = line.decode("utf-8", "replace")
+        eof = False
+        while True:
+            while b"\n" in self._pending:
+                line, _, self._pending = self._pending.partition(b"\n")
+                text = line.decode("utf-8", "replace") + "\n"
                 seen.append(text)
                 if needle in text:
                     return "".join(seen)
-        finally:
-            sel.unregister(self.popen.stdout)
+            remaining = deadline - time.monotonic()
+            if eof or remaining <= 0:
+                break
+            ready, _, _ = select.select([fd], [], [], remaining)
+            if not ready:
+                continue
+            chunk = os.read(fd, 65536)
+            if chunk:
+                self._pending += chunk
+            else:
+                eof = True
+                if self._pending:  # a last line without newline
+                    self._pending += b"\n"
         raise AssertionError(
             f"{needle!r} not seen within {timeout}s from {self.argv}; output was:\n{''.join(seen)}")
 
