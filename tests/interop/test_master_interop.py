@@ -1,0 +1,239 @@
+"""Debian's ROS 1 (rospy, roscpp and the command-line tools) against minros's master/core."""
+
+from __future__ import annotations
+
+import subprocess
+import textwrap
+import uuid
+import xmlrpc.client
+from pathlib import Path
+
+import pytest
+
+from support import Proc, free_port, reference_env, require_reference, ros_env, wait_until
+
+pytestmark = pytest.mark.interop
+
+TALKER = """
+import sys, rospy
+from std_msgs.msg import String
+rospy.init_node(sys.argv[2])
+pub = rospy.Publisher(sys.argv[1], String, queue_size=10)
+rate = rospy.Rate(20)
+i = 0
+while not rospy.is_shutdown():
+    pub.publish(String('hello %d' % i))
+    rospy.loginfo('said-%s %d', sys.argv[2], i)
+    i += 1
+    rate.sleep()
+"""
+
+LISTENER = """
+import sys, rospy
+from std_msgs.msg import String
+rospy.init_node(sys.argv[2])
+def heard(msg):
+    print('heard: ' + msg.data, flush=True)
+rospy.Subscriber(sys.argv[1], String, heard)
+rospy.spin()
+"""
+
+SERVER = """
+import sys, rospy
+from std_srvs.srv import SetBool, SetBoolResponse
+rospy.init_node(sys.argv[2])
+rospy.Service(sys.argv[1], SetBool, lambda req: SetBoolResponse(True, 'got %s' % req.data))
+print('ready', flush=True)
+rospy.spin()
+"""
+
+ROSCPP = r"""
+#include <ros/ros.h>
+#include <std_msgs/String.h>
+#include <string>
+#include <iostream>
+void heard(const std_msgs::String::ConstPtr& msg) { std::cout << "heard: " << msg->data << std::endl; }
+int main(int argc, char** argv) {
+  std::string mode = argv[1], topic = argv[2];
+  ros::init(argc, argv, mode == "talk" ? "cpp_talker" : "cpp_listener", ros::init_options::AnonymousName);
+  ros::NodeHandle n;
+  if (mode == "talk") {
+    ros::Publisher pub = n.advertise<std_msgs::String>(topic, 10);
+    ros::Rate rate(20);
+    for (int i = 0; ros::ok(); ++i) {
+      std_msgs::String msg; msg.data = "cpp " + std::to_string(i);
+      pub.publish(msg); ros::spinOnce(); rate.sleep();
+    }
+  } else {
+    ros::Subscriber sub = n.subscribe(topic, 10, heard);
+    ros::spin();
+  }
+  return 0;
+}
+"""
+
+
+def unique(prefix: str) -> str:
+    return f"{prefix}_{uuid.uuid4().hex[:8]}"
+
+
+class Ros:
+    """Runs Debian's ROS programs against a master on ``port``."""
+
+    def __init__(self, port: int, home: Path, tmp: Path) -> None:
+        require_reference()
+        self.port = port
+        self.env = reference_env(ros_env(port, home))
+        self.tmp = tmp
+        self.procs = []
+
+    def script(self, source: str, *args: str) -> Proc:
+        path = self.tmp / f"{uuid.uuid4().hex}.py"
+        path.write_text(textwrap.dedent(source))
+        proc = Proc(["/usr/bin/python3", str(path), *args], self.env)
+        self.procs.append(proc)
+        return proc
+
+    def start(self, *argv: str) -> Proc:
+        proc = Proc(list(argv), self.env)
+        self.procs.append(proc)
+        return proc
+
+    def run(self, *argv: str, input: str | None = None, timeout: float = 20) -> str:
+        done = subprocess.run(list(argv), env=self.env, input=input, capture_output=True, text=True,
+                              timeout=timeout)
+        assert done.returncode == 0, f"{argv} failed ({done.returncode}):\n{done.stdout}{done.stderr}"
+        return done.stdout
+
+    def master(self):
+        return xmlrpc.client.ServerProxy(f"http://127.0.0.1:{self.port}/")
+
+    def close(self) -> None:
+        # Short steps: Debian's rospy sometimes hangs in its own shutdown (with rosmaster too);
+        # these are only test drivers, so do not wait 10 s for each.
+        for proc in self.procs:
+            proc.stop(timeout=1.0)
+
+
+@pytest.fixture
+def ros_core(minros_core, ros_home, tmp_path):
+    ros = Ros(minros_core, ros_home, tmp_path)
+    yield ros
+    ros.close()
+
+
+@pytest.fixture(params=["minros_core", "minros_master"])
+def ros_any(request, ros_home, tmp_path):
+    ros = Ros(request.getfixturevalue(request.param), ros_home, tmp_path)
+    yield ros
+    ros.close()
+
+
+def test_rospy_talker_listener(ros_any):
+    topic = "/" + unique("chatter")
+    ros_any.script(TALKER, topic, unique("talker"))
+    listener = ros_any.script(LISTENER, topic, unique("listener"))
+    listener.read_until("heard: hello", timeout=20)
+
+
+def test_rosout_aggregates_and_logs(ros_core, ros_home):
+    name = unique("talker")
+    ros_core.script(TALKER, "/" + unique("chatter"), name)
+    echo = ros_core.start("/usr/bin/rostopic", "echo", "/rosout_agg")
+    echo.read_until(f"said-{name}", timeout=20)
+    run_id = ros_core.master().getParam("/t", "/run_id")[2]
+    log = ros_home / "log" / run_id / "rosout.log"
+
+    def logged() -> bool:
+        return log.exists() and f"said-{name}" in log.read_text()
+
+    wait_until(logged, timeout=10, what="the talker's log line in rosout.log")
+    line = next(line for line in log.read_text().splitlines() if f"said-{name}" in line)
+    assert f" INFO /{name} [" in line and "[topics: " in line
+
+
+def test_rostopic(ros_core):
+    topic = "/" + unique("chatter")
+    name = unique("talker")
+    ros_core.script(TALKER, topic, name)
+    wait_until(lambda: topic in ros_core.run("/usr/bin/rostopic", "list"), 15, what="topic listed")
+    listed = ros_core.run("/usr/bin/rostopic", "list")
+    assert "/rosout\n" in listed and "/rosout_agg\n" in listed
+    info = ros_core.run("/usr/bin/rostopic", "info", topic)
+    assert "Type: std_msgs/String" in info and f"/{name}" in info
+    echoed = ros_core.run("/usr/bin/rostopic", "echo", "-n", "1", topic)
+    assert 'data: "hello' in echoed
+    hz = ros_core.start("/usr/bin/rostopic", "hz", topic)
+    hz.read_until("average rate", timeout=15)
+
+
+def test_rosnode(ros_core):
+    name = unique("talker")
+    ros_core.script(TALKER, "/" + unique("chatter"), name)
+    wait_until(lambda: f"/{name}" in ros_core.run("/usr/bin/rosnode", "list"), 15, what="node")
+    assert "/rosout" in ros_core.run("/usr/bin/rosnode", "list").split()
+    info = ros_core.run("/usr/bin/rosnode", "info", f"/{name}")
+    assert "Publications:" in info and "/rosout [rosgraph_msgs/Log]" in info
+    assert "reply from" in ros_core.run("/usr/bin/rosnode", "ping", "-c", "1", f"/{name}")
+    # a node that died without unregistering: cleanup removes it
+    dead = f"http://127.0.0.1:{free_port()}/"
+    master = ros_core.master()
+    assert master.registerPublisher("/ghost", "/ghost_topic", "std_msgs/String", dead)[0] == 1
+    ros_core.run("/usr/bin/rosnode", "cleanup", input="y\n")
+    assert master.lookupNode("/t", "/ghost")[0] == -1
+    assert master.lookupNode("/t", f"/{name}")[0] == 1
+
+
+def test_rosparam(ros_core, tmp_path):
+    ns = "/" + unique("params")
+    ros_core.run("/usr/bin/rosparam", "set", f"{ns}/a", "1")
+    ros_core.run("/usr/bin/rosparam", "set", f"{ns}/b", "{x: 2.5, y: [1, two]}")
+    assert ros_core.run("/usr/bin/rosparam", "get", f"{ns}/a").strip() == "1"
+    assert "x: 2.5" in ros_core.run("/usr/bin/rosparam", "get", f"{ns}/b")
+    listed = ros_core.run("/usr/bin/rosparam", "list").split()
+    assert f"{ns}/a" in listed and f"{ns}/b/x" in listed and "/run_id" in listed
+    dump = tmp_path / "dump.yaml"
+    ros_core.run("/usr/bin/rosparam", "dump", str(dump), ns)
+    assert "y:" in dump.read_text()
+    ros_core.run("/usr/bin/rosparam", "load", str(dump), ns + "_copy")
+    assert ros_core.master().getParam("/t", f"{ns}_copy/b/y")[2] == [1, "two"]
+    ros_core.run("/usr/bin/rosparam", "delete", f"{ns}/a")
+    assert ros_core.master().hasParam("/t", f"{ns}/a")[2] is False
+    assert ros_core.master().getParam("/t", "/rosdistro")[2].endswith("\n")
+
+
+def test_rosservice(ros_core):
+    service = "/" + unique("set_bool")
+    server = ros_core.script(SERVER, service, unique("server"))
+    server.read_until("ready", timeout=20)
+    assert service in ros_core.run("/usr/bin/rosservice", "list").split()
+    out = ros_core.run("/usr/bin/rosservice", "call", service, "data: true")
+    assert "success: True" in out and 'message: "got True"' in out
+
+
+@pytest.fixture(scope="session")
+def roscpp_binary(tmp_path_factory):
+    require_reference()
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "roscpp", "std_msgs"],
+                           capture_output=True, text=True, timeout=30)
+    if flags.returncode != 0:
+        pytest.fail(f"roscpp development files missing: {flags.stderr}")
+    work = tmp_path_factory.mktemp("roscpp")
+    source = work / "chat.cpp"
+    source.write_text(ROSCPP)
+    binary = work / "chat"
+    done = subprocess.run(["g++", "-O2", str(source), "-o", str(binary), *flags.stdout.split()],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return binary
+
+
+@pytest.mark.timeout(300)
+def test_roscpp_talker_listener(roscpp_binary, ros_core):
+    topic = "/" + unique("cpp_chatter")
+    ros_core.start(str(roscpp_binary), "talk", topic)
+    listener = ros_core.start(str(roscpp_binary), "listen", topic)
+    listener.read_until("heard: cpp", timeout=20)
+    # roscpp talker to rospy listener through the same master
+    rospy_listener = ros_core.script(LISTENER, topic, unique("listener"))
+    rospy_listener.read_until("heard: cpp", timeout=20)

@@ -1,0 +1,38 @@
+"""rosout.log formatting, rotation and the log directory rules (no ROS needed)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from minros.rosout import RotatingLog, format_line, log_dir
+
+
+def _msg(level=2, topics=("/rosout", "/chatter")):
+    return SimpleNamespace(header=SimpleNamespace(stamp=SimpleNamespace(secs=1700000000, nsecs=42)),
+                           level=level, name="/talker", file="talker.py", line=12,
+                           function="main", topics=list(topics), msg="hello world")
+
+
+def test_line_format_matches_cpp_rosout():
+    assert format_line(_msg()) == ("1700000000.000000042 INFO /talker [talker.py:12(main)] "
+                                   "[topics: /rosout, /chatter] hello world\n")
+    assert " FATAL " in format_line(_msg(level=16))
+    assert " 3 " in format_line(_msg(level=3))  # unknown levels print their number
+    assert "[topics: ]" in format_line(_msg(topics=()))
+
+
+def test_rotation(tmp_path):
+    log = RotatingLog(tmp_path / "rosout.log", max_size=100, backups=2)
+    for i in range(10):
+        log.write(f"line {i:02d} " + "x" * 40 + "\n")
+    log.close()
+    assert (tmp_path / "rosout.log.1").exists() and (tmp_path / "rosout.log.2").exists()
+    assert not (tmp_path / "rosout.log.3").exists()
+    assert "line 09" in (tmp_path / "rosout.log").read_text()
+    assert (tmp_path / "rosout.log").stat().st_size <= 100
+
+
+def test_log_dir_rules(tmp_path):
+    assert log_dir({"ROS_LOG_DIR": "/x/y", "ROS_HOME": "/h"}) == tmp_path.__class__("/x/y")
+    assert str(log_dir({"ROS_HOME": "/h"})) == "/h/log"
+    assert str(log_dir({})).endswith(".ros/log")
