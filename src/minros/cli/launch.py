@@ -130,7 +130,7 @@ def _main(options: argparse.Namespace, prog: str) -> int:
             return 1
         config = load_all(files, args)
     if options.files:
-        for path in dict.fromkeys(os.path.abspath(f) for f in config.files):
+        for path in sorted({os.path.abspath(f) for f in config.files}):  # roslaunch: set order
             print(path)
         return 0
     if options.nodes:
@@ -138,8 +138,9 @@ def _main(options: argparse.Namespace, prog: str) -> int:
             print(node.resolved_name)
         return 0
     if options.find_node:
+        resolved = names.script_resolve_name("roslaunch", options.find_node)
         for node in config.nodes:
-            if node.resolved_name in (options.find_node, names.ns_join("/", options.find_node)):
+            if node.resolved_name == resolved:
                 print(os.path.abspath(node.filename or ""))
                 return 0
         print(f"ERROR: cannot find node named [{options.find_node}]. Run \n\troslaunch --nodes <files>\nto see list of node names.", file=sys.stderr)
@@ -183,15 +184,22 @@ def _main(options: argparse.Namespace, prog: str) -> int:
 
 
 def _print_node_args(config: LaunchConfig, runner, wanted: str) -> int:
-    import shlex
-
-    for node in config.nodes:
-        if node.resolved_name in (wanted, names.ns_join("/", wanted)):
-            argv, _cwd = runner.node_command(node, node.resolved_name.lstrip("/"))
-            env = [f"{k}={shlex.quote(v)}" for k, v in node.env_args]
-            if node.namespace != "/":
-                env.insert(0, f"ROS_NAMESPACE={node.namespace}")
-            print(" ".join(env + [shlex.quote(a) for a in argv if not a.startswith("__log:=")]))
-            return 0
-    print(f"ERROR: cannot find node named [{wanted}]. Run \n\troslaunch --nodes <files>\nto see list of node names.", file=sys.stderr)
-    return 1
+    """``roslaunch --args NODE``: the node's environment and command line, as roslaunch prints
+    them (``ROS_NAMESPACE="/g" NAME="value" exe args remaps __name:=n``)."""
+    resolved = names.script_resolve_name("roslaunch", wanted)
+    matches = [n for n in config.nodes if n.resolved_name == resolved]
+    if not matches:
+        listing = "\n".join(f" * {n.resolved_name}" for n in config.nodes)
+        print(f"ERROR: Cannot find node named [{resolved}] in [{', '.join(config.files[:1])}].\n"
+              f"Node names are:\n{listing}", file=sys.stderr)
+        return 1
+    node = matches[0]
+    argv, _cwd = runner.node_command(node, node.resolved_name.lstrip("/"))
+    wanted_env = {"ROS_MASTER_URI": runner.master_uri}
+    if node.namespace != "/":
+        wanted_env["ROS_NAMESPACE"] = node.namespace.rstrip("/")
+    wanted_env.update(node.env_args)
+    # like roslaunch, only what differs from the current environment
+    env = [f'{k}="{v}"' for k, v in wanted_env.items() if os.environ.get(k) != v]
+    print(" ".join(env + [a for a in argv if not a.startswith("__log:=")]))
+    return 0

@@ -152,8 +152,12 @@ class Scope:
                 child_ns = names.ns_join(self.ns, ns)
         else:
             child_ns = self.ns
+        # roslaunch shares the ~params list with a child scope only when it is non-empty
+        # (its `params or []`); an empty one gives the child a list of its own. Same here,
+        # so a ~param declared in an include does or does not reach later nodes exactly as there.
         scope = Scope("/" if child_ns == "~" else child_ns, self.filename, self.subst.child(),
-                      parent=self, params=self.params, env_args=list(self.env_args),
+                      parent=self, params=self.params if self.params else None,
+                      env_args=list(self.env_args),
                       arg_names=list(self.arg_names))
         scope.include_args = self.include_args
         return scope

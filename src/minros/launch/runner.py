@@ -353,7 +353,7 @@ class LaunchRunner:
         env = child_environment(self.env)
         env["ROS_MASTER_URI"] = self.master_uri
         if spec.namespace and spec.namespace != "/":
-            env["ROS_NAMESPACE"] = spec.namespace
+            env["ROS_NAMESPACE"] = spec.namespace.rstrip("/")  # roslaunch passes "/g", not "/g/"
         else:
             env.pop("ROS_NAMESPACE", None)
         for key, value in spec.env_args:

@@ -229,7 +229,7 @@ class _EvalNames(dict):
             return self._functions[key]
         if key in self._args:
             return convert_value(self._args[key], "auto")
-        raise NameError(f"name '{key}' is not defined")
+        raise KeyError(key)  # falls through to the restricted builtins, then NameError
 
 
 def evaluate(expression: str, ctx: SubstitutionContext) -> str:

@@ -1,0 +1,162 @@
+"""roslaunch against Debian's roslaunch (the oracle) and against Debian's rosmaster."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import xmlrpc.client
+from pathlib import Path
+
+import pytest
+import yaml
+
+from support import Proc, reference_env, require_reference, ros_env
+
+pytestmark = pytest.mark.interop
+
+BIN = Path(sys.executable).parent
+
+INNER = """<launch>
+  <arg name="who"/>
+  <arg name="level" default="3"/>
+  <param name="who" value="$(arg who)"/>
+  <param name="level" value="$(arg level)"/>
+  <param name="~inherited" value="in-include"/>
+  <node pkg="lprobe" type="probe.py" name="inner_node">
+    <param name="own" value="$(eval arg('level') * 2)"/>
+  </node>
+</launch>
+"""
+
+TOP = """<launch>
+  <arg name="flag" default="true"/>
+  <arg name="speed" default="1.5"/>
+  <arg name="name" default="robot"/>
+  <param name="i" value="7"/>
+  <param name="neg" value="-7"/>
+  <param name="f" value="2.50"/>
+  <param name="exp" value="1e3"/>
+  <param name="under" value="1_000"/>
+  <param name="b" value="False"/>
+  <param name="s" value=" padded "/>
+  <param name="t_str" type="str" value="42"/>
+  <param name="t_int" type="int" value="42"/>
+  <param name="t_double" type="double" value="42"/>
+  <param name="t_bool" type="bool" value="1"/>
+  <param name="t_yaml" type="yaml" value="{a: [1, 2.5, x], b: {c: true}}"/>
+  <param name="text" textfile="$(find lprobe)/note.txt"/>
+  <param name="found" value="$(find lprobe)/x"/>
+  <param name="env" value="$(env LAUNCH_TEST_VAR)"/>
+  <param name="optenv" value="$(optenv LAUNCH_UNSET_VAR fallback value)"/>
+  <param name="dir" value="$(dirname)"/>
+  <param name="eval" value="$(eval speed * 2 if flag else 0)"/>
+  <param name="evalstr" value="$(eval name + '_' + str(int(speed)))"/>
+  <param name="when_flag" value="yes" if="$(arg flag)"/>
+  <param name="unless_flag" value="no" unless="$(arg flag)"/>
+  <rosparam file="$(dirname)/conf.yaml" command="load" ns="conf"/>
+  <rosparam param="list_param">[1, 2, three]</rosparam>
+  <rosparam subst_value="true">subst: $(arg name)</rosparam>
+  <group ns="$(arg name)">
+    <param name="~group_private" value="gp"/>
+    <param name="grouped" value="1"/>
+    <rosparam ns="nested">{deep: {deeper: 2}}</rosparam>
+    <node pkg="lprobe" type="probe.py" name="n1" args="--x 1">
+      <param name="p" value="3"/>
+      <rosparam>{r: [a, b]}</rosparam>
+      <remap from="a" to="b"/>
+    </node>
+    <include file="$(dirname)/inner.launch" ns="inc">
+      <arg name="who" value="$(arg name)"/>
+    </include>
+  </group>
+  <include file="$(dirname)/inner.launch" pass_all_args="true">
+    <arg name="who" value="all"/>
+  </include>
+  <node pkg="lprobe" type="probe.py" name="top_node" ns="ns_attr"/>
+</launch>
+"""
+
+
+@pytest.fixture
+def launch_dir(tmp_path: Path) -> Path:
+    pkg = tmp_path / "src" / "lprobe"
+    (pkg / "scripts").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<?xml version="1.0"?><package format="2"><name>lprobe</name><version>0.0.0</version>'
+        "<description>d</description><maintainer email='a@b.c'>a</maintainer><license>BSD</license>"
+        "</package>\n")
+    (pkg / "note.txt").write_text("line one\nline two\n")
+    probe = pkg / "scripts" / "probe.py"
+    probe.write_text("#!/usr/bin/env python\nimport time\ntime.sleep(60)\n")
+    probe.chmod(0o755)
+    launch = tmp_path / "launch"
+    launch.mkdir()
+    (launch / "top.launch").write_text(TOP)
+    (launch / "inner.launch").write_text(INNER)
+    (launch / "conf.yaml").write_text("gain: 0.5\nangles: {a: deg(180), b: rad(pi/2), c: !degrees 90}\n"
+                                      "names: [x, y]\nempty: {}\n")
+    return tmp_path
+
+
+def _env(tmp_path: Path, port=None):
+    env = ros_env(port, tmp_path / "home", {"ROS_PACKAGE_PATH": str(tmp_path / "src"),
+                                            "LAUNCH_TEST_VAR": "from env"})
+    env.pop("LAUNCH_UNSET_VAR", None)
+    return env
+
+
+def _run(argv, env, cwd):
+    result = subprocess.run(argv, env=env, cwd=cwd, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return result.stdout
+
+
+def _both(launch_dir: Path, *args: str):
+    env = _env(launch_dir)
+    cwd = launch_dir / "launch"
+    ours = _run([str(BIN / "roslaunch"), *args], env, cwd)
+    theirs = _run(["/usr/bin/roslaunch", *args], reference_env(env), cwd)
+    return ours, theirs
+
+
+def test_dump_params_matches_debian_roslaunch(launch_dir):
+    require_reference()
+    for argv in ((), ("flag:=false", "name:=bot", "speed:=4")):
+        ours, theirs = _both(launch_dir, "--dump-params", "top.launch", *argv)
+        mine, reference = yaml.safe_load(ours), yaml.safe_load(theirs)
+        assert set(mine) == set(reference), set(mine) ^ set(reference)
+        for key, value in reference.items():
+            assert mine[key] == value and type(mine[key]) is type(value), (key, mine[key], value)
+
+
+def test_nodes_files_and_args_match_debian_roslaunch(launch_dir):
+    require_reference()
+    ours, theirs = _both(launch_dir, "--nodes", "top.launch")
+    assert ours.split() == theirs.split()
+    ours, theirs = _both(launch_dir, "--files", "top.launch")
+    assert sorted(ours.split()) == sorted(theirs.split())  # roslaunch prints them in set order
+    for node in ("/robot/n1", "/ns_attr/top_node", "inner_node", "/robot/inc/inner_node"):
+        ours, theirs = _both(launch_dir, "--args", node, "top.launch")
+        # minros names its interpreter in front of Python scripts; otherwise identical
+        assert ours.replace(f"{Path(sys.executable).parent}/python3 ", "").split() == theirs.split()
+
+
+def test_params_land_in_debian_rosmaster_with_their_types(launch_dir, debian_rosmaster):
+    env = _env(launch_dir, debian_rosmaster)
+    proc = Proc([str(BIN / "roslaunch"), "top.launch"], env, cwd=launch_dir / "launch")
+    try:
+        proc.read_until("process[ns_attr/top_node-4]: started", timeout=30)
+        master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{debian_rosmaster}/")
+        expected = {"/i": 7, "/f": 2.5, "/b": False, "/s": "padded", "/t_str": "42", "/t_double": 42.0,
+                    "/t_yaml": {"a": [1, 2.5, "x"], "b": {"c": True}}, "/robot/n1/r": ["a", "b"],
+                    "/robot/inc/who": "robot", "/conf/names": ["x", "y"], "/robot/n1/group_private": "gp"}
+        for key, value in expected.items():
+            code, msg, got = master.getParam("/test", key)
+            assert code == 1 and got == value and type(got) is type(value), (key, msg, got)
+        code, _msg, names = master.getParamNames("/test")
+        assert "/run_id" in names
+    finally:
+        out = proc.stop()
+    assert "auto-starting new master" not in out
+    assert os.path.isdir(launch_dir / "home" / "log")
