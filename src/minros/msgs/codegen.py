@@ -78,6 +78,20 @@ def min_size(spec: MsgSpec, get_spec: GetSpec) -> int:
     return total
 
 
+def has_bulk_arrays(spec: MsgSpec, get_spec: GetSpec) -> bool:
+    """Whether ``spec`` (or an embedded type) has a variable-length primitive array.
+
+    Only such messages can be large enough for copying the received bytes to matter, so only
+    they are deserialized from a ``memoryview``; the others from ``bytes`` (faster to decode).
+    """
+    for f in spec.fields:
+        if f.is_array and f.array_len is None and (f.base_type in SER_CODE or f.base_type == "char"):
+            return True
+        if not f.is_builtin and has_bulk_arrays(get_spec(f.base_type), get_spec):
+            return True
+    return False
+
+
 class _Writer:
     """Collects indented source lines and the Structs they use."""
 
@@ -203,6 +217,7 @@ class _DeserializerGen(_Writer):
         self.get_spec = get_spec
         self.type_name = type_name
         self.numpy = numpy
+        self.views = has_bulk_arrays(get_spec(type_name), get_spec)
         self.run: List[Tuple[int, str, str]] = []  # (count, code, target)
         self.post: List[str] = []
 
@@ -243,10 +258,20 @@ class _DeserializerGen(_Writer):
     def string_body(self, ind: int, target: str, length: str, fpath: str) -> None:
         self.emit(ind, f"if {length} > len(view) - end:")
         self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {length}, len(view) - end)")
-        self.emit(ind, f"{target} = str(view[end:end + {length}], 'utf-8', 'replace')")
+        if self.views:
+            # the data may be a memoryview (large messages are not copied): str() decodes both
+            self.emit(ind, f"{target} = str(view[end:end + {length}], 'utf-8', 'replace')")
+        else:
+            self.emit(ind, f"{target} = view[end:end + {length}].decode('utf-8', 'replace')")
         self.emit(ind, f"end += {length}")
 
-    def fields(self, spec: MsgSpec, obj: str, path: str, ind: int) -> None:
+    def fields(self, spec: MsgSpec, obj: str, path: str, ind: int, reuse: bool = False) -> None:
+        """Read the fields of ``spec`` into ``obj``.
+
+        With ``reuse`` (the message being filled was built by its constructor), embedded
+        messages and times already present are filled in place, as genpy does, instead of
+        being replaced by new objects; elements of arrays are always new objects.
+        """
         for f in spec.fields:
             attr = python_name(f.name)
             target = f"{obj}.{attr}"
@@ -258,15 +283,26 @@ class _DeserializerGen(_Writer):
                 elif bt in ("time", "duration"):
                     var = self.tmp("_t")
                     cls = "_Time" if bt == "time" else "_Duration"
-                    self.emit(ind, f"{var} = {target} = _new({cls})")
+                    if reuse:
+                        self.emit(ind, f"{var} = {target}")
+                        self.emit(ind, f"if {var}.__class__ is not {cls}:")
+                        self.emit(ind + 1, f"{var} = {target} = _new({cls})")
+                    else:
+                        self.emit(ind, f"{var} = {target} = _new({cls})")
                     self.tval(ind, var, bt)
                 elif bt == "string":
                     n = self.length(ind)
                     self.string_body(ind, target, n, fpath)
                 else:
                     var = self.tmp("_m")
-                    self.emit(ind, f"{var} = {target} = _new({dep_name(bt)})")
-                    self.fields(self.get_spec(bt), var, fpath + ".", ind)
+                    cls = dep_name(bt)
+                    if reuse:
+                        self.emit(ind, f"{var} = {target}")
+                        self.emit(ind, f"if {var}.__class__ is not {cls}:")
+                        self.emit(ind + 1, f"{var} = {target} = {cls}()")
+                    else:
+                        self.emit(ind, f"{var} = {target} = _new({cls})")
+                    self.fields(self.get_spec(bt), var, fpath + ".", ind, reuse)
                 continue
             n = f.array_len
             if bt in ("uint8", "char"):
@@ -277,7 +313,7 @@ class _DeserializerGen(_Writer):
                     if self.numpy:
                         self.emit(ind, f"{target} = _numpy_view('B', {count}, view, end)")
                     else:
-                        self.emit(ind, f"{target} = view[end:end + {count}].tobytes()")
+                        self.emit(ind, f"{target} = bytes(view[end:end + {count}])")
                     self.emit(ind, f"end += {count}")
                 else:
                     self.flush(ind)
@@ -398,7 +434,7 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
     ser.fields(spec, "self", "", 2)
     ser.flush(2)
     de = _DeserializerGen(structs, get_spec, spec.full_name, numpy)
-    de.fields(spec, "self", "", 2)
+    de.fields(spec, "self", "", 2, reuse=True)
     de.flush(2)
 
     out: List[str] = []
@@ -430,6 +466,7 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
         out.append(f"    _type = {spec.full_name!r}")
         out.append(f"    _md5sum = {md5sum!r}")
         out.append(f"    _has_header = {spec.has_header!r}")
+        out.append(f"    _zero_copy = {de.views!r}  # deserialize() keeps large input as a memoryview")
         out.append(f"    _full_text = {full_text!r}")
         out.append(f"    _slot_types = {spec.types!r}")
         if module:

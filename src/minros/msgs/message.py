@@ -28,8 +28,6 @@ _INT_WIDTHS = {
     "int64": (64, True), "char": (8, False), "uint8": (8, False), "uint16": (16, False),
     "uint32": (32, False), "uint64": (64, False),
 }
-#: messages up to this size are joined into one ``bytes`` before ``buff.write``
-_JOIN_LIMIT = 65536
 _SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
                      UnicodeError, IndexError, SerializationError)
 
@@ -42,6 +40,7 @@ class Message:
     _md5sum = ""
     _full_text = ""
     _has_header = False
+    _zero_copy = True
     _slot_types: List[str] = []
 
     def __init__(self, *args: Any, **kwds: Any) -> None:
@@ -60,21 +59,16 @@ class Message:
             raise SerializationError(f"{self._type}: {exc}")
 
     def serialize(self, buff: Any) -> None:
-        """Write the wire form of this message to ``buff`` (anything with ``.write``)."""
-        parts: List[Any] = []
+        """Write the wire form of this message to ``buff`` (anything with ``.write``).
+
+        The pieces are written as they are produced, as genpy does (large arrays are handed
+        over without being copied or joined); on a bad field value the error names the field,
+        and ``buff`` may hold a partial message.
+        """
         try:
-            self._serialize_parts(parts.append)
+            self._serialize_parts(buff.write)
         except _SERIALIZE_ERRORS as exc:
             raise _serialization_error(self, exc) from None
-        if len(parts) == 1:
-            buff.write(parts[0])
-        elif sum(map(len, parts)) < _JOIN_LIMIT:
-            buff.write(b"".join(parts))
-        else:
-            # large payloads (images, point clouds): hand the pieces over without joining
-            # them, so a writer that gathers buffers (sendmsg) never copies the big ones
-            for part in parts:
-                buff.write(part)
 
     def serialize_to_bytes(self) -> bytes:
         """The wire form of this message as ``bytes``."""
@@ -91,11 +85,21 @@ class Message:
         The data must hold exactly one message: truncated data, lengths pointing past the end
         and trailing bytes raise :class:`DeserializationError`.
         """
-        view = data if type(data) is memoryview else memoryview(data)
-        if view.format != "B" or view.ndim != 1:
-            view = view.cast("B")
+        view = data
+        if data.__class__ is not bytes:
+            if self._zero_copy:
+                # may hold a big array: read it in place, copy only the fields
+                view = data if data.__class__ is memoryview else memoryview(data)
+                if view.format != "B" or view.ndim != 1:
+                    view = view.cast("B")
+            else:
+                view = bytes(data)  # small: one copy, then the faster bytes operations
         try:
             end = self._deserialize_from(view, 0)
+        except AttributeError:
+            # made without its constructor (cls.__new__): give it default fields first
+            self.__init__()
+            return self.deserialize(view)
         except struct.error:
             raise DeserializationError(
                 f"{self._type}: message truncated ({len(view)} bytes do not hold a whole message)"

@@ -28,6 +28,11 @@ class TVal:
     _slot_types = ["int32", "int32"]
 
     def __init__(self, secs: float = 0, nsecs: int = 0) -> None:
+        if secs.__class__ is int and nsecs.__class__ is int and 0 <= nsecs < _NSEC_PER_SEC:
+            # fast path (every message constructor makes a few): already canonical ints
+            self.secs = secs
+            self.nsecs = nsecs
+            return
         if not isinstance(secs, numbers.Integral):
             if nsecs != 0:
                 raise ValueError("if secs is a float, nsecs cannot be set")
@@ -127,7 +132,7 @@ class Time(TVal):
     __slots__ = ()
 
     def __init__(self, secs: float = 0, nsecs: int = 0) -> None:
-        super().__init__(secs, nsecs)
+        TVal.__init__(self, secs, nsecs)
         if self.secs < 0:
             raise TypeError("time values must be positive")
 
