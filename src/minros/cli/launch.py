@@ -17,6 +17,8 @@ from minros import names, packages
 from minros.launch.config import LaunchConfig, LaunchError
 
 LAUNCH_SUFFIXES = (".launch", ".xml", ".test")
+#: Launch files of the packages minros ships (turtlesim's multisim.launch), as <pkg>/launch/...
+BUILTIN_LAUNCH_DIR = Path(__file__).resolve().parent.parent / "launch" / "share"
 
 
 def _parser(prog: str) -> argparse.ArgumentParser:
@@ -60,9 +62,14 @@ def resolve_launch_arguments(positional: List[str]) -> Tuple[List[str], List[str
         pkg, name = rest
         pkg_dir = packages.find_package(pkg)
         if pkg_dir is not None:
-            candidate = pkg_dir / name
-            matches = [candidate] if candidate.is_file() else sorted(
-                p for p in pkg_dir.rglob(Path(name).name) if p.is_file() and not _in_build(p, pkg_dir))
+            roots = [pkg_dir]
+            if packages.is_builtin(pkg_dir) and (BUILTIN_LAUNCH_DIR / pkg).is_dir():
+                roots.append(BUILTIN_LAUNCH_DIR / pkg)
+            matches = []
+            for root in roots:
+                candidate = root / name
+                matches += [candidate] if candidate.is_file() else sorted(
+                    p for p in root.rglob(Path(name).name) if p.is_file() and not _in_build(p, root))
             if len(matches) == 1:
                 return [str(matches[0])], args
             if len(matches) > 1:
@@ -169,6 +176,8 @@ def _main(options: argparse.Namespace, prog: str) -> int:
     if options.dump_params:
         sys.stdout.write(dump_params(config))
         return 0
+    if not options.node_args:
+        _add_core_params(config)
     runner = LaunchRunner(config, master_uri=_master_uri(options), screen=options.screen and not options.log,
                           wait_for_master=options.wait, run_id=options.run_id, core_only=options.core,
                           sigint_timeout=options.sigint_timeout, sigterm_timeout=options.sigterm_timeout)
@@ -181,6 +190,18 @@ def _main(options: argparse.Namespace, prog: str) -> int:
     for warning in config.warnings:
         print(f"WARNING: {warning}", file=sys.stderr, flush=True)
     return runner.run()
+
+
+def _add_core_params(config: LaunchConfig) -> None:
+    """/rosdistro and /rosversion, which roslaunch sets on every launch (from roscore.xml)."""
+    try:
+        from importlib.metadata import version
+
+        minros_version = version("minros")
+    except Exception:  # not installed as a distribution (source tree on sys.path)
+        minros_version = "0.0.0"
+    for key, value in (("/rosdistro", "noetic\n"), ("/rosversion", minros_version + "\n")):
+        config.params.setdefault(key, value)
 
 
 def _print_node_args(config: LaunchConfig, runner, wanted: str) -> int:
