@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from support import ros_env
+from support import Proc, ros_env
 
 BIN = Path(sys.executable).parent
 
@@ -143,3 +143,37 @@ def test_catkin_commands_as_processes(tmp_path):
     assert make.returncode == 0 and "-- ~~  - pkg_a" in make.stdout
     nosrc = _run(["catkin_make"], env, cwd=tmp_path)
     assert nosrc.returncode == 1 and "does not exist" in nosrc.stderr and "Traceback" not in nosrc.stderr
+
+
+def test_rosrun_builtin_rospy_tutorials_talker_listener(minros_master, ros_home):
+
+    env = ros_env(minros_master, ros_home)
+    talker = Proc([str(BIN / "rosrun"), "rospy_tutorials", "talker.py"], env)
+    listener = Proc([str(BIN / "rosrun"), "rospy_tutorials", "listener.py", "chatter:=chatter"], env)
+    try:
+        said = talker.read_until("hello world", timeout=20)
+        heard = listener.read_until("I heard hello world", timeout=20)
+    finally:
+        listener.stop()
+        talker.stop()
+    assert "[INFO]" in said
+    assert "/listener_" in heard  # anonymous node name, as the tutorial's init_node(anonymous=True)
+
+
+def test_rosrun_builtin_add_two_ints(minros_master, ros_home):
+
+    env = ros_env(minros_master, ros_home)
+    server = Proc([str(BIN / "rosrun"), "rospy_tutorials", "add_two_ints_server"], env)
+    try:
+        server.read_until("Ready to add Two Ints.", timeout=20)
+        client = subprocess.run([str(BIN / "rosrun"), "rospy_tutorials", "add_two_ints_client", "3", "4"],
+                                env=env, capture_output=True, text=True, timeout=30)
+        assert client.returncode == 0, client.stderr
+        assert client.stdout.splitlines()[-1] == "3 + 4 = 7"
+        server_out = server.read_until("Returning", timeout=10)
+        assert "Returning [3 + 4 = 7]" in server_out
+        usage = subprocess.run([str(BIN / "rosrun"), "rospy_tutorials", "add_two_ints_client", "x"],
+                               env=env, capture_output=True, text=True, timeout=30)
+        assert usage.returncode == 1 and "[x y]" in usage.stdout
+    finally:
+        server.stop()
