@@ -146,7 +146,6 @@ def test_catkin_commands_as_processes(tmp_path):
 
 
 def test_rosrun_builtin_rospy_tutorials_talker_listener(minros_master, ros_home):
-
     env = ros_env(minros_master, ros_home)
     talker = Proc([str(BIN / "rosrun"), "rospy_tutorials", "talker.py"], env)
     listener = Proc([str(BIN / "rosrun"), "rospy_tutorials", "listener.py", "chatter:=chatter"], env)
@@ -161,7 +160,6 @@ def test_rosrun_builtin_rospy_tutorials_talker_listener(minros_master, ros_home)
 
 
 def test_rosrun_builtin_add_two_ints(minros_master, ros_home):
-
     env = ros_env(minros_master, ros_home)
     server = Proc([str(BIN / "rosrun"), "rospy_tutorials", "add_two_ints_server"], env)
     try:
