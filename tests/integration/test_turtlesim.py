@@ -1,0 +1,188 @@
+"""turtlesim as processes: ``rosrun turtlesim turtlesim_node`` under ``minros core``, driven and
+observed by minros client nodes (tests/integration/turtlesim_probe.py), teleop through a pty,
+mimic across two simulators, draw_square, and the PNG snapshot."""
+
+from __future__ import annotations
+
+import json
+import os
+import pty
+import termios
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from support import PYTHON, Proc, ros_env
+
+PROBE = str(Path(__file__).resolve().parent / "turtlesim_probe.py")
+CENTER = "5.544445"
+
+
+def headless_env(port: int, home: Path) -> dict:
+    return ros_env(port, home, {"MINROS_HEADLESS": "1"})
+
+
+def start_turtlesim(port: int, home: Path, *args: str) -> Proc:
+    proc = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "turtlesim_node", *args],
+                headless_env(port, home))
+    proc.startup = proc.read_until("Spawning turtle [turtle1]", timeout=15)
+    return proc
+
+
+def probe(port: int, home: Path, *args: str, timeout: float = 20) -> dict:
+    proc = Proc([PYTHON, PROBE, *args], ros_env(port, home))
+    try:
+        out = proc.read_until("RESULT ", timeout=timeout)
+    finally:
+        rest = proc.stop()
+    for line in (out + rest).splitlines():
+        if line.startswith("RESULT "):
+            return json.loads(line[len("RESULT "):])
+    raise AssertionError(out + rest)
+
+
+@pytest.fixture
+def turtlesim(minros_core, ros_home, tmp_path):
+    snapshot = tmp_path / "frame.png"
+    proc = start_turtlesim(minros_core, ros_home, "--snapshot", str(snapshot))
+    try:
+        yield proc, minros_core, ros_home, snapshot
+    finally:
+        proc.stop()
+
+
+def test_startup_lines_and_headless_notice(minros_core, ros_home):
+    proc = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "turtlesim_node"],
+                headless_env(minros_core, ros_home))
+    try:
+        out = proc.read_until("without a window", timeout=15)
+    finally:
+        out += proc.stop()
+    assert "Starting turtlesim with node name /turtlesim" in out
+    assert f"Spawning turtle [turtle1] at x=[{CENTER}], y=[{CENTER}], theta=[0.000000]" in out
+    assert out.count("without a window") == 1
+    assert "Traceback" not in out
+
+
+def test_cmd_vel_moves_the_pose_and_pose_rate(turtlesim):
+    proc, port, home, snapshot = turtlesim
+    result = probe(port, home, "drive", "/turtle1")
+    first, moving = result["first"], result["moving"]
+    assert first["x"] == pytest.approx(float(CENTER), abs=1e-6)
+    assert (first["linear_velocity"], first["angular_velocity"]) == (0.0, 0.0)
+    assert moving["linear_velocity"] == 2.0 and moving["angular_velocity"] == 1.0
+    assert moving["x"] != first["x"] and moving["theta"] > 0
+    rate = probe(port, home, "rate", "/turtle1/pose", "1.5")["rate"]
+    assert 40.0 < rate < 75.0, rate  # 16 ms timer: 62.5 Hz even when idle (slack for loaded CI)
+
+
+def test_services_spawn_kill_pen_teleport_clear(turtlesim):
+    proc, port, home, snapshot = turtlesim
+    out = probe(port, home, "services", timeout=30)
+    assert out["spawned"] == "turtle2" and out["named"] == "leo"
+    assert out["leo_pose"]["x"] == 1.0 and out["leo_pose"]["y"] == 1.0
+    assert out["duplicate_error"].startswith("service [/spawn] responded with an error")
+    assert out["illegal_error"].startswith("service [/spawn] responded with an error")
+    assert {"/leo/pose", "/leo/color_sensor"} <= set(out["topics_before_kill"])
+    assert not any(t.startswith("/leo/") for t in out["topics_after_kill"])
+    assert "/turtle2/pose" in out["topics_after_kill"]
+    assert out["kill_unknown_error"].startswith("service [/kill] responded with an error")
+    assert out["color"] == [255, 0, 0]
+    assert out["after_clear"] == [10, 86, 255]
+    assert out["params"] == {"background_r": 10, "background_g": 86, "background_b": 255}
+    log = proc.stop()
+    assert "A turtled named [leo] already exists" in log
+    assert "Tried to kill turtle [leo], which does not exist" in log
+    # The snapshot written at shutdown: cleared to the new background, turtle1 drawn at (2, 2).
+    frame = cv2.imread(str(snapshot))
+    assert frame is not None and frame.shape == (500, 500, 3)
+    assert tuple(frame[5, 495]) == (255, 86, 10)  # BGR of background (10, 86, 255)
+    row, col = round(500 - 1 - 2.0 * 45), round(2.0 * 45)
+    patch = frame[row - 8:row + 8, col - 8:col + 8]
+    assert not np.all(patch == (255, 86, 10))
+
+
+def test_teleop_key_through_a_pty(turtlesim):
+    proc, port, home, snapshot = turtlesim
+    watcher = Proc([PYTHON, PROBE, "first_twist", "/turtle1/cmd_vel"], ros_env(port, home))
+    master_fd, slave_fd = pty.openpty()
+    teleop = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "turtle_teleop_key"],
+                  ros_env(port, home), stdin=slave_fd)
+    try:
+        watcher.read_until("READY", timeout=15)
+        # The banner goes to stdout (a pipe here); the pty is stdin, which must be in raw mode.
+        # (Only the first line is awaited: read_until cannot see lines already buffered.)
+        teleop.read_until("Reading from keyboard", timeout=15)
+        attrs = termios.tcgetattr(slave_fd)
+        assert not attrs[3] & termios.ICANON and not attrs[3] & termios.ECHO
+        assert attrs[3] & termios.ISIG  # Ctrl-C still interrupts
+        deadline = time.monotonic() + 15
+        result = None
+        while result is None and time.monotonic() < deadline:
+            os.write(master_fd, b"\x1b[A")  # arrow up: one Twist per key press
+            try:
+                result = watcher.read_until("RESULT ", timeout=0.3)
+            except AssertionError:
+                continue
+        assert result is not None, "no Twist seen on /turtle1/cmd_vel"
+        twist = json.loads(result.split("RESULT ", 1)[1].splitlines()[0])
+        assert twist == {"linear_x": 2.0, "angular_z": 0.0, "linear_y": 0.0}
+        os.write(master_fd, b"q")
+        teleop.popen.wait(10)
+        assert teleop.popen.returncode == 0
+        assert termios.tcgetattr(slave_fd)[3] & termios.ICANON  # terminal restored
+    finally:
+        watcher.stop()
+        teleop.stop()
+        os.close(master_fd)
+        os.close(slave_fd)
+
+
+def test_teleop_without_a_terminal_says_so_once(minros_core, ros_home):
+    import subprocess
+
+    proc = subprocess.run([PYTHON, "-m", "minros", "run", "turtlesim", "turtle_teleop_key"],
+                          input=b"xyq", env=ros_env(minros_core, ros_home), capture_output=True,
+                          timeout=20)
+    assert proc.returncode == 0
+    err = proc.stderr.decode()
+    assert err.count("stdin is not a terminal") == 1 and "Traceback" not in err
+    assert proc.stdout.decode().splitlines()[:3] == [
+        "Reading from keyboard", "---------------------------",
+        "Use arrow keys to move the turtle. 'q' to quit."]
+
+
+def test_mimic_follows_across_two_simulators(minros_core, ros_home):
+    port = minros_core
+    sims = [start_turtlesim(port, ros_home, "__name:=sim", f"__ns:=turtlesim{i}") for i in (1, 2)]
+    mimic = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "mimic",
+                  "input:=turtlesim1/turtle1", "output:=turtlesim2/turtle1"], ros_env(port, ros_home))
+    try:
+        assert "Starting turtlesim with node name /turtlesim1/sim" in sims[0].startup
+        moving = probe(port, ros_home, "drive", "/turtlesim1/turtle1")["moving"]
+        assert moving["linear_velocity"] == 2.0
+        follower = probe(port, ros_home, "wait_moving", "/turtlesim2/turtle1/pose", "2.0")["pose"]
+        assert follower["angular_velocity"] == 1.0
+        assert follower["x"] != pytest.approx(float(CENTER), abs=1e-3)
+    finally:
+        mimic.stop()
+        for s in sims:
+            s.stop()
+
+
+def test_draw_square_resets_and_reaches_its_first_goal(turtlesim):
+    proc, port, home, snapshot = turtlesim
+    square = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "draw_square"], ros_env(port, home))
+    try:
+        # One read: lines printed together may sit in one buffered chunk.
+        out = square.read_until(", 1.570796]", timeout=20)  # the turn goal, set in place
+    finally:
+        out += square.stop()
+    assert "New goal [7.544445 5.544445, 0.000000]" in out  # 2 m ahead of the reset turtle1
+    assert out.index("Reached goal") > out.index("New goal [7.544445")
+    assert "Traceback" not in out
+    log = proc.stop()
+    assert "Resetting turtlesim." in log
