@@ -114,6 +114,11 @@ class Ros:
         for proc in self.procs:
             proc.stop(timeout=1.0)
 
+    def wait_subscribed(self, topic: str) -> None:
+        def subscribed() -> bool:
+            return any(entry[0] == topic for entry in self.master().getSystemState("/t")[2][1])
+        wait_until(subscribed, timeout=20, what=f"a subscriber of {topic}")
+
 
 @pytest.fixture
 def ros_core(minros_core, ros_home, tmp_path):
@@ -131,8 +136,10 @@ def ros_any(request, ros_home, tmp_path):
 
 def test_rospy_talker_listener(ros_any):
     topic = "/" + unique("chatter")
-    ros_any.script(TALKER, topic, unique("talker"))
+    # listener first, so that it learns of the talker through the master's publisherUpdate
     listener = ros_any.script(LISTENER, topic, unique("listener"))
+    ros_any.wait_subscribed(topic)
+    ros_any.script(TALKER, topic, unique("talker"))
     listener.read_until("heard: hello", timeout=20)
 
 
@@ -231,8 +238,9 @@ def roscpp_binary(tmp_path_factory):
 @pytest.mark.timeout(300)
 def test_roscpp_talker_listener(roscpp_binary, ros_core):
     topic = "/" + unique("cpp_chatter")
-    ros_core.start(str(roscpp_binary), "talk", topic)
     listener = ros_core.start(str(roscpp_binary), "listen", topic)
+    ros_core.wait_subscribed(topic)  # the talker then reaches it through publisherUpdate
+    ros_core.start(str(roscpp_binary), "talk", topic)
     listener.read_until("heard: cpp", timeout=20)
     # roscpp talker to rospy listener through the same master
     rospy_listener = ros_core.script(LISTENER, topic, unique("listener"))
