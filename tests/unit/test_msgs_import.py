@@ -97,3 +97,17 @@ def test_bundled_stub_packages_import_without_ros() -> None:
     out = _run(code, {"ROS_PACKAGE_PATH": ""})
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "0100000078"
+
+
+def test_missing_embedded_type_names_the_user(tmp_path: Path, monkeypatch) -> None:
+    import pytest
+
+    from minros.msgs import UnknownTypeError, get_message_class
+
+    pkg = _make_package(tmp_path / "src", "typo_pkg")
+    (pkg / "msg" / "Typo.msg").write_text("int32 a\nPionts p\n")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "src"))
+    with pytest.raises(UnknownTypeError) as info:
+        get_message_class("typo_pkg/Typo")
+    text = str(info.value)
+    assert "typo_pkg/Pionts" in text and "needed by typo_pkg/Typo" in text and "Typo.msg" in text

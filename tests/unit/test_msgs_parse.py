@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from minros.msgs import MsgContext, MsgSpecError, generate_dynamic, get_message_class
 from minros.msgs.spec import (
@@ -175,3 +177,21 @@ def test_malformed_file_in_package_names_path(tmp_path, monkeypatch) -> None:
     with pytest.raises(MsgSpecError) as info:
         get_message_class("badpkg/Broken")
     assert str(info.value).startswith(f"{pkg / 'msg' / 'Broken.msg'}:2: ")
+
+
+_TOKENS = ["int32", "uint8", "string", "bool", "time", "Header", "pkg/T", "x", "y", "X", "[]",
+           "[3]", "[", "]", "=", "1", "-1", "True", "#", " ", "  ", "\n", "---", "abc", "1.5", "/"]
+
+
+@settings(max_examples=300, deadline=None, database=None)
+@given(st.lists(st.sampled_from(_TOKENS), max_size=30))
+def test_random_definitions_parse_or_raise_msgspecerror(tokens: list) -> None:
+    text = "".join(tokens)
+    try:
+        spec = parse_msg(text, "pkg/Fuzz", "Fuzz.msg")
+        parse_srv(text, "pkg/FuzzSrv", "Fuzz.srv")
+    except MsgSpecError as exc:
+        assert exc.filename and exc.lineno
+        return
+    for f in spec.fields:
+        assert f.name and f.type

@@ -334,3 +334,31 @@ def test_importing_messages_does_not_import_numpy() -> None:
             "print('numpy' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.stdout.strip() == "False", out.stderr
+
+
+def test_deserialize_numpy_and_instances_made_without_constructor() -> None:
+    from geometry_msgs.msg import PoseStamped
+    from std_msgs.msg import Float32MultiArray
+
+    data = Float32MultiArray(data=[1.0, 2.0]).serialize_to_bytes()
+    msg = Float32MultiArray().deserialize_numpy(data, np)
+    assert isinstance(msg.data, np.ndarray) and msg.data.tolist() == [1.0, 2.0]
+    assert numpy_msg(numpy_msg(Float32MultiArray)) is numpy_msg(Float32MultiArray)
+    pose = PoseStamped()
+    pose.header.frame_id = "f"
+    bare = PoseStamped.__new__(PoseStamped)
+    assert bare.deserialize(pose.serialize_to_bytes()) == pose
+
+
+def test_deserialize_fills_embedded_messages_in_place() -> None:
+    from geometry_msgs.msg import PoseStamped
+
+    src = PoseStamped()
+    src.pose.position.x = 3.0
+    target = PoseStamped()
+    position = target.pose.position
+    target.deserialize(src.serialize_to_bytes())
+    assert position is target.pose.position and position.x == 3.0  # as genpy
+    target.pose.position = "not a point"  # a foreign value is replaced, not written into
+    target.deserialize(src.serialize_to_bytes())
+    assert target.pose.position.x == 3.0

@@ -95,11 +95,12 @@ class Message:
             else:
                 view = bytes(data)  # small: one copy, then the faster bytes operations
         try:
-            end = self._deserialize_from(view, 0)
-        except AttributeError:
-            # made without its constructor (cls.__new__): give it default fields first
-            self.__init__()
-            return self.deserialize(view)
+            try:
+                end = self._deserialize_from(view, 0)
+            except AttributeError:
+                # made without its constructor (cls.__new__): give it default fields first
+                self.__init__()
+                end = self._deserialize_from(view, 0)
         except struct.error:
             raise DeserializationError(
                 f"{self._type}: message truncated ({len(view)} bytes do not hold a whole message)"
@@ -108,6 +109,32 @@ class Message:
             raise DeserializationError(
                 f"{self._type}: {len(view) - end} unexpected bytes after the message "
                 f"({end} of {len(view)} bytes used)")
+        return self
+
+    # genpy's numpy variants (rospy.numpy_msg and rosbag call these)
+    def serialize_numpy(self, buff: Any, numpy: Any = None) -> None:
+        """As :meth:`serialize`; numpy arrays in fields are accepted by every class."""
+        self.serialize(buff)
+
+    def deserialize_numpy(self, data: Any, numpy: Any = None) -> Message:
+        """As :meth:`deserialize`, but numeric arrays become numpy views of ``data``."""
+        from .registry import numpy_msg
+
+        view = data if data.__class__ is memoryview else memoryview(data)
+        if view.format != "B" or view.ndim != 1:
+            view = view.cast("B")
+        # the numpy variant's reader fills any instance of the type (it sets fields by name)
+        reader = numpy_msg(type(self))._deserialize_from
+        try:
+            try:
+                end = reader(self, view, 0)
+            except AttributeError:
+                self.__init__()
+                end = reader(self, view, 0)
+        except struct.error:
+            raise DeserializationError(f"{self._type}: message truncated") from None
+        if end != len(view):
+            raise DeserializationError(f"{self._type}: {len(view) - end} unexpected bytes after the message")
         return self
 
     def _serialize_parts(self, append: Callable[[Any], None]) -> None:  # pragma: no cover

@@ -210,7 +210,15 @@ class MsgContext:
         with self._lock:
             cls = self._classes.get(type_name)
             if cls is None:
-                cls = self._compile(type_name, self.source(type_name), None)
+                try:
+                    source = self.source(type_name)
+                except UnknownTypeError as exc:
+                    if exc.type_name == type_name or "needed by" in str(exc):
+                        raise
+                    spec = self._specs.get(type_name)
+                    where = f" in {spec.filename}" if spec is not None and spec.filename else ""
+                    raise UnknownTypeError(exc.type_name, f"{exc} (needed by {type_name}{where})") from None
+                cls = self._compile(type_name, source, None)
                 self._classes[type_name] = cls
             return cls
 
@@ -219,6 +227,8 @@ class MsgContext:
         found = self._numpy_classes.get(cls)
         if found is not None:
             return found
+        if cls in self._numpy_classes.values():
+            return cls  # already a numpy variant
         with self._lock:
             found = self._numpy_classes.get(cls)
             if found is None:
