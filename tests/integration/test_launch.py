@@ -188,6 +188,10 @@ def test_required_node_exit_stops_the_launch(tmp_path, pkg):
     assert "process has died [pid" in out and "exit code 3" in out and "Initiating shutdown!" in out
     assert "[stays-1] killing on exit" in out
     assert all(_gone(pid) for pid in _pids(out))
+    # output="log" (the default): the node's stdout is in <log dir>/<run_id>/<name>-stdout.log
+    logs = list((tmp_path / "home" / "log").glob("*/boss-2-stdout.log"))
+    assert len(logs) == 1 and logs[0].read_text().startswith("PROBE ")
+    assert f"log file: {logs[0].parent / 'boss-2'}*.log" in out
 
 
 def test_respawning_node_comes_back(tmp_path, pkg):

@@ -175,3 +175,18 @@ def test_rosrun_builtin_add_two_ints(minros_master, ros_home):
         assert usage.returncode == 1 and "[x y]" in usage.stdout
     finally:
         server.stop()
+
+
+def test_rosrun_non_unique_executable_asks_which(tmp_path, pkg_path):
+    other = pkg_path / "demo_pkg" / "other"
+    other.mkdir()
+    (other / "node.py").write_text(SCRIPT.replace('"exe"', '"other-exe"'))
+    (other / "node.py").chmod(0o755)
+    env = _env(tmp_path, pkg_path)
+    out = _run(["rosrun", "demo_pkg", "node.py", "x"], env, input="2\n")
+    lines = out.stdout.splitlines()
+    assert lines[0] == "[rosrun] You have chosen a non-unique executable, please pick one of the following:"
+    assert lines[1] == f"1) {other / 'node.py'}"
+    assert lines[3].startswith("#? exe ") and lines[4] == "argv ['x']"  # the second: scripts/deep/node.py
+    aborted = _run(["rosrun", "demo_pkg", "node.py"], env, input="")
+    assert aborted.returncode == 1

@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import shlex
 import sys
+from pathlib import Path
 from typing import List
 
 USAGE = """Usage: rosrun [--prefix cmd] [--debug] PACKAGE EXECUTABLE [ARGS]
@@ -19,8 +20,27 @@ USAGE = """Usage: rosrun [--prefix cmd] [--debug] PACKAGE EXECUTABLE [ARGS]
   If it finds it, it will run it with ARGS."""
 
 
+def _pick(candidates: List[Path]) -> Path | None:
+    """Ask for one of several executables by number; None on end of input."""
+    while True:
+        try:
+            answer = input("#? ")
+        except EOFError:
+            print()
+            return None
+        if answer.strip().isdigit() and 1 <= int(answer) <= len(candidates):
+            return candidates[int(answer) - 1]
+        for i, path in enumerate(candidates, 1):
+            print(f"{i}) {path}", file=sys.stderr)
+
+
 def main(argv: List[str], prog: str | None = None) -> int:
-    from minros.workspace.nodes import ExecutableError, child_environment, resolve_executable
+    from minros.workspace.nodes import (
+        ExecutableError,
+        child_environment,
+        command_for,
+        resolve_executable,
+    )
 
     args = list(argv)
     prefix: List[str] = []
@@ -48,7 +68,12 @@ def main(argv: List[str], prog: str | None = None) -> int:
         stream = sys.stderr if exc.exit_code == 2 else sys.stdout
         for line in exc.lines:
             print(line, file=stream)
-        return exc.exit_code
+        if not exc.candidates:
+            return exc.exit_code
+        chosen = _pick(exc.candidates)  # like the bash `select` of rosrun
+        if chosen is None:
+            return 1
+        command = command_for(chosen)
     full = prefix + command + rest
     if debug:
         print("[rosrun] Running", " ".join(full))

@@ -45,11 +45,14 @@ _PYTHON_SHEBANG = re.compile(rb"^#!\s*(?:/usr/bin/env\s+(?:-S\s+)?)?(?:\S*/)?pyt
 class ExecutableError(Exception):
     """rosrun/roslaunch could not resolve an executable; ``lines`` is what rosrun prints."""
 
-    def __init__(self, lines: List[str], exit_code: int, short: str) -> None:
+    def __init__(self, lines: List[str], exit_code: int, short: str,
+                 candidates: List[Path] | None = None) -> None:
         super().__init__(short)
         self.lines = lines
         self.exit_code = exit_code
         self.short = short
+        #: several executables of that name: rosrun lets the user pick one
+        self.candidates = candidates or []
 
 
 def _is_executable_file(path: Path) -> bool:
@@ -154,7 +157,8 @@ def resolve_executable(pkg: str, executable: str) -> List[str]:
         raise ExecutableError(
             ["[rosrun] You have chosen a non-unique executable, please pick one of the following:"]
             + [f"{i}) {p}" for i, p in enumerate(unique, 1)], 3,
-            f"non-unique executable {executable} in package {pkg}: " + ", ".join(map(str, unique)))
+            f"non-unique executable {executable} in package {pkg}: " + ", ".join(map(str, unique)),
+            candidates=unique)
     return command_for(unique[0])
 
 
