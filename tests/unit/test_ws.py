@@ -106,6 +106,9 @@ def test_malformed_manifest_is_one_clear_error(tmp_path: Path):
 def test_make_without_src_fails(tmp_path: Path):
     with pytest.raises(WorkspaceError, match='source space ".*/src" does not exist'):
         catkin.make_workspace(tmp_path, out=lambda s: None)
+    catkin.init_workspace(tmp_path, out=lambda s: None)  # tmp_path plays a workspace's src/
+    with pytest.raises(WorkspaceError, match="must be invoked in the root of workspace"):
+        catkin.make_workspace(tmp_path, out=lambda s: None)
 
 
 def _bash(script: str, cwd: Path, env=None) -> str:

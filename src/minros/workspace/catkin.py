@@ -409,6 +409,9 @@ def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _pr
     ws = Path(workspace).absolute()
     src, build, devel, install = ws / "src", ws / "build", ws / "devel", ws / "install"
     if not src.is_dir():
+        if (ws / "CMakeLists.txt").exists():  # run inside src/ by mistake, as catkin_make says
+            raise WorkspaceError(f'The specified base path "{ws}" contains a CMakeLists.txt but '
+                                 '"catkin_make" must be invoked in the root of workspace')
         raise WorkspaceError(f'The specified source space "{src}" does not exist')
     if (ws / "package.xml").exists():
         raise WorkspaceError(
