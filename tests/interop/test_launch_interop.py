@@ -160,3 +160,31 @@ def test_params_land_in_debian_rosmaster_with_their_types(launch_dir, debian_ros
         out = proc.stop()
     assert "auto-starting new master" not in out
     assert os.path.isdir(launch_dir / "home" / "log")
+
+
+def _summary_block(output: str) -> str:
+    """The SUMMARY ... NODES block of roslaunch's output, without colour codes and without
+    /rosdistro and /rosversion (their values name the distribution)."""
+    import re
+
+    text = re.sub(r"\x1b\[[0-9;]*m|\x1b\]2;[^\x07]*\x07", "", output)
+    start = text.index("SUMMARY")
+    end = text.index("\n\n", text.index("NODES", start) + len("NODES\n") + 1)
+    lines = text[start:end].splitlines()
+    return "\n".join(ln for ln in lines if not ln.startswith((" * /rosdistro", " * /rosversion")))
+
+
+def test_summary_matches_debian_roslaunch(launch_dir, debian_rosmaster):
+    env = _env(launch_dir, debian_rosmaster)
+    cwd = launch_dir / "launch"
+    blocks = []
+    for argv, proc_env in (([str(BIN / "roslaunch")], env), (["/usr/bin/roslaunch"], reference_env(env))):
+        proc = Proc(argv + ["top.launch", "name:=bot"], proc_env, cwd=cwd)
+        try:
+            text = proc.read_until("ROS_MASTER_URI=", timeout=30)
+        finally:
+            proc.stop()
+        blocks.append(_summary_block(text))
+    ours, theirs = blocks
+    assert ours == theirs
+    assert " * /t_yaml: {'a': [1, 2.5, 'x..." in ours  # long values cut to 20 characters
