@@ -382,20 +382,12 @@ def _lookup_service(resolved_name: str) -> str:
 
 
 def _connect(host: str, port: int, timeout: float) -> socket.socket:
-    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    """TCP connection to a service; every address of ``host`` is tried (localhost may be ::1)."""
+    sock = socket.create_connection((host, port), timeout=timeout)
     try:
-        infos = socket.getaddrinfo(host, port, 0, socket.SOCK_STREAM)
-        family, _, _, _, addr = infos[0]
-    except OSError:
-        addr = (host, port)
-    sock = socket.socket(family, socket.SOCK_STREAM)
-    try:
-        sock.settimeout(timeout)
-        sock.connect(addr)
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    except OSError:
-        sock.close()
-        raise
+    except OSError:  # not fatal: only latency
+        pass
     return sock
 
 
