@@ -48,6 +48,8 @@ DEFAULT_MAX_HEADER = 1 << 20
 DEFAULT_MAX_FRAME = 1_000_000_000
 #: a frame up to this size is received into the shared buffer, larger ones get their own
 DEFAULT_BUFF_SIZE = 65536
+#: the largest shared receive buffer; frames that do not fit get their own buffer
+MAX_SHARED_BUFFER = 256 << 10
 #: a big frame's own buffer starts at most this large and then doubles as bytes arrive,
 #: so a lying length field costs at most twice what the peer really sent
 _FIRST_CHUNK = 16 << 20
@@ -252,8 +254,10 @@ class FrameReader:
 
     def __init__(self, max_frame: int = DEFAULT_MAX_FRAME, buff_size: int = DEFAULT_BUFF_SIZE,
                  ok_byte: bool = False) -> None:
-        if buff_size < 16:
-            buff_size = 16
+        # The shared buffer only ever holds small frames; anything larger goes to a buffer of
+        # its own, so a huge buff_size (rospy users pass 2**24 for images) must not turn big
+        # frames into copies out of the shared buffer.
+        buff_size = min(max(buff_size, 16), MAX_SHARED_BUFFER)
         self._buf = bytearray(buff_size)
         self._view = memoryview(self._buf)
         self._start = 0  # first unread byte
@@ -285,19 +289,33 @@ class FrameReader:
         return self._view[self._end:]
 
     def received(self, n: int) -> None:
-        """Account for ``n`` bytes written into the last ``recv_buffer()``; parse frames."""
+        """Account for ``n`` bytes written into the last ``recv_buffer()``; ``frames()`` then
+        pops the completed frames."""
+        self._ready = self.received_frames(n)
+
+    def received_frames(self, n: int) -> list:
+        """``received(n)`` and ``frames()`` in one call (the subscriber's hot path): the frames
+        completed so far. An error in the data is raised by the next call, once the good
+        frames before it are out."""
         self.bytes_received += n
         if self._big is not None:
             self._big_fill += n
             if self._big_fill == self._big_len:
                 self._finish_big()
-            return
-        self._end += n
-        try:
-            self._parse()
-        except FrameError as exc:
-            # the frames before the bad one are still good: frames() hands them out first
-            self._error = exc
+        else:
+            self._end += n
+            try:
+                if self.ok_byte:
+                    self._parse()
+                else:
+                    self._parse_frames()
+            except FrameError as exc:
+                # the frames before the bad one are still good: they are handed out first
+                self._error = exc
+        ready = self._ready
+        if ready:
+            self._ready = []
+        return ready
 
     def frames(self) -> list:
         """Pop the complete frames parsed so far (``bytes``/``bytearray``, or (ok, payload)).
@@ -346,6 +364,33 @@ class FrameReader:
             self._start = 0
         if self._end == len(self._buf):  # a header that does not fit: must be a big frame
             raise AssertionError("FrameReader invariant violated")  # pragma: no cover
+
+    def _parse_frames(self) -> None:
+        """Topic frames (no ok byte): the hot path of every subscriber."""
+        buf = self._buf
+        view = self._view
+        pos = self._start
+        end = self._end
+        ready = self._ready
+        unpack = _U32.unpack_from
+        while end - pos >= 4:
+            (size,) = unpack(buf, pos)
+            stop = pos + 4 + size
+            if stop <= end:
+                if size > self.max_frame:
+                    raise FrameError(f"frame of {size} bytes exceeds the limit of {self.max_frame}")
+                ready.append(bytes(view[pos + 4:stop]))
+                pos = stop
+                continue
+            self._start = pos
+            self._parse()  # an incomplete frame: the general parser decides where it goes
+            return
+        if pos == end:
+            self._start = self._end = 0
+        else:
+            self._start = pos
+            if len(buf) - pos < 4:
+                self._compact()
 
     def _parse(self) -> None:
         buf = self._buf

@@ -57,6 +57,10 @@ _conn_ids = iter(range(1, 1 << 62))
 _conn_id_lock = threading.Lock()
 
 
+def _yield_gil() -> None:
+    time.sleep(0)
+
+
 def _next_conn_id() -> int:
     with _conn_id_lock:
         return next(_conn_ids)
@@ -127,31 +131,65 @@ class _Chunks:
         return len(data)
 
 
+class _Discard:
+    """Sink for re-running a failed serialization to get the message's own error text."""
+
+    @staticmethod
+    def write(_data: Any) -> None:
+        pass
+
+
+_SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
+                     UnicodeError, IndexError, SerializationError)
+
+
 def serialize_frame(msg: Any) -> Any:
     """Serialize ``msg`` into one frame: ``bytes`` for small messages, else a tuple of buffers
     (length prefix first) that ``sendmsg`` writes without joining them."""
-    chunks = _Chunks()
-    try:
-        msg.serialize(chunks)
-    except SerializationError as exc:
-        raise ROSSerializationException(str(exc)) from None
-    except (struct.error, TypeError, ValueError, AttributeError, OverflowError) as exc:
-        raise ROSSerializationException(str(exc)) from None
-    if chunks.size <= _JOIN_LIMIT:
-        return _U32.pack(chunks.size) + b"".join(chunks.parts)
-    parts = [_U32.pack(chunks.size)]
+    parts_of = getattr(msg, "_serialize_parts", None)
+    if parts_of is None:  # not a minros message class (AnyMsg, hand-written genpy-style)
+        chunks = _Chunks()
+        try:
+            msg.serialize(chunks)
+        except ROSSerializationException:
+            raise
+        except _SERIALIZE_ERRORS as exc:
+            raise ROSSerializationException(str(exc)) from None
+        parts = chunks.parts
+    else:
+        parts = [b""]  # slot for the length prefix
+        try:
+            parts_of(parts.append)
+        except _SERIALIZE_ERRORS:
+            try:  # again through serialize(), whose error names the bad field
+                msg.serialize(_Discard)
+            except SerializationError as exc:
+                raise ROSSerializationException(str(exc)) from None
+            except _SERIALIZE_ERRORS as exc:
+                raise ROSSerializationException(str(exc)) from None
+            raise
+        del parts[0]
+    size = 0
+    for part in parts:
+        size += len(part) if part.__class__ is bytes else memoryview(part).nbytes
+    if size <= _JOIN_LIMIT:
+        parts.insert(0, _U32.pack(size))
+        return b"".join(parts)
+    out = [_U32.pack(size)]
     small: list = []
-    for part in chunks.parts:  # coalesce the many small field writes around the big ones
-        if len(part) < 4096:
+    for part in parts:  # coalesce the many small field writes around the big ones
+        n = len(part) if part.__class__ is bytes else memoryview(part).nbytes
+        if n < 4096:
             small.append(part)
-        else:
-            if small:
-                parts.append(b"".join(small))
-                small = []
-            parts.append(part)
+            continue
+        if small:
+            out.append(b"".join(small))
+            small = []
+        # mutable buffers are snapshotted: the frame may wait in a queue after publish returns
+        out.append(part if part.__class__ is bytes else bytes(part))
     if small:
-        parts.append(b"".join(small))
-    return tuple(parts)
+        out.append(b"".join(small))
+    return tuple(out)
 
 
 def _frame_len(frame: Any) -> int:
@@ -162,6 +200,8 @@ def _frame_len(frame: Any) -> int:
 
 def args_kwds_to_message(data_class: Any, args: tuple, kwds: dict) -> Any:
     """rospy's publish(msg | *fields | **fields) convention."""
+    if len(args) == 1 and not kwds and args[0].__class__ is data_class:
+        return args[0]
     if args and kwds:
         raise TypeError("publish() can be called with arguments or keywords, but not both.")
     if kwds:
@@ -186,7 +226,7 @@ class _PubConnection:
     """One subscriber connected to one of our publications."""
 
     __slots__ = ("id", "sock", "callerid", "local", "remote", "fileno", "queue", "queue_size",
-                 "cond", "busy", "done", "stat_bytes", "stat_msgs", "impl", "sync", "thread",
+                 "lock", "cond", "busy", "done", "stat_bytes", "stat_msgs", "impl", "sync", "thread",
                  "header")
 
     def __init__(self, impl: _PublisherImpl, sock: socket.socket, addr, header: Dict[str, str],
@@ -201,7 +241,8 @@ class _PubConnection:
         self.fileno = sock.fileno()
         self.queue: collections.deque = collections.deque()
         self.queue_size = queue_size
-        self.cond = threading.Condition(threading.Lock())
+        self.lock = threading.Lock()  # C-level `with` on the hot path; cond shares it
+        self.cond = threading.Condition(self.lock)
         self.busy = False
         self.done = False
         self.stat_bytes = 0
@@ -235,16 +276,30 @@ class _PubConnection:
                 except OSError as exc:
                     self._fail(exc)
             return
-        with self.cond:
+        with self.lock:
             if not self.queue and not self.busy:
                 # fast path: the socket is idle, try to hand the bytes to the kernel now
-                try:
-                    sent = self._send_nowait(frame)
-                except OSError as exc:
-                    self._fail(exc)
-                    return
-                if sent is None:
-                    return
+                if frame.__class__ is bytes:
+                    try:
+                        sent = self.sock.send(frame, _MSG_DONTWAIT)
+                    except BlockingIOError:
+                        sent = 0
+                    except OSError as exc:
+                        self._fail(exc)
+                        return
+                    self.stat_bytes += sent
+                    if sent == len(frame):
+                        self.stat_msgs += 1
+                        return
+                    sent = _Partial(memoryview(frame)[sent:])
+                else:
+                    try:
+                        sent = self._send_nowait(frame)
+                    except OSError as exc:
+                        self._fail(exc)
+                        return
+                    if sent is None:
+                        return
                 self.queue.append(sent)
                 self.cond.notify()
                 return
@@ -258,6 +313,9 @@ class _PubConnection:
                     queue.popleft()
             queue.append(frame)
             self.cond.notify()
+        # The writer thread is behind: let it have the GIL now rather than after the
+        # interpreter's switch interval (5 ms), or a publishing loop starves it.
+        _yield_gil()
 
     def _send_nowait(self, frame: Any) -> Any:
         """Send what the kernel takes without blocking; return the unsent rest or None."""
@@ -495,7 +553,15 @@ class _PublisherImpl:
             conns = self.connections
             if not conns:
                 return
-            frame = self._serialize(msg)
+            # Header auto-fill, then one serialization for every connection (inlined _serialize)
+            self.seq += 1
+            if getattr(msg, "_has_header", False):
+                header = msg.header
+                header.seq = self.seq
+                if header.frame_id is None:
+                    header.frame_id = "0"
+            frame = serialize_frame(msg)
+            self.message_data_sent += (len(frame) if frame.__class__ is bytes else _frame_len(frame)) - 4
             for conn in conns:
                 conn.write(frame)
 
@@ -634,8 +700,7 @@ class _SubConnection:
             if not n:
                 reader.eof()
                 raise tcpros.HeaderError("publisher closed the connection during the handshake")
-            reader.received(n)
-            frames = reader.frames()
+            frames = reader.received_frames(n)
         if len(frames[0]) > tcpros.DEFAULT_MAX_HEADER:
             raise tcpros.HeaderError(f"connection header of {len(frames[0])} bytes exceeds the "
                                      f"limit of {tcpros.DEFAULT_MAX_HEADER}")
@@ -696,8 +761,7 @@ class _SubConnection:
                 reader.eof()
                 return
             self.stat_bytes += n
-            reader.received(n)
-            frames = reader.frames()
+            frames = reader.received_frames(n)
 
 
 class _GiveUp(Exception):

@@ -1,0 +1,607 @@
+#!/usr/bin/env python3
+"""Publish/subscribe benchmark: minros vs Debian's rospy vs roscpp vs raw Python sockets.
+
+    .venv/bin/python benchmarks/pubsub.py [--rounds 3] [--seconds 2] [--only minros,rospy]
+
+Each scenario runs a pair of processes of one implementation on one master (Debian's
+rosmaster when installed, else minros's): the contenders are interleaved round by round and
+the table shows the median of the rounds plus ratios, because this machine is shared and
+noisy (see shared/spec/ros1-reference.md).
+
+Scenarios
+* ping-pong round trip of a 20-byte std_msgs/String (each side answers from its receive
+  callback, subscriber tcp_nodelay), publisher queue_size=10 and queue_size=None;
+* small-message flood: std_msgs/String "x"*20 published as fast as possible for N seconds,
+  messages per second *received*;
+* 640x480 and 1920x1080 bgr8 sensor_msgs/Image floods, frames per second received.
+
+This same file is also the worker: ``--role ...`` runs one side of a scenario, in whichever
+Python runs it (the venv's for minros, /usr/bin/python3 for rospy), and prints one JSON line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import socket
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+VENV_PYTHON = os.path.join(REPO, ".venv", "bin", "python")
+REFERENCE_PYTHON = "/usr/bin/python3"
+KINDS = {"small": None, "vga": (480, 640), "hd": (1080, 1920)}
+
+# --------------------------------------------------------------------------------- workers
+
+
+def _make(kind: str):
+    if kind == "small":
+        from std_msgs.msg import String
+
+        return String, String("x" * 20)
+    from sensor_msgs.msg import Image
+
+    height, width = KINDS[kind]
+    msg = Image()
+    msg.height, msg.width, msg.encoding, msg.step = height, width, "bgr8", width * 3
+    msg.header.frame_id = "camera"
+    msg.data = bytes(height * width * 3)
+    return Image, msg
+
+
+def _queue(text: str):
+    return None if text == "none" else int(text)
+
+
+def _wait_connections(pub, n: int = 1, timeout: float = 20.0) -> None:
+    deadline = time.monotonic() + timeout
+    while pub.get_num_connections() < n:
+        if time.monotonic() > deadline:
+            raise SystemExit("no subscriber connected")
+        time.sleep(0.005)
+
+
+def role_echo(args) -> None:
+    import warnings
+
+    import rospy
+    from std_msgs.msg import String
+
+    warnings.simplefilter("ignore", SyntaxWarning)
+    rospy.init_node("bench_echo", anonymous=True)
+    pub = rospy.Publisher("/bench_pong", String, queue_size=_queue(args.queue), tcp_nodelay=True)
+    rospy.Subscriber("/bench_ping", String, pub.publish, tcp_nodelay=True)
+    print(json.dumps({"ready": True}), flush=True)
+    rospy.spin()
+
+
+def role_ping(args) -> None:
+    import warnings
+
+    import rospy
+    from std_msgs.msg import String
+
+    warnings.simplefilter("ignore", SyntaxWarning)
+    rospy.init_node("bench_ping", anonymous=True)
+    pub = rospy.Publisher("/bench_ping", String, queue_size=_queue(args.queue), tcp_nodelay=True)
+    msg = String("x" * 16)  # 20 bytes on the wire
+    times: list = []
+    done = threading.Event()
+    state = {"t": 0.0, "n": 0}
+    total = args.count + 200  # the first 200 warm up
+
+    def on_pong(_msg) -> None:
+        now = time.perf_counter()
+        state["n"] += 1
+        if state["n"] > 200:
+            times.append(now - state["t"])
+        if state["n"] >= total:
+            done.set()
+            return
+        state["t"] = time.perf_counter()
+        pub.publish(msg)
+
+    rospy.Subscriber("/bench_pong", String, on_pong, tcp_nodelay=True)
+    _wait_connections(pub)
+    time.sleep(0.5)  # the echo's publisher needs our subscription too
+    state["t"] = time.perf_counter()
+    cpu = time.process_time()
+    pub.publish(msg)
+    if not done.wait(60):
+        raise SystemExit(f"ping-pong stalled after {state['n']} round trips")
+    cpu = time.process_time() - cpu
+    print(json.dumps({"median_us": statistics.median(times) * 1e6,
+                      "mean_us": statistics.mean(times) * 1e6,
+                      "cpu_us": cpu / total * 1e6}), flush=True)
+    rospy.signal_shutdown("done")
+
+
+def role_flood_pub(args) -> None:
+    import warnings
+
+    import rospy
+
+    warnings.simplefilter("ignore", SyntaxWarning)
+    cls, msg = _make(args.kind)
+    rospy.init_node("bench_flood_pub", anonymous=True)
+    pub = rospy.Publisher("/bench_flood", cls, queue_size=_queue(args.queue))
+    _wait_connections(pub)
+    time.sleep(0.3)
+    sent = 0
+    end = time.monotonic() + args.seconds
+    while time.monotonic() < end:
+        for _ in range(10):
+            pub.publish(msg)
+        sent += 10
+    print(json.dumps({"sent": sent}), flush=True)
+    time.sleep(1.0)
+    rospy.signal_shutdown("done")
+
+
+def role_flood_sub(args) -> None:
+    import rospy
+
+    cls, _ = _make(args.kind)
+    stamps: list = []
+
+    def on_msg(_msg) -> None:
+        stamps.append(time.perf_counter())
+
+    rospy.init_node("bench_flood_sub", anonymous=True)
+    rospy.Subscriber("/bench_flood", cls, on_msg, queue_size=None, buff_size=1 << 24)
+    print(json.dumps({"ready": True}), flush=True)
+    # report once the flow stopped for a while
+    last = -1
+    while True:
+        time.sleep(0.5)
+        if stamps and len(stamps) == last:
+            break
+        last = len(stamps)
+    n = len(stamps)
+    rate = (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0
+    print(json.dumps({"received": n, "rate": rate}), flush=True)
+    rospy.signal_shutdown("done")
+
+
+# raw sockets: the same exchanges with a 4-byte length prefix and nothing else
+
+def _recv_exact(sock, view) -> None:
+    got = 0
+    while got < len(view):
+        n = sock.recv_into(view[got:])
+        if not n:
+            raise ConnectionError("peer closed")
+        got += n
+
+
+def role_raw_echo(args) -> None:
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    server.bind(("127.0.0.1", args.port))
+    server.listen(1)
+    print(json.dumps({"ready": True}), flush=True)
+    conn, _ = server.accept()
+    conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    head = bytearray(4)
+    body = bytearray(1 << 16)
+    try:
+        while True:
+            _recv_exact(conn, memoryview(head))
+            (size,) = struct.unpack("<I", head)
+            _recv_exact(conn, memoryview(body)[:size])
+            conn.sendall(bytes(head) + bytes(body[:size]))
+    except (ConnectionError, OSError):
+        pass
+
+
+def role_raw_ping(args) -> None:
+    sock = socket.create_connection(("127.0.0.1", args.port))
+    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    payload = struct.pack("<I", 20) + struct.pack("<I", 16) + b"x" * 16
+    reply = bytearray(len(payload))
+    view = memoryview(reply)
+    times = []
+    cpu = time.process_time()
+    for i in range(args.count + 200):
+        t = time.perf_counter()
+        sock.sendall(payload)
+        _recv_exact(sock, view)
+        if i >= 200:
+            times.append(time.perf_counter() - t)
+    cpu = time.process_time() - cpu
+    print(json.dumps({"median_us": statistics.median(times) * 1e6,
+                      "mean_us": statistics.mean(times) * 1e6,
+                      "cpu_us": cpu / (args.count + 200) * 1e6}), flush=True)
+
+
+def role_raw_flood_sub(args) -> None:
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    server.bind(("127.0.0.1", args.port))
+    server.listen(1)
+    print(json.dumps({"ready": True}), flush=True)
+    conn, _ = server.accept()
+    head = bytearray(4)
+    body = bytearray(8 << 20)
+    stamps = []
+    try:
+        while True:
+            _recv_exact(conn, memoryview(head))
+            (size,) = struct.unpack("<I", head)
+            _recv_exact(conn, memoryview(body)[:size])
+            stamps.append(time.perf_counter())
+    except (ConnectionError, OSError):
+        pass
+    n = len(stamps)
+    print(json.dumps({"received": n, "rate": (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0}),
+          flush=True)
+
+
+def role_raw_flood_pub(args) -> None:
+    sock = socket.create_connection(("127.0.0.1", args.port))
+    if args.kind == "small":
+        frame = struct.pack("<I", 24) + struct.pack("<I", 20) + b"x" * 20
+    else:
+        height, width = KINDS[args.kind]
+        frame = struct.pack("<I", height * width * 3) + bytes(height * width * 3)
+    sent = 0
+    end = time.monotonic() + args.seconds
+    while time.monotonic() < end:
+        for _ in range(10):
+            sock.sendall(frame)
+        sent += 10
+    sock.close()
+    print(json.dumps({"sent": sent}), flush=True)
+
+
+ROLES = {
+    "echo": role_echo, "ping": role_ping, "flood-pub": role_flood_pub, "flood-sub": role_flood_sub,
+    "raw-echo": role_raw_echo, "raw-ping": role_raw_ping, "raw-flood-pub": role_raw_flood_pub,
+    "raw-flood-sub": role_raw_flood_sub,
+}
+
+# --------------------------------------------------------------------------------- roscpp
+
+ROSCPP_SOURCE = r'''
+#include <ros/ros.h>
+#include <std_msgs/String.h>
+#include <sensor_msgs/Image.h>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+#include <algorithm>
+
+typedef std::chrono::steady_clock Clock;
+static ros::Publisher pub;
+static std::vector<double> times;
+static Clock::time_point t0;
+static int n = 0, total = 0;
+static std::vector<Clock::time_point> stamps;
+static std_msgs::String pingMsg;
+
+static void onPing(const std_msgs::String::ConstPtr& m) { pub.publish(*m); }
+static void onPong(const std_msgs::String::ConstPtr&) {
+  Clock::time_point now = Clock::now();
+  if (++n > 200) times.push_back(std::chrono::duration<double, std::micro>(now - t0).count());
+  if (n >= total) { ros::shutdown(); return; }
+  t0 = Clock::now();
+  pub.publish(pingMsg);
+}
+template <class M> static void onFlood(const typename M::ConstPtr&) { stamps.push_back(Clock::now()); }
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "bench_cpp", ros::init_options::AnonymousName | ros::init_options::NoSigintHandler);
+  ros::NodeHandle nh;
+  std::string role = argv[1], kind = argv[2];
+  int queue = atoi(argv[3]);
+  double seconds = atof(argv[4]);
+  int count = atoi(argv[5]);
+  ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
+  if (role == "echo") {
+    pub = nh.advertise<std_msgs::String>("/bench_pong", queue);
+    ros::Subscriber s = nh.subscribe("/bench_ping", 100, onPing, hints);
+    printf("{\"ready\": true}\n"); fflush(stdout);
+    ros::spin();
+  } else if (role == "ping") {
+    pub = nh.advertise<std_msgs::String>("/bench_ping", queue);
+    ros::Subscriber s = nh.subscribe("/bench_pong", 100, onPong, hints);
+    pingMsg.data = std::string(16, 'x');
+    total = count + 200;
+    while (pub.getNumSubscribers() == 0) ros::Duration(0.005).sleep();
+    ros::AsyncSpinner spinner(1); spinner.start();
+    ros::Duration(0.5).sleep();
+    t0 = Clock::now();
+    pub.publish(pingMsg);
+    ros::waitForShutdown();
+    std::sort(times.begin(), times.end());
+    double sum = 0; for (double t : times) sum += t;
+    printf("{\"median_us\": %f, \"mean_us\": %f}\n", times[times.size() / 2], sum / times.size());
+  } else if (role == "flood-sub") {
+    ros::Subscriber s;
+    if (kind == "small") s = nh.subscribe<std_msgs::String>("/bench_flood", 100000, onFlood<std_msgs::String>);
+    else s = nh.subscribe<sensor_msgs::Image>("/bench_flood", 100, onFlood<sensor_msgs::Image>);
+    printf("{\"ready\": true}\n"); fflush(stdout);
+    size_t last = (size_t)-1;
+    ros::AsyncSpinner spinner(1); spinner.start();
+    while (true) {
+      ros::WallDuration(0.5).sleep();
+      if (!stamps.empty() && stamps.size() == last) break;
+      last = stamps.size();
+    }
+    size_t k = stamps.size();
+    double span = k > 1 ? std::chrono::duration<double>(stamps.back() - stamps.front()).count() : 0;
+    printf("{\"received\": %zu, \"rate\": %f}\n", k, span > 0 ? (k - 1) / span : 0.0);
+  } else {  // flood-pub
+    std_msgs::String small; small.data = std::string(20, 'x');
+    sensor_msgs::Image img;
+    if (kind != "small") {
+      int h = kind == "vga" ? 480 : 1080, w = kind == "vga" ? 640 : 1920;
+      img.height = h; img.width = w; img.encoding = "bgr8"; img.step = w * 3; img.data.assign(h * w * 3, 0);
+    }
+    if (kind == "small") pub = nh.advertise<std_msgs::String>("/bench_flood", queue);
+    else pub = nh.advertise<sensor_msgs::Image>("/bench_flood", queue);
+    while (pub.getNumSubscribers() == 0) ros::Duration(0.005).sleep();
+    ros::Duration(0.3).sleep();
+    long sent = 0;
+    Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    while (Clock::now() < end) {
+      for (int i = 0; i < 10; ++i) { if (kind == "small") pub.publish(small); else pub.publish(img); }
+      sent += 10;
+      ros::spinOnce();
+    }
+    printf("{\"sent\": %ld}\n", sent); fflush(stdout);
+    ros::WallDuration(1.0).sleep();
+  }
+  return 0;
+}
+'''
+
+
+def build_roscpp(cache: str):
+    """Compile the C++ worker (once); None when g++/roscpp are unavailable."""
+    binary = os.path.join(cache, "bench_roscpp")
+    if os.path.exists(binary):
+        return binary
+    if not shutil.which("g++") or not shutil.which("pkg-config"):
+        return None
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "roscpp", "std_msgs", "sensor_msgs"],
+                           capture_output=True, text=True)
+    if flags.returncode != 0:
+        return None
+    os.makedirs(cache, exist_ok=True)
+    source = os.path.join(cache, "bench_roscpp.cpp")
+    with open(source, "w") as f:
+        f.write(ROSCPP_SOURCE)
+    result = subprocess.run(["g++", "-O2", "-o", binary, source, *flags.stdout.split()],
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        print("roscpp build failed:\n" + result.stderr[-2000:], file=sys.stderr)
+        return None
+    return binary
+
+
+# --------------------------------------------------------------------------------- driver
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Runner:
+    def __init__(self, args) -> None:
+        self.args = args
+        self.home = tempfile.mkdtemp(prefix="minros-bench-")
+        self.port = _free_port()
+        self.reference = os.path.exists(REFERENCE_PYTHON) and subprocess.run(
+            [REFERENCE_PYTHON, "-c", "import rospy"], env=self.env(True), capture_output=True).returncode == 0
+        self.roscpp = build_roscpp(os.path.join(tempfile.gettempdir(), "minros-bench-roscpp")) \
+            if self.reference else None
+        if self.reference:
+            master = ["/usr/bin/rosmaster", "--core", "-p", str(self.port)]
+            self.master = subprocess.Popen(master, env=self.env(True), stdout=subprocess.DEVNULL,
+                                           stderr=subprocess.DEVNULL)
+        else:
+            self.master = subprocess.Popen([VENV_PYTHON, "-m", "minros.master", "-p", str(self.port)],
+                                           env=self.env(False), stdout=subprocess.DEVNULL,
+                                           stderr=subprocess.DEVNULL)
+        time.sleep(1.5)
+
+    def env(self, reference: bool) -> dict:
+        env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_") and k != "PYTHONPATH"}
+        env.update(ROS_MASTER_URI=f"http://localhost:{self.port}", ROS_HOSTNAME="localhost",
+                   ROS_HOME=self.home, ROS_LOG_DIR=os.path.join(self.home, "log"))
+        if reference:
+            env.pop("VIRTUAL_ENV", None)
+            env["PATH"] = "/usr/bin:/bin"
+        return env
+
+    def contenders(self) -> list:
+        names = ["minros"] + (["rospy"] if self.reference else []) + \
+                (["roscpp"] if self.roscpp else []) + ["raw"]
+        if self.args.only:
+            names = [n for n in names if n in self.args.only.split(",")]
+        return names
+
+    def command(self, who: str, role: str, extra: list) -> tuple:
+        if who == "roscpp":
+            return [self.roscpp, *extra], self.env(True)
+        python = REFERENCE_PYTHON if who == "rospy" else VENV_PYTHON
+        return [python, os.path.abspath(__file__), "--role", role, *extra], self.env(who == "rospy")
+
+    def pair(self, who: str, first: tuple, second: tuple, timeout: float = 90,
+             first_measures: bool = False) -> dict:
+        """Start ``first`` (waits for its ready line), run ``second``; the result is the JSON
+        printed by ``second``, plus ``first``'s last line when ``first_measures``."""
+        p1 = subprocess.Popen(first[0], env=first[1], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                              text=True)
+        try:
+            line = p1.stdout.readline()
+            if "ready" not in line:
+                raise RuntimeError(f"{who}: first process failed to start: {line!r}")
+            p2 = subprocess.Popen(second[0], env=second[1], stdout=subprocess.PIPE,
+                                  stderr=subprocess.DEVNULL, text=True)
+            try:
+                out2, _ = p2.communicate(timeout=timeout)
+                out1 = p1.stdout.readline() if first_measures else ""
+            finally:
+                if p2.poll() is None:
+                    p2.kill()
+            results = {}
+            for text in (out2, out1):
+                for raw in text.splitlines():
+                    if raw.startswith("{"):
+                        results.update(json.loads(raw))
+            return results
+        finally:
+            try:
+                p1.terminate()
+                p1.wait(5)
+            except subprocess.TimeoutExpired:
+                p1.kill()
+
+    def latency(self, who: str, queue: str):
+        if who == "raw":
+            if queue == "none":
+                return None
+            port = _free_port()
+            r = self.pair(who, self.command(who, "raw-echo", ["--port", str(port)]),
+                          self.command(who, "raw-ping", ["--port", str(port), "--count", str(self.args.count)]))
+        elif who == "roscpp":
+            if queue == "none":
+                return None
+            r = self.pair(who, self.command(who, "", ["echo", "small", "10", "0", "0"]),
+                          self.command(who, "", ["ping", "small", "10", "0", str(self.args.count)]))
+        else:
+            r = self.pair(who, self.command(who, "echo", ["--queue", queue]),
+                          self.command(who, "ping", ["--queue", queue, "--count", str(self.args.count)]))
+        return r.get("median_us")
+
+    def flood(self, who: str, kind: str):
+        seconds = str(self.args.seconds)
+        if who == "raw":
+            port = _free_port()
+            r = self.pair(who, self.command(who, "raw-flood-sub", ["--port", str(port)]),
+                          self.command(who, "raw-flood-pub", ["--port", str(port), "--kind", kind,
+                                                              "--seconds", seconds]),
+                          first_measures=True)
+        elif who == "roscpp":
+            r = self.pair(who, self.command(who, "", ["flood-sub", kind, "10", seconds, "0"]),
+                          self.command(who, "", ["flood-pub", kind, "10", seconds, "0"]),
+                          first_measures=True)
+        else:
+            r = self.pair(who, self.command(who, "flood-sub", ["--kind", kind]),
+                          self.command(who, "flood-pub", ["--kind", kind, "--queue", "10",
+                                                          "--seconds", seconds]),
+                          first_measures=True)
+        return r.get("rate")
+
+    def idle_memory(self, who: str):
+        if who in ("raw", "roscpp"):
+            return None
+        code = ("import rospy, time\nrospy.init_node('bench_idle', anonymous=True)\ntime.sleep(1.0)\n"
+                "print([l.split()[1] for l in open('/proc/self/status') if l.startswith('VmRSS')][0])\n")
+        python = REFERENCE_PYTHON if who == "rospy" else VENV_PYTHON
+        out = subprocess.run([python, "-c", code], env=self.env(who == "rospy"), capture_output=True,
+                             text=True, timeout=60).stdout.split()
+        return float(out[-1]) / 1024 if out else None
+
+    def close(self) -> None:
+        self.master.terminate()
+        try:
+            self.master.wait(5)
+        except subprocess.TimeoutExpired:
+            self.master.kill()
+        shutil.rmtree(self.home, ignore_errors=True)
+
+
+SCENARIOS = [
+    ("round trip, queue_size=10 (µs)", "lat10", lambda r, w: r.latency(w, "10"), "low"),
+    ("round trip, queue_size=None (µs)", "latnone", lambda r, w: r.latency(w, "none"), "low"),
+    ("small-message flood (msg/s received)", "flood", lambda r, w: r.flood(w, "small"), "high"),
+    ("640x480 bgr8 images (frames/s)", "vga", lambda r, w: r.flood(w, "vga"), "high"),
+    ("1920x1080 bgr8 images (frames/s)", "hd", lambda r, w: r.flood(w, "hd"), "high"),
+    ("idle node memory (MB RSS)", "mem", lambda r, w: r.idle_memory(w), "low"),
+]
+
+
+def _fmt(value) -> str:
+    if value is None:
+        return "—"
+    return f"{value:,.0f}" if value >= 100 else f"{value:.1f}"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--role", choices=sorted(ROLES), help=argparse.SUPPRESS)
+    parser.add_argument("--queue", default="10", help=argparse.SUPPRESS)
+    parser.add_argument("--kind", default="small", help=argparse.SUPPRESS)
+    parser.add_argument("--port", type=int, default=0, help=argparse.SUPPRESS)
+    parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (median shown)")
+    parser.add_argument("--seconds", type=float, default=2.0, help="duration of each flood")
+    parser.add_argument("--count", type=int, default=2000, help="round trips per latency run")
+    parser.add_argument("--only", default="", help="comma-separated contenders")
+    parser.add_argument("--scenarios", default="", help="comma-separated: " +
+                        ",".join(s[1] for s in SCENARIOS))
+    args = parser.parse_args(argv)
+    if args.role:
+        ROLES[args.role](args)
+        return 0
+
+    runner = Runner(args)
+    try:
+        contenders = runner.contenders()
+        scenarios = [s for s in SCENARIOS if not args.scenarios or s[1] in args.scenarios.split(",")]
+        results = {(s[1], c): [] for s in scenarios for c in contenders}
+        for rnd in range(args.rounds):
+            for _title, key, fn, _better in scenarios:
+                for who in contenders:  # interleaved: every contender once per round
+                    try:
+                        value = fn(runner, who)
+                    except Exception as exc:  # one failed run must not lose the table
+                        print(f"  {who} {key}: failed: {exc}", file=sys.stderr)
+                        value = None
+                    if value is not None:
+                        results[(key, who)].append(value)
+                    print(f"round {rnd + 1} {key:8} {who:7} {_fmt(value)}", file=sys.stderr, flush=True)
+        header = ["scenario", *contenders]
+        if "rospy" in contenders:
+            header.append("minros/rospy")
+        if "raw" in contenders:
+            header.append("minros/raw")
+        rows = []
+        for title, key, _fn, _better in scenarios:
+            med = {c: statistics.median(results[(key, c)]) if results[(key, c)] else None
+                   for c in contenders}
+            row = [title] + [_fmt(med[c]) for c in contenders]
+            for other in ("rospy", "raw"):
+                if other in contenders:
+                    ok = med.get("minros") and med.get(other)
+                    row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
+            rows.append(row)
+        widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
+        print(f"pubsub benchmark: {args.rounds} interleaved rounds, median; master: "
+              f"{'Debian rosmaster' if runner.reference else 'minros'}; {os.cpu_count()} CPUs")
+        print("| " + " | ".join(h.ljust(w) for h, w in zip(header, widths)) + " |")
+        print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+        for row in rows:
+            print("| " + " | ".join(str(c).ljust(w) for c, w in zip(row, widths)) + " |")
+    finally:
+        runner.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
