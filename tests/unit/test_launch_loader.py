@@ -259,3 +259,21 @@ def test_anon_names_shared_across_tags():
       <param name="who" value="$(anon talker)"/>
     </launch>""")
     assert cfg.params["/who"] == cfg.nodes[0].name and cfg.nodes[0].name.startswith("talker_")
+
+
+def test_absurd_nesting_is_an_error_not_a_crash(tmp_path: Path):
+    deep = "<launch>" + "<group>" * 3000 + "</group>" * 3000 + "</launch>"
+    with pytest.raises(LaunchError, match="nest too deeply"):
+        load(deep)
+    chain = 400  # distinct files, each including the next
+    for i in range(chain):
+        body = f'<include file="$(dirname)/f{i + 1}.launch"/>' if i + 1 < chain else ""
+        write(tmp_path, f"f{i}.launch", f"<launch>{body}</launch>")
+    with pytest.raises(LaunchError, match="nest too deeply"):
+        load_launch(str(tmp_path / "f0.launch"))
+
+
+def test_entity_declarations_are_refused():
+    bomb = '<?xml version="1.0"?><!DOCTYPE l [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;">]><launch/>'
+    with pytest.raises(LaunchError, match="entity declarations are not allowed"):
+        load(bomb)

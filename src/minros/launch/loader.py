@@ -31,6 +31,8 @@ from minros.launch.substitution import (
 
 #: Upper bound for a launch or included file (they are hand-written configuration).
 MAX_FILE_BYTES = 16 * 1024 * 1024
+#: Deepest nesting of groups and includes accepted (real files use a handful).
+MAX_NESTING = 100
 #: ``<param command=...>`` must finish within this many seconds.
 COMMAND_TIMEOUT = 60.0
 
@@ -282,6 +284,7 @@ class Loader:
         self.anon: Dict[str, str] = {}
         self._stack: List[str] = []  # real paths of the files being loaded (cyclic includes)
         self._stack_names: List[str] = []  # the same files as the user named them
+        self._depth = 0
 
     # -- entry points
     def load(self, filename: str, argv: Sequence[str] = ()) -> LaunchConfig:
@@ -305,6 +308,8 @@ class Loader:
             self._recurse(root.children, scope)
         except ArgError as exc:
             raise LaunchError(f"requires the '{exc.name}' arg to be set", filename) from None
+        except RecursionError:  # hundreds of nested groups/includes: refuse, do not crash
+            raise LaunchError("groups and includes nest too deeply", filename) from None
         finally:
             self._stack.pop()
             self._stack_names.pop()
@@ -362,6 +367,15 @@ class Loader:
             "machine": self._machine_tag, "rosparam": self._rosparam_tag,
             "include": self._include_tag, "env": self._env_tag, "master": lambda el, sc: None,
         }
+        self._depth += 1
+        try:
+            self._recurse_elements(elements, scope, handlers)
+        finally:
+            self._depth -= 1
+
+    def _recurse_elements(self, elements: List[Element], scope: Scope, handlers: Dict[str, Any]) -> None:
+        if self._depth > MAX_NESTING and elements:
+            raise self._err(scope, elements[0], f"groups and includes nest too deeply (more than {MAX_NESTING} levels)")
         for el in elements:
             handler = handlers.get(el.tag)
             if self.args_only and el.tag != "arg":
