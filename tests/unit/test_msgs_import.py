@@ -111,3 +111,26 @@ def test_missing_embedded_type_names_the_user(tmp_path: Path, monkeypatch) -> No
         get_message_class("typo_pkg/Typo")
     text = str(info.value)
     assert "typo_pkg/Pionts" in text and "needed by typo_pkg/Typo" in text and "Typo.msg" in text
+
+
+def test_action_files_generate_messages_like_genaction(tmp_path: Path, monkeypatch) -> None:
+    from minros.msgs import get_message_class
+    from minros.msgs.registry import list_types
+    from minros.packages import BUILTIN_SHARE_DIRS
+
+    # the bundled nav_msgs ships Debian's generated files: our generator must agree byte for byte
+    pkg = _make_package(tmp_path / "src", "act_pkg")
+    (pkg / "action").mkdir()
+    share = BUILTIN_SHARE_DIRS[0]
+    for source, name in (("nav_msgs", "GetMap"), ("tf2_msgs", "LookupTransform")):
+        (pkg / "action" / f"{name}.action").write_bytes(
+            (share / source / "action" / f"{name}.action").read_bytes())
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "src"))
+    for source, name in (("nav_msgs", "GetMap"), ("tf2_msgs", "LookupTransform")):
+        for suffix in ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result",
+                       "Feedback"):
+            ours = get_message_class(f"act_pkg/{name}{suffix}")
+            debian = get_message_class(f"{source}/{name}{suffix}")
+            assert ours._md5sum == debian._md5sum
+            assert ours._full_text.replace("act_pkg/", f"{source}/") == debian._full_text
+    assert "act_pkg/GetMapActionGoal" in list_types("act_pkg")

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import importlib.abc
 import importlib.machinery
-import os
 import sys
 import threading
 from pathlib import Path
@@ -43,11 +42,9 @@ def type_names(package: str, kind: str) -> List[str]:
     package_dir = _package_dir(package)
     if package_dir is None:
         return []
-    folder = package_dir / kind
-    try:
-        stems = sorted(p[:-len(kind) - 1] for p in os.listdir(folder) if p.endswith("." + kind))
-    except OSError:
-        return []
+    from .registry import type_names_in
+
+    stems = type_names_in(package_dir, kind)
     if kind == "srv":
         return [name for stem in stems for name in (stem, stem + "Request", stem + "Response")]
     return stems

@@ -10,6 +10,7 @@ minros ships); :func:`generate_dynamic` uses a private context filled from a
 from __future__ import annotations
 
 import linecache
+import os
 import threading
 from pathlib import Path
 from typing import Any, Dict, List, Tuple
@@ -18,11 +19,13 @@ from . import runtime
 from .codegen import generate_source, numpy_class_name
 from .message import Message
 from .spec import (
+    ACTION_SUFFIXES,
     HEADER,
     HEADER_FULL_NAME,
     MsgSpec,
     MsgSpecError,
     SrvSpec,
+    action_message_texts,
     compute_full_text,
     compute_md5_text,
     md5_hex,
@@ -125,6 +128,12 @@ class MsgContext:
             try:
                 path = self._find_file(type_name, "msg")
             except UnknownTypeError:
+                generated = self._from_action(type_name)
+                if generated is not None:
+                    text, origin = generated
+                    spec = parse_msg(text, type_name, origin)
+                    self._specs[type_name] = spec
+                    return spec
                 for suffix in ("Request", "Response"):
                     if type_name.endswith(suffix) and len(type_name) > len(suffix):
                         try:
@@ -137,6 +146,25 @@ class MsgContext:
             spec = parse_msg(text, type_name, str(path))
             self._specs[type_name] = spec
             return spec
+
+    def _from_action(self, type_name: str) -> Tuple[str, str] | None:
+        """(text, origin) of a message generated from an ``.action`` file, as catkin does."""
+        if not self._search:
+            return None
+        from minros.packages import find_package
+
+        package, _, short = type_name.partition("/")
+        package_dir = find_package(package) if package else None
+        if package_dir is None:
+            return None
+        for suffix in ACTION_SUFFIXES:
+            if short.endswith(suffix) and len(short) > len(suffix):
+                base = short[:-len(suffix)]
+                path = package_dir / "action" / f"{base}.action"
+                if path.is_file():
+                    texts = action_message_texts(_read_text(path), base)
+                    return texts[short], f"{path} ({short} generated from it)"
+        return None
 
     def get_srv_spec(self, type_name: str) -> SrvSpec:
         """The spec of service type ``type_name``."""
@@ -383,15 +411,29 @@ def packages_with(kind: str) -> Dict[str, Path]:
 
 
 def list_types(package: str, kind: str = "msg") -> List[str]:
-    """``pkg/Type`` names of the ``.msg`` (or ``.srv``) files of ``package``, sorted."""
+    """``pkg/Type`` names of the message (or service) types of ``package``, sorted."""
     from minros.packages import find_package
 
     package_dir = find_package(package)
     if package_dir is None:
         raise UnknownTypeError(package, f"package [{package}] not found")
-    folder = package_dir / kind
-    if not folder.is_dir():
-        return []
+    return [f"{package}/{name}" for name in type_names_in(package_dir, kind)]
+
+
+def type_names_in(package_dir: Path, kind: str = "msg") -> List[str]:
+    """Short names of the ``.msg`` (or ``.srv``) types of a package folder, sorted; for
+    messages this includes the ones generated from ``action/*.action`` files."""
+    names = set()
     suffix = "." + kind
-    return [f"{package}/{p.name[:-len(suffix)]}" for p in sorted(folder.iterdir())
-            if p.name.endswith(suffix) and p.is_file()]
+    try:
+        names.update(p[:-len(suffix)] for p in os.listdir(package_dir / kind) if p.endswith(suffix))
+    except OSError:
+        pass
+    if kind == "msg":
+        try:
+            actions = [p[:-7] for p in os.listdir(package_dir / "action") if p.endswith(".action")]
+        except OSError:
+            actions = []
+        for base in actions:
+            names.update(base + s for s in ACTION_SUFFIXES)
+    return sorted(names)
