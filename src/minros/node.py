@@ -660,6 +660,18 @@ def _valid_topic(param: str, value: Any, caller_id: str) -> str:
     return names.resolve_name(value, caller_id)
 
 
+_INT32_MAX = (1 << 31) - 1
+
+
+def _xmlrpc_ints(value: Any) -> Any:
+    """Byte counters of a long-lived connection outgrow XML-RPC's 32-bit int: saturate them."""
+    if isinstance(value, list):
+        return [_xmlrpc_ints(v) for v in value]
+    if isinstance(value, int) and not isinstance(value, bool) and value > _INT32_MAX:
+        return _INT32_MAX
+    return value
+
+
 class SlaveApi:
     """The node's XML-RPC API (methods are called by the master, tools and other nodes)."""
 
@@ -679,7 +691,7 @@ class SlaveApi:
         with _registry_lock:
             pubs = [impl.get_stats() for impl in _publications.values()]
             subs = [impl.get_stats() for impl in _subscriptions.values()]
-        return 1, "", [pubs, subs, []]
+        return 1, "", _xmlrpc_ints([pubs, subs, []])
 
     @_slave_api([], 0)
     def getBusInfo(self, caller_id):

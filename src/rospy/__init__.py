@@ -8,7 +8,19 @@ import minros
 from minros import __all__ as __all__  # noqa: PLC0414 - rospy's public names are minros's
 
 # the submodules scripts reach through the package (rospy.timer.TimerEvent, rospy.exceptions...)
-from rospy import client, core, exceptions, impl, msg, names, rostime, service, timer, topics  # noqa: F401
+from rospy import (  # noqa: F401
+    client,
+    core,
+    exceptions,
+    impl,
+    msg,
+    msproxy,
+    names,
+    rostime,
+    service,
+    timer,
+    topics,
+)
 
 # Bind every public name now (as rospy's own __init__ does), except the message classes,
 # which are imported on first use like in the minros facade.

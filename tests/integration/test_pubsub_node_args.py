@@ -99,3 +99,28 @@ def test_signals_shut_down_cleanly(tmp_path, minros_master, ros_home, signal_nam
     assert "hook ran" in out and "spin returned" in out and "Traceback" not in out
     master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{minros_master}/")
     assert master.lookupNode("/t", "/spinner")[0] == -1
+
+
+def test_node_started_before_the_master_registers_when_it_comes(tmp_path, ros_home):
+    from support import free_port, wait_for_master, wait_until
+
+    port = free_port()
+    script = tmp_path / "early.py"
+    script.write_text("import rospy\nfrom std_msgs.msg import String\n"
+                      "p = rospy.Publisher('/early', String, queue_size=1)\n"
+                      "rospy.init_node('early')\nprint('registered', flush=True)\nrospy.spin()\n")
+    node = Proc([PYTHON, str(script)], ros_env(port, ros_home))
+    master = None
+    try:
+        out = node.read_until("Unable to immediately register with master", 20)
+        assert "registered" not in out
+        master = Proc([PYTHON, "-m", "minros.master", "-p", str(port)], ros_env(port, ros_home))
+        wait_for_master(port)
+        node.read_until("registered", 10)
+        proxy = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{port}/")
+        wait_until(lambda: ["/early", ["/early"]] in proxy.getSystemState("/t")[2][0], 5,
+                   what="/early registered")
+    finally:
+        node.stop()
+        if master is not None:
+            master.stop()

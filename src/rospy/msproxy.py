@@ -1,0 +1,3 @@
+"""rospy.msproxy: MasterProxy (minros.node)."""
+
+from minros.node import MasterProxy  # noqa: F401
