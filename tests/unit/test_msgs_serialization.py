@@ -362,3 +362,23 @@ def test_deserialize_fills_embedded_messages_in_place() -> None:
     target.pose.position = "not a point"  # a foreign value is replaced, not written into
     target.deserialize(src.serialize_to_bytes())
     assert target.pose.position.x == 3.0
+
+
+def test_python_keyword_fields_get_an_underscore() -> None:
+    ctx = MsgContext(search=False)
+    ctx.add_spec(parse_msg("int32 from\nstring class\nint32 end\nint32 view", "pkg/Kw"))
+    Kw = ctx.get_class("pkg/Kw")
+    assert Kw.__slots__ == ["from_", "class_", "end", "view"]
+    msg = Kw(from_=1, class_="c", end=2, view=3)
+    assert Kw().deserialize(msg.serialize_to_bytes()) == msg
+
+
+def test_generated_source_is_the_compiled_code() -> None:
+    from minros.msgs import REGISTRY
+
+    source = REGISTRY.source("sensor_msgs/Image")
+    compile(source, "<test>", "exec")
+    assert "class Image(_Message):" in source and "_S_B2I = _Struct('<B2I')" in source
+    namespace: dict = {"_load": REGISTRY.get_class}
+    exec(compile(source, "<test>", "exec"), namespace)
+    assert namespace["Image"]._full_text == get_message_class("sensor_msgs/Image")._full_text

@@ -466,8 +466,8 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
         out.append(f"    _type = {spec.full_name!r}")
         out.append(f"    _md5sum = {md5sum!r}")
         out.append(f"    _has_header = {spec.has_header!r}")
-        out.append(f"    _zero_copy = {de.views!r}  # deserialize() keeps large input as a memoryview")
-        out.append(f"    _full_text = {full_text!r}")
+        out.append(f"    _zero_copy = {de.views!r}  # True: deserialize() reads big input in place (memoryview)")
+        out.append(f"    _full_text = {_text_literal(full_text, 8)}")
         out.append(f"    _slot_types = {spec.types!r}")
         if module:
             out.append(f"    __module__ = {module!r}")
@@ -499,6 +499,15 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
     out.append("        return end")
     out.append("")
     return "\n".join(out)
+
+
+def _text_literal(text: str, indent: int) -> str:
+    """A readable literal for a multi-line text: one quoted line per source line."""
+    lines = text.splitlines(keepends=True)
+    if len(lines) <= 1:
+        return repr(text)
+    pad = " " * indent
+    return "(\n" + "".join(f"{pad}{line!r}\n" for line in lines) + " " * (indent - 4) + ")"
 
 
 def _collect_deps(type_name: str, get_spec: GetSpec, out: List[str]) -> None:
