@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 import os
 import pty
+import shutil
+import subprocess
 import termios
 import time
 from pathlib import Path
@@ -15,7 +17,7 @@ import cv2
 import numpy as np
 import pytest
 
-from support import PYTHON, Proc, ros_env
+from support import PYTHON, Proc, ros_env, wait_until
 
 PROBE = str(Path(__file__).resolve().parent / "turtlesim_probe.py")
 CENTER = "5.544445"
@@ -142,8 +144,6 @@ def test_teleop_key_through_a_pty(turtlesim):
 
 
 def test_teleop_without_a_terminal_says_so_once(minros_core, ros_home):
-    import subprocess
-
     proc = subprocess.run([PYTHON, "-m", "minros", "run", "turtlesim", "turtle_teleop_key"],
                           input=b"xyq", env=ros_env(minros_core, ros_home), capture_output=True,
                           timeout=20)
@@ -186,3 +186,48 @@ def test_draw_square_resets_and_reaches_its_first_goal(turtlesim):
     assert "Traceback" not in out
     log = proc.stop()
     assert "Resetting turtlesim." in log
+
+
+def _read_xwd(path: Path) -> np.ndarray:
+    """The 24/32-bit ZPixmap screen dump Xvfb keeps in its -fbdir, as an (h, w, 3) BGR array."""
+    import struct
+
+    data = path.read_bytes()
+    fields = struct.unpack(">25I", data[:100])
+    header_size, width, height, bytes_per_line, ncolors = (
+        fields[0], fields[4], fields[5], fields[12], fields[19])
+    start = header_size + ncolors * 12
+    rows = np.frombuffer(data[start:start + bytes_per_line * height], np.uint8)
+    return rows.reshape(height, bytes_per_line)[:, :width * 4].reshape(height, width, 4)[:, :, :3]
+
+
+@pytest.mark.skipif(not shutil.which("Xvfb"), reason="Xvfb not installed (the window is optional)")
+def test_window_on_a_virtual_display(minros_core, ros_home, tmp_path):
+    read_fd, write_fd = os.pipe()
+    xvfb = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "640x560x24",
+                             "-fbdir", str(tmp_path), "-nolisten", "tcp"],
+                            pass_fds=[write_fd], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(write_fd)
+    try:
+        with os.fdopen(read_fd) as numbers:
+            display = numbers.readline().strip()
+        assert display.isdigit(), "Xvfb did not report its display"
+        env = ros_env(minros_core, ros_home, {"DISPLAY": f":{display}"})
+        sim = Proc([PYTHON, "-m", "minros.turtlesim.turtlesim_node"], env)
+        try:
+            sim.read_until("Spawning turtle [turtle1]", timeout=15)
+
+            def background_shown():
+                screen = _read_xwd(tmp_path / "Xvfb_screen0")
+                return np.all(screen == (255, 86, 69), axis=2).sum() > 200_000  # BGR
+
+            wait_until(background_shown, timeout=10, what="turtlesim window on the screen")
+            screen = _read_xwd(tmp_path / "Xvfb_screen0")
+            green = (screen[:, :, 1] > screen[:, :, 0]) & (screen[:, :, 1] > screen[:, :, 2])
+            assert green.sum() > 100  # the turtle icon
+        finally:
+            out = sim.stop()
+        assert "without a window" not in out and "Traceback" not in out
+    finally:
+        xvfb.terminate()
+        xvfb.wait(5)
