@@ -340,8 +340,8 @@ def _cmd_kill(argv: List[str], prog: str) -> int:
         known = get_node_names(graph.master)
         unknown = [n for n in targets if n not in known]
         if unknown:
-            # rosnode prints this over several lines; the first names the problem
-            raise ToolError("Unknown node(s):\n" + "\n".join(f" * {n}" for n in unknown))
+            # rosnode lists them on further lines; one line is enough to name the problem
+            raise ToolError("Unknown node(s): " + ", ".join(unknown))
     if not targets:
         print("No nodes running", file=sys.stderr)
         return 0
