@@ -816,6 +816,16 @@ def read_inbound_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_
     return tcpros.decode_header(_recv_exact(sock, size))
 
 
+def _user_warn(text: str) -> None:
+    """A WARN line on the node's console and /rosout, as rospy's logwarn."""
+    try:
+        from minros import log
+
+        log.logwarn(text)
+    except Exception:
+        _logger.warning(text)
+
+
 def _is_refused(exc: BaseException) -> bool:
     return isinstance(exc, ConnectionRefusedError) or getattr(exc, "errno", None) == errno.ECONNREFUSED
 
@@ -901,7 +911,8 @@ class Node:
             header = read_inbound_header(sock)
             sock.settimeout(None)
         except (OSError, tcpros.HeaderError) as exc:
-            _logger.warning("inbound TCPROS connection from %s:%s dropped: %s", addr[0], addr[1], exc)
+            if not is_shutdown_requested():
+                _user_warn(f"Inbound TCP/IP connection failed: {exc}")
             _close(sock)
             return
         try:
@@ -928,8 +939,10 @@ class Node:
             error = f"internal error: {exc}"
             _logger.error("inbound connection failed: %s", traceback.format_exc())
         if error is not None:
-            _logger.warning("rejected TCPROS connection from [%s]: %s",
-                            header.get("callerid", f"{addr[0]}:{addr[1]}"), error)
+            if is_shutdown_requested():
+                error = "node shutting down"
+            else:  # rospy's wording, header dict included
+                _user_warn(f"Could not process inbound connection: {error}{header}")
             try:
                 sock.sendall(tcpros.encode_error_header(error))
             except OSError:

@@ -605,6 +605,7 @@ class _SubConnection:
         self.remote: Tuple[Any, ...] = ("", 0)
         self.fileno = -1
         self.gen = 0
+        self.reported: set = set()
         self.reader: tcpros.FrameReader | None = None
         self.pending: list = []
         self.thread = threading.Thread(target=self._run, daemon=True,
@@ -643,9 +644,17 @@ class _SubConnection:
                             interval = 0.5
                             self._receive_loop()
                     except (OSError, tcpros.HeaderError, tcpros.FrameError, _Rejected) as exc:
-                        if not self.done and not _node_mod.is_shutdown_requested():
+                        text = str(exc)
+                        if isinstance(exc, (ConnectionResetError, ConnectionAbortedError,
+                                            BrokenPipeError)):
+                            # the publisher went away (killed): not worth a console line
+                            _logger.debug("publisher %s went away: %s", self.pub_uri, text)
+                        elif (not self.done and not _node_mod.is_shutdown_requested()
+                                and text not in self.reported):
+                            # one line per distinct failure, not one per retry
+                            self.reported.add(text)
                             _log_warn(f"[{self.impl.resolved_name}] connection to publisher "
-                                      f"[{self.pub_uri}] failed: {exc}")
+                                      f"[{self.pub_uri}] failed: {text}")
                     finally:
                         self.connected = False
                         if self.sock is not None:

@@ -225,6 +225,11 @@ def test_publisher_rejects_bad_handshakes_and_stays_healthy(latched_talker, scri
     assert proc.alive()
     log = proc.stop()
     assert "Traceback" not in log
+    # one WARN line per rejected or broken connection, in rospy's words
+    warnings = [x for x in log.splitlines() if x.startswith("[WARN]")]
+    assert len([x for x in warnings if "Could not process inbound connection: " in x]) == 4
+    assert len([x for x in warnings if "Inbound TCP/IP connection failed: " in x]) == 3, log
+    assert any("Missing required 'md5sum' field{" in x for x in warnings)
 
 
 def test_wildcard_subscriber_gets_definition(latched_talker):

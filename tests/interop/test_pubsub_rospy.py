@@ -91,3 +91,47 @@ def test_1080p_images(scripts, debian_rosmaster, ros_home, pub_impl, sub_impl):
         for i in range(4)
     ]
     assert got == expected
+
+
+MISMATCH_SUB = r'''
+import rospy
+from std_msgs.msg import Int32
+rospy.init_node("typed_sub", anonymous=True)
+rospy.Subscriber("/typed", Int32, lambda m: print("UNEXPECTED", m, flush=True))
+print("subscribed", flush=True)
+rospy.spin()
+'''
+
+MISMATCH_PUB = r'''
+import rospy
+from std_msgs.msg import String
+rospy.init_node("typed_pub", anonymous=True)
+pub = rospy.Publisher("/typed", String, queue_size=1)
+print("publishing", flush=True)
+while not rospy.is_shutdown():
+    pub.publish("text")
+    rospy.sleep(0.05)
+'''
+
+
+@pytest.mark.parametrize("pub_impl, sub_impl", PAIRS)
+def test_type_mismatch_reported_on_both_sides(tmp_path, debian_rosmaster, ros_home, pub_impl, sub_impl):
+    require_reference()
+    pub_script = tmp_path / "pub.py"
+    sub_script = tmp_path / "sub.py"
+    pub_script.write_text(MISMATCH_PUB)
+    sub_script.write_text(MISMATCH_SUB)
+    sub = _run(sub_impl, sub_script, [], debian_rosmaster, ros_home)
+    pub = _run(pub_impl, pub_script, [], debian_rosmaster, ros_home)
+    try:
+        sub.read_until("subscribed", 20)
+        pub.read_until("publishing", 20)
+        expected = "topic types do not match: [std_msgs/Int32] vs. [std_msgs/String]"
+        # the publisher refuses the connection and says why in its log...
+        pub.read_until(f"Could not process inbound connection: {expected}", 15)
+        if sub_impl == "minros":  # ...and the subscriber shows the error the publisher sent
+            sub.read_until(f"remote error reported: {expected}", 15)
+    finally:
+        sub_out = sub.stop()
+        pub.stop()
+    assert "UNEXPECTED" not in sub_out
