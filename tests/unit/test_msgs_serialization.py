@@ -275,7 +275,13 @@ def test_bytes_and_lists_accepted_for_uint8_arrays() -> None:
     b = UInt8MultiArray(data=b"\x01\x02\x03").serialize_to_bytes()
     c = UInt8MultiArray(data=bytearray(b"\x01\x02\x03")).serialize_to_bytes()
     d = UInt8MultiArray(data=np.array([1, 2, 3], dtype=np.uint8)).serialize_to_bytes()
-    assert a == b == c == d
+    e = UInt8MultiArray(data=np.array([1, 2, 3])).serialize_to_bytes()  # int64 values, converted
+    f = UInt8MultiArray(data=np.arange(1, 7, dtype=np.uint8)[::2]).serialize_to_bytes()  # strided
+    g = UInt8MultiArray(data=(1, 2, 3)).serialize_to_bytes()
+    assert a == b == c == d == e == g
+    assert f.endswith(b"\x03\x00\x00\x00\x01\x03\x05")
+    with pytest.raises(SerializationError, match="field data"):
+        UInt8MultiArray(data=np.array([1, 256])).serialize_to_bytes()
 
 
 def test_large_payload_written_without_join() -> None:

@@ -93,8 +93,25 @@ def as_bytes(value: Any) -> Any:
         return bytes(value)
     if cls is str:  # genpy (py2 heritage) accepts a str of latin-1 characters
         return value.encode("latin-1")
+    if hasattr(value, "__array_interface__"):
+        return _numpy_uint8(value)
     view = memoryview(value)
     return view if view.format == "B" and view.ndim == 1 else view.cast("B")
+
+
+def _numpy_uint8(value: Any) -> memoryview:
+    """A numpy array for a ``uint8[]`` field: 1-byte items as they are, wider ones converted
+    (values must fit 0..255), always C-contiguous."""
+    import numpy
+
+    array = numpy.asarray(value)
+    if array.dtype.itemsize != 1 or array.dtype.kind not in "iub":
+        if array.dtype.kind not in "iu":
+            raise TypeError(f"a uint8[] field cannot hold a numpy array of {array.dtype}")
+        if array.size and (array.min() < 0 or array.max() > 255):
+            raise ValueError("a uint8[] field holds values outside 0..255")
+        array = array.astype(numpy.uint8)
+    return memoryview(numpy.ascontiguousarray(array).reshape(-1)).cast("B")
 
 
 def put_bytes(append: Callable[[Any], None], value: Any) -> None:
