@@ -223,8 +223,11 @@ def test_window_on_a_virtual_display(minros_core, ros_home, tmp_path):
 
             wait_until(background_shown, timeout=10, what="turtlesim window on the screen")
             screen = _read_xwd(tmp_path / "Xvfb_screen0")
-            green = (screen[:, :, 1] > screen[:, :, 0]) & (screen[:, :, 1] > screen[:, :, 2])
-            assert green.sum() > 100  # the turtle icon
+            ys, xs = np.all(screen == (255, 86, 69), axis=2).nonzero()
+            top, left = ys.min(), xs.min()  # the canvas inside the window
+            assert (ys.max() - top, xs.max() - left) == (499, 499)
+            icon = screen[top + 230:top + 270, left + 230:left + 270]
+            assert np.any(icon != (255, 86, 69), axis=2).sum() > 300  # turtle1 at the centre
         finally:
             out = sim.stop()
         assert "without a window" not in out and "Traceback" not in out

@@ -109,7 +109,10 @@ def main(argv: List[str] | None = None) -> int:
         latest[0] = None  # poses from before the reset are stale
     driver = SquareDriver(log=rospy.loginfo)
 
-    def on_timer(_event: Any) -> None:
+    # createWallTimer(0.016): wall time, so it also runs when /use_sim_time has no /clock.
+    from minros import node as _node
+
+    while not rospy.is_shutdown():
         with lock:
             pose = latest[0]
         command = driver.step(pose)
@@ -117,9 +120,7 @@ def main(argv: List[str] | None = None) -> int:
             twist = Twist()
             twist.linear.x, twist.angular.z = command
             pub.publish(twist)
-
-    rospy.Timer(rospy.Duration(0.016), on_timer)
-    rospy.spin()
+        _node.wait_for_shutdown(0.016)
     return 0
 
 

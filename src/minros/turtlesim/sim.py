@@ -13,6 +13,7 @@ The ROS node (:mod:`minros.turtlesim.turtlesim_node`) is a thin layer around
 from __future__ import annotations
 
 import math
+import random
 import re
 import time
 from dataclasses import dataclass, field
@@ -101,6 +102,8 @@ class Turtle:
     pen_color: Tuple[int, int, int] = DEFAULT_PEN_COLOR
     pen_width: int = DEFAULT_PEN_WIDTH
     teleports: List[_Teleport] = field(default_factory=list)
+    #: Which look the turtle gets in the window (turtlesim picks a random turtle image).
+    icon: int = 0
 
     # -- what the ROS callbacks do (they only record; the tick applies) ----------------------
 
@@ -242,6 +245,7 @@ class TurtleFrame:
         self.id_counter = 0
         self.frame_count = 0
         self._started = False
+        self._icons = random.Random()
         if spawn_first:
             self.spawn("", CENTER, CENTER, 0.0)
 
@@ -260,7 +264,8 @@ class TurtleFrame:
     def add_turtle(self, name: str, x: float, y: float, theta: float) -> Turtle:
         """Insert a turtle whose name was chosen by :meth:`next_name`, and log it."""
         x, y, theta = _f32(x), _f32(y), _f32(theta)  # spawnTurtle takes C++ floats
-        turtle = Turtle(name, x, _f32(self.height_m - y), theta, last_command_time=self.clock())
+        turtle = Turtle(name, x, _f32(self.height_m - y), theta, last_command_time=self.clock(),
+                        icon=self._icons.randrange(len(ICON_COLORS)))
         self.turtles[name] = turtle
         self.info(f"Spawning turtle [{name}] at x=[{x:f}], y=[{y:f}], theta=[{theta:f}]")
         return turtle
@@ -319,7 +324,7 @@ class TurtleFrame:
         frame = self.path.pixels.copy()
         for name in sorted(self.turtles):
             t = self.turtles[name]
-            draw_turtle_icon(frame, t.x * METER, t.y_qt * METER, t.orient)
+            draw_turtle_icon(frame, t.x * METER, t.y_qt * METER, t.orient, ICON_COLORS[t.icon])
         return frame
 
 
@@ -338,7 +343,18 @@ _LEGS = [np.array([[dx - 3, dy - 3], [dx + 3, dy - 3], [dx + 3, dy + 3], [dx - 3
          for dx, dy in ((7, 11), (7, -11), (-7, 11), (-7, -11))]
 
 
-def draw_turtle_icon(frame: np.ndarray, cx: float, cy: float, orient: float) -> None:
+#: (shell, skin, shell pattern) RGB per icon.
+ICON_COLORS = [
+    ((34, 110, 34), (96, 160, 64), (150, 200, 90)),
+    ((120, 80, 40), (200, 170, 110), (230, 200, 140)),
+    ((40, 90, 120), (110, 170, 150), (160, 210, 220)),
+    ((140, 40, 60), (210, 150, 110), (240, 170, 170)),
+    ((90, 90, 30), (170, 170, 80), (220, 220, 120)),
+]
+
+
+def draw_turtle_icon(frame: np.ndarray, cx: float, cy: float, orient: float,
+                     colors: Tuple[Tuple[int, int, int], ...] = ICON_COLORS[0]) -> None:
     """Draw a turtle centred at pixel (cx, cy) heading ``orient`` (radians, CCW from +x)."""
     import cv2
 
@@ -348,8 +364,9 @@ def draw_turtle_icon(frame: np.ndarray, cx: float, cy: float, orient: float) -> 
     def poly(points: np.ndarray) -> np.ndarray:
         return np.round((_rotate(points, orient) + centre) * (1 << shift)).astype(np.int32)
 
+    shell, skin, pattern = colors
     for leg in _LEGS:
-        cv2.fillPoly(frame, [poly(leg)], (96, 160, 64), cv2.LINE_AA, shift)
-    cv2.fillPoly(frame, [poly(_HEAD)], (96, 160, 64), cv2.LINE_AA, shift)
-    cv2.fillPoly(frame, [poly(_SHELL)], (34, 110, 34), cv2.LINE_AA, shift)
-    cv2.polylines(frame, [poly(_SHELL * 0.55)], True, (150, 200, 90), 1, cv2.LINE_AA, shift)
+        cv2.fillPoly(frame, [poly(leg)], skin, cv2.LINE_AA, shift)
+    cv2.fillPoly(frame, [poly(_HEAD)], skin, cv2.LINE_AA, shift)
+    cv2.fillPoly(frame, [poly(_SHELL)], shell, cv2.LINE_AA, shift)
+    cv2.polylines(frame, [poly(_SHELL * 0.55)], True, pattern, 1, cv2.LINE_AA, shift)
