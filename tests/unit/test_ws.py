@@ -177,3 +177,21 @@ def test_make_generates_importable_messages_and_rejects_malformed(tmp_path: Path
     (pkg / "msg" / "Broken.msg").write_text("int64 num\nnot_a_type@ x\n")
     with pytest.raises(WorkspaceError, match=r"Broken.msg: "):
         catkin.make_workspace(ws, out=lambda s: None)
+
+
+@pytest.mark.parametrize("shell,setup", [("bash", "setup.bash"), ("sh", "setup.sh"), ("zsh", "setup.zsh")])
+def test_setup_files_in_each_shell_with_a_space_in_the_path(tmp_path: Path, shell: str, setup: str):
+    import shutil
+
+    if shutil.which(shell) is None:
+        pytest.skip(f"{shell} is not installed")
+    ws = tmp_path / "my ws"
+    (ws / "src").mkdir(parents=True)
+    catkin.make_workspace(ws, out=lambda s: None)
+    script = f'. "{ws}/devel/{setup}"; echo "$ROS_PACKAGE_PATH"; command -v python'
+    out = subprocess.run([shell, "-c", script], env={"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)},
+                         capture_output=True, text=True, timeout=30)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0] == str(ws / "src")
+    assert lines[1] == str(Path(sys.executable).absolute().parent / "python")
