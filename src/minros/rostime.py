@@ -189,6 +189,21 @@ def _stop_node_time() -> None:
     _switch_to_wallclock()
 
 
+# rospy.rostime's internal names, which some tests and tools call directly
+set_rostime_initialized = _set_initialized
+switch_to_wallclock = _switch_to_wallclock
+
+
+def get_rostime_cond() -> threading.Condition:
+    """The condition notified whenever the node clock moves (rospy.rostime internal API)."""
+    return _clock.cond
+
+
+def wallsleep(duration: float) -> None:
+    """Sleep in wall-clock time regardless of simulated time (rospy.rostime.wallsleep)."""
+    time.sleep(duration)
+
+
 # --------------------------------------------------------------------------- sleeping
 
 def _to_duration(value: Union[float, int, _MsgDuration]) -> Duration:
