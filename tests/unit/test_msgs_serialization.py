@@ -388,3 +388,17 @@ def test_generated_source_is_the_compiled_code() -> None:
     namespace: dict = {"_load": REGISTRY.get_class}
     exec(compile(source, "<test>", "exec"), namespace)
     assert namespace["Image"]._full_text == get_message_class("sensor_msgs/Image")._full_text
+
+
+def test_numpy_values_for_numeric_arrays_are_checked() -> None:
+    from geometry_msgs.msg import PoseWithCovariance
+    from std_msgs.msg import Float32MultiArray, Int8MultiArray
+
+    assert Float32MultiArray(data=np.array([1, 2])).serialize_to_bytes() == \
+        Float32MultiArray(data=[1.0, 2.0]).serialize_to_bytes()
+    cov = np.arange(36, dtype=np.float64)
+    assert PoseWithCovariance(covariance=cov).serialize_to_bytes() == \
+        PoseWithCovariance(covariance=list(cov)).serialize_to_bytes()
+    for bad in (np.array([300]), np.array([1.5])):
+        with pytest.raises(SerializationError, match="field data"):
+            Int8MultiArray(data=bad).serialize_to_bytes()

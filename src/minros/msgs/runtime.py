@@ -48,9 +48,25 @@ def bad_length(field: str, want: int, got: int) -> SerializationError:
 
 
 def _numpy_bytes(code: str, value: Any) -> memoryview:
+    """A numpy array (or other sequence) as the wire bytes of a numeric array field.
+
+    Values are converted to the field's type only when that loses nothing a reader would
+    notice: floats never become integers, integers must fit the field's range.
+    """
     import numpy
 
-    array = numpy.ascontiguousarray(value, dtype=_NUMPY_DTYPE[code]).reshape(-1)
+    array = numpy.asarray(value)
+    target = numpy.dtype(_NUMPY_DTYPE[code])
+    if array.dtype != target:
+        if array.dtype.kind not in "biuf":
+            raise TypeError(f"a {target} array field cannot hold values of type {array.dtype}")
+        if target.kind in "iu":
+            if array.dtype.kind == "f":
+                raise TypeError(f"an integer array field cannot hold {array.dtype} values")
+            info = numpy.iinfo(target)
+            if array.size and (array.min() < info.min or array.max() > info.max):
+                raise ValueError(f"values outside the range of {target}")
+    array = numpy.ascontiguousarray(array, dtype=target).reshape(-1)
     return memoryview(array).cast("B")
 
 
