@@ -295,3 +295,16 @@ def test_roslaunch_pkg_file_form_and_unknown(tmp_path, pkg):
     assert bad.popen.wait(timeout=30) == 1
     assert bad.output().strip() == ("roslaunch: error: [nope.launch] is neither a launch file in package "
                                     "[launch_probe] nor is [launch_probe] a launch file name")
+
+
+def test_killed_roslaunch_takes_its_nodes_along(tmp_path, pkg):
+    xml = '<launch><node pkg="launch_probe" type="probe.py" name="orphan" output="screen"/></launch>'
+    proc, _port = _launch(tmp_path, pkg, xml)
+    try:
+        text = proc.read_until("PROBE", timeout=20)
+        pids = _pids(text)
+        assert len(pids) >= 2  # master and node
+        os.kill(proc.pid, signal.SIGKILL)  # roslaunch alone, no chance to clean up
+        wait_until(lambda: all(_gone(pid) for pid in pids), timeout=10, what="children gone")
+    finally:
+        proc.stop()

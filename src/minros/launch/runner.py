@@ -71,6 +71,23 @@ def log_root(env: Dict[str, str]) -> Path:
     return Path(env.get("ROS_LOG_DIR") or ros_home(env) / "log")
 
 
+def _die_with_parent() -> None:
+    """In the child before exec (Linux): SIGTERM when roslaunch dies, even by SIGKILL, so a
+    killed roslaunch leaves no node behind. roslaunch starts processes from its main thread
+    only, which lives as long as the process (the signal follows the forking thread)."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGTERM, 0, 0, 0)
+    except Exception:  # not Linux or no libc: roslaunch's own shutdown still stops the nodes
+        pass
+
+
+_PREEXEC = _die_with_parent if sys.platform.startswith("linux") else None
+
+
 def _safe_printer(stream: TextIO) -> Print:
     """A printer that never raises: a closed terminal or pipe (``roslaunch x | head``) must not
     stop roslaunch from cleaning up its processes."""
@@ -127,7 +144,8 @@ class LaunchProcess:
             self._files = [out, err]
             stdout, stderr = out, err
         self.popen = subprocess.Popen(self.argv, env=self.env, cwd=self.cwd, stdin=subprocess.DEVNULL,
-                                      stdout=stdout, stderr=stderr, start_new_session=True)
+                                      stdout=stdout, stderr=stderr, start_new_session=True,
+                                      preexec_fn=_PREEXEC)
         self.exit_code = None
         self.died_at = None
         self.started_once = True
