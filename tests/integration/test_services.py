@@ -354,6 +354,39 @@ def test_server_dying_mid_call(master_env, tmp_path):
         proc.stop()
 
 
+BIG_SERVER = r'''
+import rospy
+from sensor_msgs.srv import SetCameraInfo, SetCameraInfoResponse
+def handle(req):
+    d = req.camera_info.D
+    return SetCameraInfoResponse(True, "%d %s %s" % (len(d), d[0], d[-1]) + "x" * 3000000)
+rospy.init_node("big_server")
+rospy.Service("set_camera_info", SetCameraInfo, handle, buff_size=1024)
+print("READY", flush=True)
+rospy.spin()
+'''
+
+
+def test_big_request_and_response(master_env, tmp_path):
+    from sensor_msgs.msg import CameraInfo
+    from sensor_msgs.srv import SetCameraInfo
+
+    script = tmp_path / "big.py"
+    script.write_text(BIG_SERVER)
+    proc = Proc([PYTHON, str(script)], master_env)
+    try:
+        proc.read_until("READY", 30)
+        minros.wait_for_service("/set_camera_info", timeout=10)
+        d = [0.25] * 1_000_000  # 8 MB of float64 in the request
+        d[-1] = 7.5
+        proxy = minros.ServiceProxy("/set_camera_info", SetCameraInfo)
+        response = proxy(CameraInfo(D=d))
+        assert response.success
+        assert response.status_message == "1000000 0.25 7.5" + "x" * 3000000
+    finally:
+        proc.stop()
+
+
 def test_parse_rosrpc_uri():
     assert parse_rosrpc_uri("rosrpc://host:1234") == ("host", 1234)
     assert parse_rosrpc_uri("rosrpc://10.0.0.1:99/extra") == ("10.0.0.1", 99)
