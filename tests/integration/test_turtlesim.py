@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 import pytest
 
-from support import PYTHON, Proc, ros_env, wait_until
+from support import PYTHON, Proc, free_port, ros_env, wait_for_master, wait_until
 
 PROBE = str(Path(__file__).resolve().parent / "turtlesim_probe.py")
 CENTER = "5.544445"
@@ -234,3 +234,43 @@ def test_window_on_a_virtual_display(minros_core, ros_home, tmp_path):
     finally:
         xvfb.terminate()
         xvfb.wait(5)
+
+
+def test_seed_workflow_roscore_rosrun_and_arrow_keys(ros_home, tmp_path):
+    """The seed's three terminals: roscore, rosrun turtlesim turtlesim_node, rosrun turtlesim
+    turtle_teleop_key, then a left-arrow key press turns the turtle (angular 2.0 in the pose)."""
+    bin_dir = Path(PYTHON).parent
+    port = free_port()
+    env = ros_env(port, ros_home, {"MINROS_HEADLESS": "1"})
+    core = Proc([str(bin_dir / "roscore"), "-p", str(port)], env)
+    procs = [core]
+    master_fd, slave_fd = pty.openpty()
+    try:
+        wait_for_master(port)
+        sim = Proc([str(bin_dir / "rosrun"), "turtlesim", "turtlesim_node"], env)
+        procs.append(sim)
+        sim.read_until("Spawning turtle [turtle1]", timeout=15)
+        teleop = Proc([str(bin_dir / "rosrun"), "turtlesim", "turtle_teleop_key"], env,
+                      stdin=slave_fd)
+        procs.append(teleop)
+        teleop.read_until("Reading from keyboard", timeout=15)
+        watcher = Proc([PYTHON, PROBE, "wait_pose", "/turtle1/pose", "angular_velocity", "2.0"],
+                       ros_env(port, ros_home))
+        procs.append(watcher)
+        deadline = time.monotonic() + 15
+        result = None
+        while result is None and time.monotonic() < deadline:
+            os.write(master_fd, b"\x1b[D")  # left arrow
+            try:
+                result = watcher.read_until("RESULT ", timeout=0.3)
+            except AssertionError:
+                continue
+        assert result is not None, "the turtle never turned"
+        pose = json.loads(result.split("RESULT ", 1)[1].splitlines()[0])["pose"]
+        assert pose["linear_velocity"] == 0.0 and pose["angular_velocity"] == 2.0
+        assert pose["x"] == pytest.approx(float(CENTER), abs=1e-6)  # turning in place
+    finally:
+        for proc in reversed(procs):
+            proc.stop()
+        os.close(master_fd)
+        os.close(slave_fd)

@@ -148,11 +148,19 @@ def cmd_wait_moving(topic: str, speed: str) -> dict:
     return {"pose": pose_dict(moving)}
 
 
+def cmd_wait_pose(topic: str, field: str, value: str) -> dict:
+    """Wait until a pose on ``topic`` has ``field`` == value (within 1e-6)."""
+    poses = Latest(topic, Pose)
+    pose = poses.wait(lambda m: bool(m) and abs(getattr(m[-1], field) - float(value)) < 1e-6)
+    return {"pose": pose_dict(pose)}
+
+
 def main() -> None:
     command, args = sys.argv[1], sys.argv[2:]
     rospy.init_node("turtlesim_probe", anonymous=True)
     handlers = {"drive": cmd_drive, "rate": cmd_rate, "services": cmd_services,
-                "first_twist": cmd_first_twist, "wait_moving": cmd_wait_moving}
+                "first_twist": cmd_first_twist, "wait_moving": cmd_wait_moving,
+                "wait_pose": cmd_wait_pose}
     result = handlers[command](*args)
     print("RESULT " + json.dumps(result), flush=True)
     rospy.signal_shutdown("probe done")
