@@ -251,10 +251,23 @@ class RosoutHandler(logging.Handler):
             _rosout.local.busy = False
 
 
+#: after a failed parameter lookup, /rosout records use the default for this many seconds
+#: (a master that hangs must not stall every log call for an XML-RPC timeout)
+_PARAM_RETRY = 10.0
+_param_failed_at: Dict[str, float] = {}
+
+
 def _get_param_cached(key: str, default: Any) -> Any:
     from minros import params
 
-    return params.get_param_cached(key, default)
+    failed = _param_failed_at.get(key)
+    if failed is not None and time.monotonic() - failed < _PARAM_RETRY:
+        return default
+    try:
+        return params.get_param_cached(key, default)
+    except Exception:
+        _param_failed_at[key] = time.monotonic()
+        return default
 
 
 def _get_loggers(_request):

@@ -245,3 +245,22 @@ def test_node_log_filename_rules(tmp_path):
     assert log.node_log_filename("/ns/sub/talker", {}, env) == "/logs/ns_sub_talker.log"
     assert log.node_log_filename("/talker", {}, {"ROS_HOME": "/home"}) == "/home/log/talker.log"
     assert log.node_log_filename("/t", {"__log": str(tmp_path / "x.log")}, env) == str(tmp_path / "x.log")
+
+
+def test_failed_param_lookup_is_not_retried_on_every_record(monkeypatch):
+    from minros import params
+
+    calls = []
+
+    def failing(key, default):
+        calls.append(key)
+        raise OSError("master unreachable")
+
+    monkeypatch.setattr(params, "get_param_cached", failing)
+    monkeypatch.setattr(log, "_param_failed_at", {})
+    assert log._get_param_cached("/rosout_disable_topics_generation", False) is False
+    assert log._get_param_cached("/rosout_disable_topics_generation", False) is False
+    assert calls == ["/rosout_disable_topics_generation"]
+    log._param_failed_at["/rosout_disable_topics_generation"] -= log._PARAM_RETRY + 1
+    log._get_param_cached("/rosout_disable_topics_generation", False)
+    assert len(calls) == 2
