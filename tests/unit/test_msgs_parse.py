@@ -121,6 +121,11 @@ def test_generate_dynamic_needs_msg_lines() -> None:
         generate_dynamic("a/B", "int8 x\n" + SEPARATOR + "\nint8 y")
     with pytest.raises(LookupError, match="c/D"):
         generate_dynamic("a/B", "c/D d")
+    # embedded types missing from the text come from the installed definitions
+    classes = generate_dynamic("a/C", "Header h\ngeometry_msgs/Point p")
+    assert classes["a/C"]._md5sum == generate_dynamic(
+        "a/C", "Header h\ngeometry_msgs/Point p\n" + SEPARATOR + "\nMSG: std_msgs/Header\n"
+        + get_message_class("std_msgs/Header")._full_text)["a/C"]._md5sum
 
 
 def test_srv_split_like_genmsg() -> None:

@@ -76,8 +76,10 @@ def _split_type(type_name: str, kind: str) -> Tuple[str, str]:
 class MsgContext:
     """Specs, md5 sums, full texts and classes of a set of message types."""
 
-    def __init__(self, search: bool = True, module_name: str | None = None) -> None:
+    def __init__(self, search: bool = True, module_name: str | None = None,
+                 fallback: MsgContext | None = None) -> None:
         self._search = search
+        self._fallback = fallback
         self._module_name = module_name
         self._lock = threading.RLock()
         self._specs: Dict[str, MsgSpec] = {}
@@ -125,6 +127,14 @@ class MsgContext:
             spec = self._specs.get(type_name)
             if spec is not None:
                 return spec
+            if self._fallback is not None and not self._search:
+                try:
+                    spec = self._fallback.get_spec(type_name)
+                except UnknownTypeError:
+                    pass
+                else:
+                    self._specs[type_name] = spec
+                    return spec
             try:
                 path = self._find_file(type_name, "msg")
             except UnknownTypeError:
@@ -347,7 +357,8 @@ def generate_dynamic(core_type: str, full_text: str) -> Dict[str, type]:
         found = _dynamic_cache.get(key)
     if found is not None:
         return dict(found)
-    context = MsgContext(search=False, module_name="minros.msgs.dynamic")
+    # types the text lacks (a sloppy publisher or bag) come from the installed definitions
+    context = MsgContext(search=False, module_name="minros.msgs.dynamic", fallback=REGISTRY)
     core_type = normalize_type(core_type)
     blocks = split_full_text(full_text)
     types: List[str] = []
