@@ -89,10 +89,11 @@ def topic_type(master: Master, topic: str) -> Tuple[str | None, str | None, str]
     candidates = sorted(((t, ty) for t, ty in types if topic.startswith(t + "/")), reverse=True)
     for name, type_name in candidates:
         field = topic[len(name) + 1:].rstrip("/").split("[")[0]
-        cls = _message_class(type_name)
-        if cls is None or field == "":
+        if field == "":
             break
-        if _nested_ok(cls, field):
+        cls = _message_class(type_name)
+        # a type not installed here is checked against its definition when messages arrive
+        if cls is None or _nested_ok(cls, field):
             if type_name == names.ANYTYPE:
                 return None, None, ""
             return type_name, name, topic[len(name):]
@@ -296,7 +297,8 @@ def _cmd_find(argv: List[str], prog: str) -> int:
 class _Echo:
     """The echo callback: decode, filter, select a field, print; counts for ``-n``."""
 
-    def __init__(self, topic: str, field_path: str, options: Any, filter_fn: Callable | None) -> None:
+    def __init__(self, topic: str, field_path: str, options: Any, filter_fn: Callable | None,
+                 real_topic: str = '') -> None:
         from minros.tools.decode import Decoder
         from minros.tools.echo import (
             make_field_filter,
@@ -305,6 +307,7 @@ class _Echo:
         )
 
         self.topic = topic
+        self.real_topic = real_topic or topic
         self.field_path = field_path
         self.getter = make_field_getter(field_path) if field_path else None
         self.decoder = Decoder()
@@ -349,7 +352,7 @@ class _Echo:
     def _print(self, msg: Any) -> None:
         from minros.tools.echo import field_type, plot_header, plot_line, yaml_text
 
-        if self.filter_fn is not None and not self.filter_fn(msg, self.topic):
+        if self.filter_fn is not None and not self.filter_fn(msg, self.real_topic):
             return
         if self.max_count is not None and self.count >= self.max_count:
             self.done = True
@@ -448,7 +451,7 @@ def _cmd_echo(argv: List[str], prog: str) -> int:
 
     _type, real_topic, field_path = wait_topic_type(master, topic)
     try:
-        echo = _Echo(topic.rstrip("/"), field_path, args, filter_fn)
+        echo = _Echo(topic.rstrip("/"), field_path, args, filter_fn, real_topic)
     except FieldError as exc:
         raise ToolError(str(exc)) from None
     from minros.topics import AnyMsg, Subscriber
@@ -788,7 +791,8 @@ def _cmd_pub(argv: List[str], prog: str) -> int:
                    help="When publishing with a rate, performs keyword ('now' or 'auto') substitution for each message")
     p.add_argument("--use-rostime", dest="use_rostime", action="store_true",
                    help="use rostime for time stamps, else walltime is used")
-    # message values such as -1 or -0.5 are arguments, not options
+    # negative numbers such as -7 or -0.5 are message values, not options ('-1' is --once, as in
+    # rostopic; '--' ends the options)
     options: List[str] = []
     positional: List[str] = []
     takes_value = {"-r", "--rate", "-f", "--file"}
@@ -798,7 +802,7 @@ def _cmd_pub(argv: List[str], prog: str) -> int:
         if a == "--":
             positional.extend(argv[i + 1:])
             break
-        if len(positional) >= 2 or not a.startswith("-") or a == "-" or (a[1:2].isdigit() and a != "-1") or a[1:2] == ".":
+        if not a.startswith("-") or a == "-" or (a[1:2].isdigit() and a != "-1") or a[1:2] == ".":
             positional.append(a)
         else:
             options.append(a)
