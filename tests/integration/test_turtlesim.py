@@ -274,3 +274,23 @@ def test_seed_workflow_roscore_rosrun_and_arrow_keys(ros_home, tmp_path):
             proc.stop()
         os.close(master_fd)
         os.close(slave_fd)
+
+
+def test_teleop_ctrl_c_restores_the_terminal(minros_core, ros_home):
+    import signal
+
+    master_fd, slave_fd = pty.openpty()
+    teleop = Proc([PYTHON, "-m", "minros.turtlesim.turtle_teleop_key"],
+                  ros_env(minros_core, ros_home), stdin=slave_fd)
+    try:
+        teleop.read_until("Reading from keyboard", timeout=15)
+        assert not termios.tcgetattr(slave_fd)[3] & termios.ICANON
+        os.kill(teleop.pid, signal.SIGINT)  # what Ctrl-C sends (ISIG stays on in the raw mode)
+        teleop.popen.wait(10)
+        assert termios.tcgetattr(slave_fd)[3] & termios.ICANON
+        assert termios.tcgetattr(slave_fd)[3] & termios.ECHO
+        assert "Traceback" not in teleop.output()
+    finally:
+        teleop.stop()
+        os.close(master_fd)
+        os.close(slave_fd)
