@@ -373,9 +373,9 @@ def test_master_restart_reregisters_and_reconnects(scripts, ros_home):
         wait_until(registered, 10, what="publisher and subscriber registered with the new master")
         # a publisher that comes back as a new process (new ports) is found through the new master
         pub.stop()
-        pub2 = _node(talker, ["/restart", "string", 100000, 20, 0], port, ros_home)
+        pub2 = _node(talker, ["/restart", "string", 100000, 20, 0, "__name:=talker2"], port, ros_home)
         pub2.read_until("subscriber connected", 15)
-        sub.read_until("got msg 5 from /talker", 15)
+        sub.read_until("from /talker2", 15)
     finally:
         for proc in (sub, pub, pub2, master):
             if proc is not None:

@@ -97,3 +97,47 @@ def test_rosnode_info_ping_kill(talker, debian_rosmaster, ros_home):
         assert "/talker" not in _tool(debian_rosmaster, ros_home, "rosnode", "list").stdout
     finally:
         echo.stop()
+
+
+def test_debian_master_restart_under_minros_pair(tmp_path, ros_home):
+    """Kill Debian's rosmaster under a running minros pair and start a new one on the same
+    port: the nodes register again by themselves, and a publisher restarted afterwards (new
+    ports) reaches the subscriber through the new master."""
+    import xmlrpc.client
+
+    from support import free_port, wait_for_master
+
+    require_reference()
+    port = free_port()
+    talker, listener = tmp_path / "talker.py", tmp_path / "listener.py"
+    talker.write_text(TALKER)
+    listener.write_text(LISTENER)
+
+    def start_master() -> Proc:
+        proc = Proc(["/usr/bin/rosmaster", "--core", "-p", str(port)], reference_env(ros_env(port, ros_home)))
+        wait_for_master(port)
+        return proc
+
+    master = start_master()
+    sub = Proc([PYTHON, str(listener), "/again", "string", "100000"], ros_env(port, ros_home))
+    pub = Proc([PYTHON, str(talker), "/again", "string", "100000", "20", "0"], ros_env(port, ros_home))
+    pub2 = None
+    try:
+        sub.read_until("got msg 3 from /talker", 20)
+        master.stop()
+        master = start_master()
+        proxy = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{port}/")
+
+        def registered():
+            pubs, subs, _ = proxy.getSystemState("/t")[2]
+            return any(t == "/again" for t, _ in pubs) and any(t == "/again" for t, _ in subs)
+        wait_until(registered, 10, what="both nodes registered with the new rosmaster")
+        pub.stop()
+        pub2 = Proc([PYTHON, str(talker), "/again", "string", "100000", "20", "0", "__name:=talker2"],
+                    ros_env(port, ros_home))
+        pub2.read_until("subscriber connected", 15)
+        sub.read_until("from /talker2", 15)
+    finally:
+        for proc in (sub, pub, pub2, master):
+            if proc is not None:
+                proc.stop()
