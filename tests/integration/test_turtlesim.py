@@ -5,6 +5,7 @@ mimic across two simulators, draw_square, and the PNG snapshot."""
 from __future__ import annotations
 
 import json
+import math
 import os
 import pty
 import shutil
@@ -95,6 +96,8 @@ def test_services_spawn_kill_pen_teleport_clear(turtlesim):
     assert out["color"] == [255, 0, 0]
     assert out["after_clear"] == [10, 86, 255]
     assert out["params"] == {"background_r": 10, "background_g": 86, "background_b": 255}
+    assert "non-finite value (x=nan)" in out["nan_teleport_error"]
+    assert all(math.isfinite(v) for v in out["pose_after_inf"].values())
     log = proc.stop()
     assert "A turtled named [leo] already exists" in log
     assert "Tried to kill turtle [leo], which does not exist" in log

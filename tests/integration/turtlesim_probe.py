@@ -124,6 +124,19 @@ def cmd_services() -> dict:
     rospy.ServiceProxy("turtle1/teleport_absolute", TeleportAbsolute)(2.0, 2.0, 0.0)
     red = colors.wait(lambda m: bool(m) and (m[-1].r, m[-1].g, m[-1].b) == (255, 0, 0))
     out["color"] = [red.r, red.g, red.b]
+    # NaN from a client: the service says why, the simulator keeps running with finite poses.
+    out["nan_teleport_error"] = call_error(
+        rospy.ServiceProxy("turtle1/teleport_absolute", TeleportAbsolute), float("nan"), 1.0, 0.0)
+    bad = Twist()
+    bad.angular.z = float("inf")
+    cmd = rospy.Publisher("turtle1/cmd_vel", Twist, queue_size=1)
+    poses = Latest("/turtle1/pose", Pose)
+    for _ in range(10):
+        cmd.publish(bad)
+        time.sleep(0.02)
+    poses.msgs.clear()
+    after = poses.wait(lambda m: len(m) >= 5)
+    out["pose_after_inf"] = pose_dict(after)
     rospy.set_param("/turtlesim/background_r", 10)
     rospy.ServiceProxy("clear", Empty)()
     colors.msgs.clear()

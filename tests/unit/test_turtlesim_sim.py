@@ -292,3 +292,21 @@ def test_draw_square_driver_closes_the_square_on_the_simulator():
     assert states[:5] == [FORWARD, STOP_FORWARD, TURN, STOP_TURN, FORWARD]
     assert states.count(TURN) >= 4  # went round at least once
     assert all(sim.CENTER - 0.2 <= v <= sim.CENTER + 2.2 for v in (pose.x, pose.y))
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_non_finite_commands_are_refused_and_the_turtle_survives(bad):
+    world, clock, _ = make_world()
+    turtle = world.turtles["turtle1"]
+    with pytest.raises(sim.NonFiniteError, match=r"\[turtle1\] cmd_vel: non-finite value \(angular_z="):
+        turtle.command_velocity(1.0, 0.0, bad, clock())
+    with pytest.raises(sim.NonFiniteError, match="teleport_absolute"):
+        turtle.teleport_absolute(bad, 1.0, 0.0)
+    with pytest.raises(sim.NonFiniteError, match="teleport_relative"):
+        turtle.teleport_relative(1.0, bad)
+    counter = world.id_counter
+    with pytest.raises(sim.NonFiniteError, match="spawn"):
+        world.spawn("", 1.0, bad, 0.0)
+    assert world.id_counter == counter and list(world.turtles) == ["turtle1"]
+    pose = run(world, clock, 2)["turtle1"].pose
+    assert all(math.isfinite(v) for v in pose) and pose.linear_velocity == 0.0

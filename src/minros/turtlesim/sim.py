@@ -49,6 +49,17 @@ WALL_WARNING = "Oh no! I hit the wall! (Clamping from [x=%f, y=%f])"
 _LEGAL_NAME = re.compile(r"^[~/]?[A-Za-z][\w/]*$", re.ASCII)
 
 
+class NonFiniteError(ValueError):
+    """A command or request carried NaN or infinity (C++ turtlesim would lose the turtle)."""
+
+
+def check_finite(what: str, **values: float) -> None:
+    """Raise :class:`NonFiniteError` naming the offending fields if any value is NaN/inf."""
+    bad = [f"{k}={v}" for k, v in values.items() if not math.isfinite(v)]
+    if bad:
+        raise NonFiniteError(f"{what}: non-finite value ({', '.join(bad)}) ignored")
+
+
 def _f32(value: float) -> float:
     """Round a Python float to the nearest float32, as a C++ ``float`` member would store it."""
     return float(np.float32(value))
@@ -109,6 +120,8 @@ class Turtle:
 
     def command_velocity(self, linear_x: float, linear_y: float, angular_z: float, now: float) -> None:
         """cmd_vel callback: store the velocities and the (wall) time they arrived."""
+        check_finite(f"[{self.name}] cmd_vel", linear_x=linear_x, linear_y=linear_y,
+                     angular_z=angular_z)
         self.last_command_time = now
         self.lin_vel_x = linear_x
         self.lin_vel_y = linear_y
@@ -124,10 +137,12 @@ class Turtle:
 
     def teleport_absolute(self, x: float, y: float, theta: float) -> None:
         """teleport_absolute service: queued, applied at the start of the next tick."""
+        check_finite(f"[{self.name}] teleport_absolute", x=x, y=y, theta=theta)
         self.teleports.append(_Teleport(relative=False, x=x, y=y, theta=theta))
 
     def teleport_relative(self, linear: float, angular: float) -> None:
         """teleport_relative service: queued, applied at the start of the next tick."""
+        check_finite(f"[{self.name}] teleport_relative", linear=linear, angular=angular)
         self.teleports.append(_Teleport(relative=True, theta=angular, linear=linear))
 
     # -- the tick --------------------------------------------------------------------------
@@ -263,6 +278,7 @@ class TurtleFrame:
 
     def add_turtle(self, name: str, x: float, y: float, theta: float) -> Turtle:
         """Insert a turtle whose name was chosen by :meth:`next_name`, and log it."""
+        check_finite("spawn", x=x, y=y, theta=theta)
         x, y, theta = _f32(x), _f32(y), _f32(theta)  # spawnTurtle takes C++ floats
         turtle = Turtle(name, x, _f32(self.height_m - y), theta, last_command_time=self.clock(),
                         icon=self._icons.randrange(len(ICON_COLORS)))
@@ -272,6 +288,7 @@ class TurtleFrame:
 
     def spawn(self, name: str, x: float, y: float, theta: float) -> str:
         """spawn service: the turtle's name, or '' when ``name`` already exists (logged)."""
+        check_finite("spawn", x=x, y=y, theta=theta)
         real = self.next_name(name)
         if not real:
             self.error(f"A turtled named [{name}] already exists")

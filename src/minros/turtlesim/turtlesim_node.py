@@ -91,20 +91,32 @@ class _TurtleInterfaces:
             return True
 
     def _on_cmd_vel(self, msg: Any) -> None:
+        import rospy
+
         now = self.node.world.clock()
-        self._with_turtle(lambda t: t.command_velocity(msg.linear.x, msg.linear.y, msg.angular.z, now))
+        try:
+            self._with_turtle(
+                lambda t: t.command_velocity(msg.linear.x, msg.linear.y, msg.angular.z, now))
+        except sim.NonFiniteError as exc:
+            rospy.logwarn_throttle(5.0, str(exc))
+
+    def _service(self, action: Callable[[sim.Turtle], None]) -> Any:
+        import rospy
+
+        try:
+            ok = self._with_turtle(action)
+        except sim.NonFiniteError as exc:
+            raise rospy.ServiceException(str(exc)) from None
+        return [] if ok else False
 
     def _on_set_pen(self, req: Any) -> Any:
-        ok = self._with_turtle(lambda t: t.set_pen(req.r, req.g, req.b, req.width, req.off))
-        return [] if ok else False
+        return self._service(lambda t: t.set_pen(req.r, req.g, req.b, req.width, req.off))
 
     def _on_teleport_relative(self, req: Any) -> Any:
-        ok = self._with_turtle(lambda t: t.teleport_relative(req.linear, req.angular))
-        return [] if ok else False
+        return self._service(lambda t: t.teleport_relative(req.linear, req.angular))
 
     def _on_teleport_absolute(self, req: Any) -> Any:
-        ok = self._with_turtle(lambda t: t.teleport_absolute(req.x, req.y, req.theta))
-        return [] if ok else False
+        return self._service(lambda t: t.teleport_absolute(req.x, req.y, req.theta))
 
     def publish(self, update: sim.TurtleUpdate) -> None:
         self.pose_pub.publish(self.pose_msg(*update.pose))
@@ -168,6 +180,10 @@ class TurtlesimNode:
     def _spawn(self, name: str, x: float, y: float, theta: float) -> str:
         import rospy
 
+        try:
+            sim.check_finite("spawn", x=x, y=y, theta=theta)
+        except sim.NonFiniteError as exc:
+            raise rospy.ServiceException(str(exc)) from None
         with self.lock:
             real = self.world.next_name(name)
         if not real:
