@@ -359,11 +359,21 @@ def main(argv: List[str] | None = None) -> int:
     next_snapshot = next_tick + args.snapshot_period if snapshot and args.snapshot_period > 0 else None
     try:
         while not rospy.is_shutdown():
-            node.step()
+            try:
+                node.step()
+            except Exception as exc:  # e.g. a publisher closed by a shutdown racing this tick
+                if rospy.is_shutdown():
+                    break
+                rospy.logerr_throttle(5.0, f"turtlesim: update failed: {exc}")
             if display is not None:
-                if node.dirty:
-                    display.show(node.render())
-                if not display.pump():
+                try:
+                    if node.dirty:
+                        display.show(node.render())
+                    alive = display.pump()
+                except Exception as exc:  # the display went away (X server gone)
+                    rospy.logwarn(f"turtlesim: window lost ({exc}); continuing without it")
+                    display, alive = None, True
+                if not alive:
                     rospy.signal_shutdown("window closed")
                     break
             if next_snapshot is not None and time.monotonic() >= next_snapshot:
