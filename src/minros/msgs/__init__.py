@@ -12,23 +12,21 @@ and produce genpy's bytes. Importing this package installs the import hook that 
 
 from __future__ import annotations
 
+from typing import Any
+
 from minros.exceptions import DeserializationError, SerializationError
 
 from .importer import install_import_hook, write_stub_package
-from .message import Message, check_type, strify_message
-from .registry import (
-    REGISTRY,
-    MsgContext,
-    ServiceDefinition,
-    UnknownTypeError,
-    generate_dynamic,
-    get_message_class,
-    get_service_class,
-    normalize_type,
-    numpy_msg,
-)
-from .spec import MsgSpecError
 from .tval import Duration, Time, TVal
+
+#: name -> submodule; loaded on first use so ``import rospy`` stays light (PEP 562)
+_LAZY = {
+    "Message": "message", "check_type": "message", "strify_message": "message",
+    "REGISTRY": "registry", "MsgContext": "registry", "ServiceDefinition": "registry",
+    "UnknownTypeError": "registry", "generate_dynamic": "registry",
+    "get_message_class": "registry", "get_service_class": "registry",
+    "normalize_type": "registry", "numpy_msg": "registry", "MsgSpecError": "spec",
+}
 
 __all__ = [
     "Message", "Time", "Duration", "TVal", "get_message_class", "get_service_class",
@@ -37,5 +35,21 @@ __all__ = [
     "check_type", "strify_message", "normalize_type", "DeserializationError",
     "SerializationError",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'minros.msgs' has no attribute '{name}'")
+    import importlib
+
+    value = getattr(importlib.import_module(f"minros.msgs.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list:
+    return sorted(set(globals()) | set(__all__))
+
 
 install_import_hook()
