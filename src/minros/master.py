@@ -67,7 +67,9 @@ class ParamTree:
         """Value at the resolved ``key`` (a dict for a namespace); KeyError when unset."""
         value: Any = self.root
         if key != GLOBALNS:
-            for part in _key_parts(key):
+            # The first segment is skipped, as rosmaster does: for a global key it is the empty
+            # root; for the odd relative key a non-global caller_id produces it is dropped.
+            for part in [p for p in key.split(SEP)[1:] if p]:
                 if type(value) is not dict:
                     raise KeyError(key)
                 value = value[part]
@@ -107,7 +109,9 @@ class ParamTree:
             if type(node) is not dict or part not in node:
                 raise KeyError(key)
             node = node[part]
-        if type(node) is not dict or parts[-1] not in node:
+        # Like rosmaster, the last step is plain Python: under a scalar parent this raises
+        # TypeError (reported as "invalid arguments"), not KeyError.
+        if parts[-1] not in node:
             raise KeyError(key)
         del node[parts[-1]]
 
@@ -204,7 +208,8 @@ class Registrations:
     def __init__(self, kind: int) -> None:
         self.kind = kind
         self.map: Dict[str, List[Caller]] = {}
-        self.service_api_map: Dict[str, Caller] = {}
+        # None until the first service registration (rosmaster's messages depend on it)
+        self.service_api_map: Dict[str, Caller] | None = None
 
     def __bool__(self) -> bool:
         return bool(self.map)
@@ -222,7 +227,7 @@ class Registrations:
         return [api for _id, api in self.map.get(key, ())]
 
     def get_service_api(self, service: str) -> str | None:
-        entry = self.service_api_map.get(service)
+        entry = self.service_api_map.get(service) if self.service_api_map else None
         return entry[1] if entry else None
 
     def get_state(self) -> List[List[Any]]:
@@ -232,6 +237,8 @@ class Registrations:
                  service_api: str | None = None) -> None:
         if service_api:
             self.map[key] = [(caller_id, caller_api)]
+            if self.service_api_map is None:
+                self.service_api_map = {}
             self.service_api_map[key] = (caller_id, service_api)
             return
         callers = self.map.get(key)
@@ -248,13 +255,14 @@ class Registrations:
                 dead.append(key)
         for key in dead:
             del self.map[key]
-        for key in [k for k, v in self.service_api_map.items() if v[0] == caller_id]:
-            del self.service_api_map[key]
+        if self.service_api_map:
+            for key in [k for k, v in self.service_api_map.items() if v[0] == caller_id]:
+                del self.service_api_map[key]
 
     def unregister(self, key: str, caller_id: str, caller_api: str | None,
                    service_api: str | None = None) -> List[Any]:
         if service_api:
-            if not self.service_api_map:
+            if self.service_api_map is None:
                 return [1, f"[{caller_id}] is not a provider of [{key}]", 0]
             if self.service_api_map.get(key) != (caller_id, service_api):
                 return [1, f"[{service_api}] is no longer the current service api handle for [{key}]", 0]
