@@ -41,7 +41,7 @@ def _cpp_service_class():
             def wrapped(request: Any) -> Any:
                 result = handler(request)
                 local.refused = result is False
-                return [] if result is False else result
+                return service_class._response_class() if result is False else result
 
             super().__init__(name, service_class, wrapped)
             self._local = local
