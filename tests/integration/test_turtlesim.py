@@ -89,6 +89,7 @@ def test_services_spawn_kill_pen_teleport_clear(turtlesim):
     assert out["leo_pose"]["x"] == 1.0 and out["leo_pose"]["y"] == 1.0
     assert out["duplicate_error"].startswith("service [/spawn] responded with an error")
     assert out["illegal_error"].startswith("service [/spawn] responded with an error")
+    assert "Cannot spawn turtle [no way]: not a legal ROS name" in out["illegal_error"]
     assert {"/leo/pose", "/leo/color_sensor"} <= set(out["topics_before_kill"])
     assert not any(t.startswith("/leo/") for t in out["topics_after_kill"])
     assert "/turtle2/pose" in out["topics_after_kill"]

@@ -191,8 +191,9 @@ class TurtlesimNode:
             return ""
         if not sim.is_legal_turtle_name(real):
             # roscpp would throw InvalidNameException from NodeHandle(name) and die; refuse instead.
-            rospy.logerr(f"Cannot spawn turtle [{real}]: not a legal ROS name")
-            return ""
+            text = f"Cannot spawn turtle [{real}]: not a legal ROS name"
+            rospy.logerr(text)
+            raise rospy.ServiceException(text)
         self.interfaces[real] = _TurtleInterfaces(self, real)
         with self.lock:
             self.world.add_turtle(real, x, y, theta)
