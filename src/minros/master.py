@@ -35,7 +35,7 @@ from minros.names import resolve_name as _resolve_name
 DEFAULT_MASTER_PORT = 11311
 #: Timeout of one callback (publisherUpdate, paramUpdate, shutdown) to a node, in seconds.
 CALLBACK_TIMEOUT = 5.0
-CALLBACK_WORKERS = 4
+CALLBACK_WORKERS = 16  # started on demand; many slow nodes do not stall the others
 #: Bound on callbacks queued for one node (a node that never answers cannot grow memory forever).
 MAX_QUEUED_PER_NODE = 10000
 #: Queued calls to one node beyond which a newer update replaces a queued one for the same key.

@@ -161,6 +161,7 @@ class Dispatcher:
 # ------------------------------------------------------------------ HTTP server
 
 _REASONS = {200: "OK", 400: "Bad Request", 404: "Not Found", 408: "Request Timeout",
+            503: "Service Unavailable",
             411: "Length Required", 413: "Payload Too Large", 414: "URI Too Long",
             431: "Request Header Fields Too Large", 501: "Not Implemented",
             505: "HTTP Version Not Supported"}
@@ -190,7 +191,7 @@ class XmlRpcServer:
     def __init__(self, handler: Any, host: str = "", port: int = 0, *,
                  max_body: int = DEFAULT_MAX_BODY, idle_timeout: float = DEFAULT_IDLE_TIMEOUT,
                  max_connections: int = DEFAULT_MAX_CONNECTIONS, backlog: int = 1024,
-                 ipv6: bool | None = None) -> None:
+                 ipv6: bool | None = None, body_budget: int | None = None) -> None:
         self.dispatcher = Dispatcher(handler)
         self.host = host
         self.requested_port = port
@@ -205,6 +206,9 @@ class XmlRpcServer:
         self._conns_lock = threading.Lock()
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
+        self.body_budget = max(max_body, body_budget if body_budget is not None else 4 * max_body)
+        self._budget_used = 0
+        self._budget_cond = threading.Condition()
         self.port = 0
 
     # -- life cycle
@@ -245,6 +249,19 @@ class XmlRpcServer:
                 pass
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(2.0)
+
+    def _reserve(self, size: int) -> bool:
+        with self._budget_cond:
+            if not self._budget_cond.wait_for(
+                    lambda: self._budget_used + size <= self.body_budget, timeout=self.idle_timeout):
+                return False
+            self._budget_used += size
+            return True
+
+    def _release(self, size: int) -> None:
+        with self._budget_cond:
+            self._budget_used -= size
+            self._budget_cond.notify_all()
 
     def connection_count(self) -> int:
         with self._conns_lock:
@@ -299,7 +316,11 @@ class XmlRpcServer:
                 if request is None:
                     return
                 body, keep_alive = request
-                payload = self.dispatcher.handle_request_body(body)
+                try:
+                    payload = self.dispatcher.handle_request_body(body)
+                finally:
+                    self._release(len(body))
+                    del body
                 head = ("HTTP/1.1 200 OK\r\nServer: minros\r\nContent-type: text/xml\r\n"
                         f"Content-length: {len(payload)}\r\n"
                         + ("" if keep_alive else "Connection: close\r\n") + "\r\n")
@@ -369,8 +390,16 @@ class XmlRpcServer:
             raise _HttpError(400, "bad Content-Length")
         if length > self.max_body:
             raise _HttpError(413, f"body of {length} bytes exceeds the limit of {self.max_body}")
-        body = reader.read(length)
+        # Bodies in memory at once are bounded too, not only each one: wait for room, briefly.
+        if not self._reserve(length):
+            raise _HttpError(503, "server busy with large requests, try again")
+        try:
+            body = reader.read(length)
+        except BaseException:
+            self._release(length)
+            raise
         if len(body) != length:
+            self._release(length)
             return None  # peer closed mid-body
         connection = headers.get("connection", "").lower()
         if version == "HTTP/1.0":

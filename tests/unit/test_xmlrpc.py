@@ -265,3 +265,21 @@ def test_address_rules():
     assert mx.parse_http_host_and_port("http://h:99/") == ("h", 99)
     with pytest.raises(ValueError):
         mx.parse_http_host_and_port("rosrpc://h:99")
+
+
+def test_bodies_in_memory_are_bounded_in_total():
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", max_body=1000, body_budget=1000, idle_timeout=0.1)
+    assert srv._reserve(900)
+    start = time.monotonic()
+    assert not srv._reserve(200)  # would exceed the budget: refused after a short wait
+    assert time.monotonic() - start >= 0.09
+    srv._release(900)
+    assert srv._reserve(200)
+    srv._release(200)
+    # and the server still answers requests through the budget
+    srv.start()
+    try:
+        assert mx.ServerProxy(f"http://127.0.0.1:{srv.port}/").add(1, 2) == 3
+        assert srv._budget_used == 0
+    finally:
+        srv.shutdown()
