@@ -402,3 +402,21 @@ def test_numpy_values_for_numeric_arrays_are_checked() -> None:
     for bad in (np.array([300]), np.array([1.5])):
         with pytest.raises(SerializationError, match="field data"):
             Int8MultiArray(data=bad).serialize_to_bytes()
+
+
+def test_arrays_of_fixed_size_messages() -> None:
+    from geometry_msgs.msg import Point, PoseArray
+
+    ctx = MsgContext(search=False)
+    ctx.add_spec(parse_msg("float32 x\nbool ok", "pkg/P"))
+    ctx.add_spec(parse_msg("P[2] two\nP[] many", "pkg/Ps"))
+    Ps, P = ctx.get_class("pkg/Ps"), ctx.get_class("pkg/P")
+    msg = Ps(two=[P(1.0, True), P(2.0, False)], many=[P(3.0, True)])
+    wire = msg.serialize_to_bytes()
+    assert wire == struct.pack("<f?f?If?", 1.0, True, 2.0, False, 1, 3.0, True)
+    assert Ps().deserialize(wire) == msg
+    with pytest.raises(DeserializationError, match="two"):
+        Ps().deserialize(wire[:5])
+    poses = PoseArray(poses=[__import__("geometry_msgs.msg").msg.Pose(position=Point(1, 2, 3))] * 3)
+    back = PoseArray().deserialize(poses.serialize_to_bytes())
+    assert back == poses and back.poses[0] is not back.poses[1]

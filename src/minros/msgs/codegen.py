@@ -78,6 +78,34 @@ def min_size(spec: MsgSpec, get_spec: GetSpec) -> int:
     return total
 
 
+BUILTIN_NAMES = frozenset(SER_CODE) | {"string", "time", "duration"}
+
+
+def _flat_codes(spec: MsgSpec, get_spec: GetSpec) -> List[Tuple[int, str]]:
+    out: List[Tuple[int, str]] = []
+    for f in spec.fields:
+        if f.base_type in DESER_CODE:
+            out.append((1, DESER_CODE[f.base_type]))
+        else:
+            out.extend(_flat_codes(get_spec(f.base_type), get_spec))
+    return out
+
+
+def is_flat(spec: MsgSpec, get_spec: GetSpec) -> bool:
+    """Whether ``spec`` is a non-empty run of fixed-size primitives (nested ones included):
+    arrays of such messages are packed and unpacked element by element in one pass."""
+    if not spec.fields:
+        return False
+    for f in spec.fields:
+        if f.is_array:
+            return False
+        if f.base_type in SER_CODE:
+            continue
+        if f.is_builtin or not is_flat(get_spec(f.base_type), get_spec):
+            return False
+    return True
+
+
 def has_bulk_arrays(spec: MsgSpec, get_spec: GetSpec) -> bool:
     """Whether ``spec`` (or an embedded type) has a variable-length primitive array.
 
@@ -117,6 +145,7 @@ class _SerializerGen(_Writer):
     def __init__(self, structs: Dict[str, str], get_spec: GetSpec) -> None:
         super().__init__(structs)
         self.get_spec = get_spec
+        self.out = "append"  # the function that receives each piece
         self.run: List[Tuple[int, str, str]] = []  # (count, code, expression)
 
     def flush(self, ind: int) -> None:
@@ -124,7 +153,7 @@ class _SerializerGen(_Writer):
             return
         fmt = _compress([(n, c) for n, c, _ in self.run])
         name = self.struct(fmt)
-        self.emit(ind, f"append({name}.pack({', '.join(e for _, _, e in self.run)}))")
+        self.emit(ind, f"{self.out}({name}.pack({', '.join(e for _, _, e in self.run)}))")
         self.run = []
 
     def string(self, ind: int, expr: str) -> None:
@@ -136,7 +165,7 @@ class _SerializerGen(_Writer):
         self.emit(ind + 1, f"{var} = _string_bytes({var})")
         self.run.append((1, "I", f"len({var})"))
         self.flush(ind)
-        self.emit(ind, f"append({var})")
+        self.emit(ind, f"{self.out}({var})")
 
     def fields(self, spec: MsgSpec, obj: str, path: str, ind: int) -> None:
         for f in spec.fields:
@@ -172,12 +201,12 @@ class _SerializerGen(_Writer):
                     self.emit(ind, f"if len({var}) != {n}:")
                     self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
                 self.flush(ind)
-                self.emit(ind, f"append({var})")
+                self.emit(ind, f"{self.out}({var})")
             elif bt in SER_CODE:
                 code = SER_CODE[bt]
                 if n is None:
                     self.flush(ind)
-                    self.emit(ind, f"_put_array(append, {code!r}, {expr})")
+                    self.emit(ind, f"_put_array({self.out}, {code!r}, {expr})")
                 elif n > 0:
                     var = self.tmp("_a")
                     self.emit(ind, f"{var} = {expr}")
@@ -196,6 +225,17 @@ class _SerializerGen(_Writer):
                     self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
                 self.flush(ind)
                 item = self.tmp("_e")
+                if bt not in BUILTIN_NAMES and is_flat(self.get_spec(bt), self.get_spec):
+                    # small fixed-size elements: pack them all, hand over one piece
+                    parts, outer = self.tmp("_p"), self.out
+                    self.emit(ind, f"{parts} = []")
+                    self.out = f"{parts}.append"
+                    self.emit(ind, f"for {item} in {var}:")
+                    self.fields(self.get_spec(bt), item, fpath + "[].", ind + 1)
+                    self.flush(ind + 1)
+                    self.out = outer
+                    self.emit(ind, f"{self.out}(b''.join({parts}))")
+                    continue
                 self.emit(ind, f"for {item} in {var}:")
                 if bt == "string":
                     self.string(ind + 1, item)
@@ -368,6 +408,9 @@ class _DeserializerGen(_Writer):
                     count = str(n)
                 items = self.tmp("_l")
                 self.emit(ind, f"{items} = {target} = []")
+                if bt not in BUILTIN_NAMES and is_flat(self.get_spec(bt), self.get_spec):
+                    self._flat_array(ind, items, bt, count, fpath)
+                    continue
                 self.emit(ind, f"for _ in range({count}):")
                 if bt == "string":
                     length = self.length(ind + 1)
@@ -386,6 +429,33 @@ class _DeserializerGen(_Writer):
                     self.emit(ind + 1, f"{items}.append({var})")
                     self.fields(self.get_spec(bt), var, fpath + "[].", ind + 1)
                 self.flush(ind + 1)
+
+    def _flat_array(self, ind: int, items: str, bt: str, count: str, fpath: str) -> None:
+        """Elements of fixed-size primitives only: one ``iter_unpack`` over the whole array."""
+        sub = _DeserializerGen(self.structs, self.get_spec, self.type_name, self.numpy)
+        sub.counter = self.counter
+        var = sub.tmp("_e")
+        sub.emit(0, f"{var} = _new({dep_name(bt)})")
+        sub.fields(self.get_spec(bt), var, fpath + "[].", 0)
+        sub.flush(0)
+        self.counter = sub.counter
+        unpack = [line for line in sub.lines if ".unpack_from(view, end)" in line]
+        size = struct.calcsize("<" + _compress(
+            [(n, c) for n, c in _flat_codes(self.get_spec(bt), self.get_spec)]))
+        targets, _, call = unpack[0].partition(" = ")
+        struct_name = call.split(".", 1)[0]
+        values = self.tmp("_v")
+        if count.isdigit():  # fixed length: variable ones were checked against the data already
+            self.emit(ind, f"if {count} * {size} > len(view) - end:")
+            self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {count} * {size}, len(view) - end)")
+        self.emit(ind, f"for {values} in {struct_name}.iter_unpack(view[end:end + {count} * {size}]):")
+        for line in sub.lines:
+            if line in unpack or line.startswith("end += "):
+                continue
+            self.emit(ind + 1, line)
+        self.emit(ind + 1, f"{targets} = {values}")
+        self.emit(ind + 1, f"{items}.append({var})")
+        self.emit(ind, f"end += {count} * {size}")
 
     def _numeric_array(self, ind: int, target: str, code: str, count: str, bt: str) -> None:
         if bt == "bool":
