@@ -245,3 +245,54 @@ def test_roscpp_talker_listener(roscpp_binary, ros_core):
     # roscpp talker to rospy listener through the same master
     rospy_listener = ros_core.script(LISTENER, topic, unique("listener"))
     rospy_listener.read_until("heard: cpp", timeout=20)
+
+
+CACHED = """
+import sys, time, rospy
+rospy.init_node(sys.argv[2])
+last = None
+deadline = time.time() + 30
+while not rospy.is_shutdown() and time.time() < deadline:
+    value = rospy.get_param_cached(sys.argv[1], 'unset')
+    if value != last:
+        print('value: %s' % (value,), flush=True)
+        last = value
+    time.sleep(0.02)
+"""
+
+SPINNER = """
+import sys, rospy
+rospy.init_node(sys.argv[1])
+rospy.Subscriber('/' + sys.argv[1] + '_topic', rospy.AnyMsg, lambda m: None)
+print('up', flush=True)
+rospy.spin()
+print('spin returned', flush=True)
+"""
+
+
+def test_rospy_param_cache_follows_param_updates(ros_core):
+    key = "/" + unique("cached")
+    master = ros_core.master()
+    master.setParam("/t", key, 1)
+    node = ros_core.script(CACHED, key, unique("cacher"))
+    node.read_until("value: 1", timeout=20)
+    master.setParam("/t", key, 2)  # reaches the node as paramUpdate, not by polling the master
+    node.read_until("value: 2", timeout=10)
+    master.setParam("/t", key, {"a": 3})
+    node.read_until("value: {'a': 3}", timeout=10)
+    master.deleteParam("/t", key)
+    node.read_until("value: unset", timeout=10)
+
+
+def test_same_name_node_replaces_the_old_one(ros_core):
+    name = unique("twin")
+    first = ros_core.script(SPINNER, name)
+    first.read_until("up", timeout=20)
+    old_uri = ros_core.master().lookupNode("/t", f"/{name}")[2]
+    second = ros_core.script(SPINNER, name)
+    second.read_until("up", timeout=20)
+    # the master told the first one to shut down; rospy's spin() then returns
+    first.read_until("spin returned", timeout=15)
+    assert first.popen.wait(10) == 0
+    new_uri = ros_core.master().lookupNode("/t", f"/{name}")[2]
+    assert new_uri != old_uri and second.alive()
