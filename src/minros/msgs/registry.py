@@ -374,12 +374,6 @@ def generate_dynamic(core_type: str, full_text: str) -> Dict[str, type]:
     return dict(classes)
 
 
-def message_sources(type_name: str) -> str:
-    """The generated source of ``type_name``'s class (for ``minros msg gen``)."""
-    return REGISTRY.source(type_name)
-
-
-
 # ---------------------------------------------------------------------------------------------
 # text for people (rosmsg show / rossrv show)
 
