@@ -10,7 +10,10 @@ noisy (see shared/spec/ros1-reference.md).
 
 Scenarios
 * ping-pong round trip of a 20-byte std_msgs/String (each side answers from its receive
-  callback, subscriber tcp_nodelay), publisher queue_size=10 and queue_size=None;
+  callback, subscriber tcp_nodelay), publisher queue_size=10 and queue_size=None; the CPU
+  time the pinging process spends per round trip is shown too (steadier than wall time on a
+  shared machine). "raw" is one bidirectional TCP connection with a length prefix and
+  blocking send/recv in one thread: the floor; ROS needs two connections (one per topic);
 * small-message flood: std_msgs/String "x"*20 published as fast as possible for N seconds,
   messages per second *received*;
 * 640x480 and 1920x1080 bgr8 sensor_msgs/Image floods, frames per second received.
@@ -403,6 +406,7 @@ def _free_port() -> int:
 class Runner:
     def __init__(self, args) -> None:
         self.args = args
+        self.cpu: dict = {}  # (queue, contender) -> CPU µs per round trip of the ping process
         self.home = tempfile.mkdtemp(prefix="minros-bench-")
         self.port = _free_port()
         self.reference = os.path.exists(REFERENCE_PYTHON) and subprocess.run(
@@ -487,6 +491,8 @@ class Runner:
         else:
             r = self.pair(who, self.command(who, "echo", ["--queue", queue]),
                           self.command(who, "ping", ["--queue", queue, "--count", str(self.args.count)]))
+        if "cpu_us" in r:
+            self.cpu[(queue, who)] = self.cpu.get((queue, who), []) + [r["cpu_us"]]
         return r.get("median_us")
 
     def flood(self, who: str, kind: str):
@@ -591,6 +597,16 @@ def main(argv=None) -> int:
                     ok = med.get("minros") and med.get(other)
                     row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
             rows.append(row)
+        if "lat10" in [s[1] for s in scenarios]:
+            # CPU time is steadier than wall-clock latency on a loaded machine
+            med = {c: statistics.median(runner.cpu[("10", c)]) if runner.cpu.get(("10", c)) else None
+                   for c in contenders}
+            row = ["CPU per round trip, ping side, q=10 (µs)"] + [_fmt(med[c]) for c in contenders]
+            for other in ("rospy", "raw"):
+                if other in contenders:
+                    ok = med.get("minros") and med.get(other)
+                    row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
+            rows.insert(2 if len(rows) > 1 else 1, row)
         widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
         print(f"pubsub benchmark: {args.rounds} interleaved rounds, median; master: "
               f"{'Debian rosmaster' if runner.reference else 'minros'}; {os.cpu_count()} CPUs")

@@ -85,6 +85,7 @@ _resolved_mappings: Dict[str, str] = {}
 _caller_id = names.get_ros_namespace(argv=sys.argv) + "unnamed"
 _signal_chain: Dict[int, Any] = {}
 _init_argv: List[str] | None = None
+_initialized = False
 
 # registries filled by minros.topics / minros.services, registered with the master on init
 _publications: Dict[str, Any] = {}  # resolved topic -> publisher impl (.type, .md5sum, ...)
@@ -200,7 +201,8 @@ def get_node() -> Node | None:
 
 
 def is_initialized() -> bool:
-    return _node is not None
+    """True once init_node has registered the node (publishing is allowed from then on)."""
+    return _initialized
 
 
 def is_shutdown() -> bool:
@@ -305,7 +307,7 @@ atexit.register(lambda: signal_shutdown("atexit"))
 
 def spin() -> None:
     """Block until the node is shut down."""
-    if _node is None:
+    if not _initialized:
         raise ROSInitException("client code must call rospy.init_node() first")
     try:
         while not _shutdown_event.wait(0.5):
@@ -324,6 +326,7 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
               xmlrpc_port: int = 0, tcpros_port: int = 0) -> None:
     """Register this process as the node ``name`` with the master (rospy.init_node)."""
     global _node, _init_args, _caller_id, _argv_mappings, _resolved_mappings, _init_argv
+    global _initialized
     if argv is None:
         argv = sys.argv
     else:
@@ -374,6 +377,7 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
     for key, value in params.items():
         node.master_call("setParam", names.ns_join(caller_id, key), value)
 
+    _initialized = True  # as rospy: before /rosout and /clock are set up
     use_sim_time = False
     if not disable_rostime:
         try:
@@ -826,6 +830,16 @@ def _user_warn(text: str) -> None:
         _logger.warning(text)
 
 
+def _user_error(text: str) -> None:
+    """An ERROR line on the node's console (rospy's logerr)."""
+    try:
+        from minros import log
+
+        log.logerr(text)
+    except Exception:
+        sys.stderr.write(text + "\n")
+
+
 def _is_refused(exc: BaseException) -> bool:
     return isinstance(exc, ConnectionRefusedError) or getattr(exc, "errno", None) == errno.ECONNREFUSED
 
@@ -1024,12 +1038,12 @@ class Node:
             except Exception as exc:
                 if not self._warned_master:
                     self._warned_master = True
-                    _logger.error("Unable to immediately register with master node [%s]: master "
-                                  "may not be running yet. Will keep trying.", self.master_uri)
+                    text = (f"Unable to immediately register with master node [{self.master_uri}]: "
+                            "master may not be running yet. Will keep trying.")
                     if first:
-                        sys.stderr.write(
-                            f"Unable to immediately register with master node [{self.master_uri}]: "
-                            "master may not be running yet. Will keep trying.\n")
+                        _user_error(text)
+                    else:
+                        _logger.error(text)
                 _logger.debug("registration failed: %s", exc)
                 if _shutdown_event.wait(0.2):
                     return

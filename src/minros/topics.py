@@ -902,7 +902,7 @@ def _acquire(kind: str, name: str, data_class: Any) -> Any:
         raise ValueError("topic name must be a non-empty string")
     if data_class is None or not hasattr(data_class, "_md5sum"):
         raise ValueError(f"data_class [{data_class}] is not a message data class")
-    if _node_mod.is_initialized():
+    if _node_mod.get_node() is not None:  # init_node has named the node
         resolved = _node_mod.resolve_name(name)
     else:
         resolved = _node_mod.resolve_name_without_node_name(name)
