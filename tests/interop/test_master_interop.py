@@ -55,7 +55,7 @@ ROSCPP = r"""
 void heard(const std_msgs::String::ConstPtr& msg) { std::cout << "heard: " << msg->data << std::endl; }
 int main(int argc, char** argv) {
   std::string mode = argv[1], topic = argv[2];
-  ros::init(argc, argv, mode == "talk" ? "cpp_talker" : "cpp_listener", ros::init_options::AnonymousName);
+  ros::init(argc, argv, (mode == "talk" ? "cpp_talker" : "cpp_" + mode), ros::init_options::AnonymousName);
   ros::NodeHandle n;
   if (mode == "talk") {
     ros::Publisher pub = n.advertise<std_msgs::String>(topic, 10);
@@ -63,6 +63,15 @@ int main(int argc, char** argv) {
     for (int i = 0; ros::ok(); ++i) {
       std_msgs::String msg; msg.data = "cpp " + std::to_string(i);
       pub.publish(msg); ros::spinOnce(); rate.sleep();
+    }
+  } else if (mode == "param") {
+    std::string last = "<none>";
+    ros::Rate rate(50);
+    while (ros::ok()) {
+      std::string value;
+      if (!ros::param::getCached(topic, value)) value = "unset";
+      if (value != last) { std::cout << "value: " << value << std::endl; last = value; }
+      rate.sleep();
     }
   } else {
     ros::Subscriber sub = n.subscribe(topic, 10, heard);
@@ -296,3 +305,16 @@ def test_same_name_node_replaces_the_old_one(ros_core):
     assert first.popen.wait(10) == 0
     new_uri = ros_core.master().lookupNode("/t", f"/{name}")[2]
     assert new_uri != old_uri and second.alive()
+
+
+@pytest.mark.timeout(300)
+def test_roscpp_param_cache_follows_param_updates(roscpp_binary, ros_core):
+    key = "/" + unique("cpp_cached")
+    master = ros_core.master()
+    master.setParam("/t", key, "one")
+    node = ros_core.start(str(roscpp_binary), "param", key)
+    node.read_until("value: one", timeout=20)
+    master.setParam("/t", key, "two")
+    node.read_until("value: two", timeout=10)
+    master.deleteParam("/t", key)
+    node.read_until("value: unset", timeout=10)
