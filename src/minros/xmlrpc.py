@@ -306,7 +306,7 @@ class XmlRpcServer:
         try:
             while not self._stopping.is_set():
                 try:
-                    request = self._read_request(reader)
+                    request = self._read_request(reader, conn)
                 except _HttpError as err:
                     try:
                         conn.sendall(_status_response(err.status, str(err)))
@@ -342,7 +342,7 @@ class XmlRpcServer:
                 self._conns.pop(id(conn), None)
             self._slots.release()
 
-    def _read_request(self, reader: Any) -> Tuple[bytes, bool] | None:
+    def _read_request(self, reader: Any, conn: socket.socket) -> Tuple[bytes, bool] | None:
         """Read one request; ``None`` when the peer closed between requests or stayed idle."""
         try:
             line = reader.readline(MAX_HEADER_LINE + 1)
@@ -393,6 +393,8 @@ class XmlRpcServer:
         # Bodies in memory at once are bounded too, not only each one: wait for room, briefly.
         if not self._reserve(length):
             raise _HttpError(503, "server busy with large requests, try again")
+        if headers.get("expect", "").lower() == "100-continue" and version != "HTTP/1.0":
+            conn.sendall(b"HTTP/1.1 100 Continue\r\n\r\n")  # curl & co. wait for it
         try:
             body = reader.read(length)
         except BaseException:

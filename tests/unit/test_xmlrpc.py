@@ -283,3 +283,13 @@ def test_bodies_in_memory_are_bounded_in_total():
         assert srv._budget_used == 0
     finally:
         srv.shutdown()
+
+
+def test_expect_100_continue(server):
+    body = xmlrpc.client.dumps((1, 2), "add").encode()
+    with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
+        s.sendall(b"POST / HTTP/1.1\r\nExpect: 100-continue\r\nContent-Length: %d\r\n\r\n"
+                  % len(body))
+        assert s.recv(100) == b"HTTP/1.1 100 Continue\r\n\r\n"
+        s.sendall(body)
+        assert b"<int>3</int>" in _read_all(s)
