@@ -330,3 +330,73 @@ def test_kill_like_rosnode(graph: Graph) -> None:
         assert not victim.alive()
     finally:
         victim.stop()
+
+
+RSPY_CUSTOM_PUB = '''
+import rospy, genpy.dynamic
+text = "Header header\\nstring name\\nfloat64[] values\\ndemo_types/Point2[] points\\n" + "=" * 80 + \\
+    "\\nMSG: std_msgs/Header\\nuint32 seq\\ntime stamp\\nstring frame_id\\n" + "=" * 80 + \\
+    "\\nMSG: demo_types/Point2\\nfloat32 x\\nfloat32 y\\n"
+classes = genpy.dynamic.generate_dynamic("demo_types/Reading", text)
+Reading, Point2 = classes["demo_types/Reading"], classes["demo_types/Point2"]
+rospy.init_node("custom_pub")
+pub = rospy.Publisher("/custom", Reading, queue_size=1, latch=True)
+msg = Reading(name="rospy", values=[0.25], points=[Point2(x=1.0, y=-1.0)])
+msg.header.frame_id = "f"
+pub.publish(msg)
+print("ready", flush=True)
+rospy.spin()
+'''
+
+
+def test_echo_rospy_type_nobody_installed(graph: Graph) -> None:
+    """A rospy publisher of a type that exists only in its process: Debian's rostopic cannot
+    print it, minros decodes it from the publisher's message_definition."""
+    pub = Proc([REFERENCE_PYTHON, "-c", RSPY_CUSTOM_PUB], graph.renv)
+    try:
+        pub.read_until("ready", 30)
+        ours, reference = graph.both("rostopic", "echo", "-n", "1", "/custom")
+        assert reference.status != 0 or reference.stdout == ""  # "Cannot load message class ..."
+        assert ours.status == 0, ours.stderr
+        assert ours.stdout.endswith('  frame_id: "f"\nname: "rospy"\nvalues: [0.25]\npoints: \n'
+                                    "  - \n    x: 1.0\n    y: -1.0\n---\n"), ours.stdout
+        ours = graph.ours("rostopic", "echo", "-n", "1", "-p", "/custom/points[0]")
+        assert ours.stdout == "%time,field.x,field.y\n" + ours.stdout.splitlines()[1] + "\n"
+        assert ours.stdout.splitlines()[1].endswith(",1.0,-1.0")
+    finally:
+        pub.stop()
+
+
+def test_graph_of_mixed_nodes(graph: Graph) -> None:
+    dot = graph.ours("rqt_graph" if (BIN / "rqt_graph").exists() else "minros",
+                     *(() if (BIN / "rqt_graph").exists() else ("graph",))).stdout
+    assert '"n__rospy_demo" -> "n__minros_demo" [label="/rospy_demo_chatter"];' in dot
+    assert '"n__minros_demo" -> "n__rospy_demo" [label="/minros_demo_chatter"];' in dot
+    assert "rosout" not in dot
+
+
+def test_kill_both_ways(graph: Graph) -> None:
+    """Our rosnode kills a rospy node; Debian's rosnode kills a minros node."""
+    rospy_victim = Proc([REFERENCE_PYTHON, DEMO, "rospy_victim"], graph.renv)
+    minros_victim = Proc([PYTHON, DEMO, "minros_victim"], graph.env)
+    try:
+        rospy_victim.read_until("ready", 30)
+        minros_victim.read_until("ready", 30)
+        ours = graph.ours("rosnode", "kill", "/rospy_victim")
+        reference = graph.reference("rosnode", "kill", "/minros_victim")
+        assert ours.stdout == "killing /rospy_victim\nkilled\n" and ours.status == 0
+        assert reference.stdout == "killing /minros_victim\nkilled\n" and reference.status == 0
+        wait_until(lambda: not rospy_victim.alive() and not minros_victim.alive(), 15, what="victims exit")
+    finally:
+        rospy_victim.stop()
+        minros_victim.stop()
+
+
+def test_ping_all_and_service_wait(graph: Graph) -> None:
+    ours = graph.ours("rosnode", "ping", "--all")
+    assert ours.status == 0
+    for node in ("/minros_demo", "/rospy_demo"):
+        assert f" * {node}\n" in ours.stdout and f"pinging {node} with a timeout of 3.0s" in ours.stdout
+    assert ours.stdout.count("xmlrpc reply from http://localhost:") >= 2
+    ours = graph.ours("rosservice", "call", "--wait", "/minros_demo/trigger")
+    assert ours.stdout == 'success: True\nmessage: "triggered"\n'
