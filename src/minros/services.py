@@ -224,13 +224,17 @@ class Service:
         if self.resolved_name in getattr(node, "_services", {}):
             raise ServiceException(f"service [{self.resolved_name}] already registered")
         node.register_service(self.resolved_name, self._handle_connection)
-        #: rosrpc:// URI the master knows us by (None until init_node started the node)
-        self.uri: str | None = None
+
+    @property
+    def uri(self) -> str | None:
+        """The ``rosrpc://host:port`` URI the master knows us by (None before init_node)."""
+        from minros import node
+
         try:
             host, port = node.get_tcpros_address()
-            self.uri = f"{ROSRPC}{host}:{port}"
         except ROSException:
-            pass
+            return None
+        return f"{ROSRPC}{host}:{port}"
 
     # -- lifecycle ---------------------------------------------------------------------------
 

@@ -298,7 +298,7 @@ def stop(req):
     target.shutdown("asked to")
     return EmptyResponse()
 rospy.Service("stop_target", Empty, stop)
-print("READY", flush=True)
+print("READY %s" % target.uri, flush=True)
 rospy.spin()
 '''
 
@@ -313,11 +313,13 @@ def test_service_shutdown_unregisters(master_env, tmp_path):
         out = proc.read_until("READY", 30)
         assert "DUPLICATE service [/target] already registered" in out
         minros.wait_for_service("/target", timeout=10)
+        master = xmlrpc.client.ServerProxy(master_env["ROS_MASTER_URI"])
+        code, _msg, uri = master.lookupService("/tester", "/target")
+        assert f"READY {uri}" in out  # Service.uri is what the master hands out
         minros.ServiceProxy("/target", Empty)()
         minros.ServiceProxy("/stop_target", Empty)()
         with pytest.raises(ServiceException, match=r"service \[/target\] unavailable"):
             minros.ServiceProxy("/target", Empty)()
-        master = xmlrpc.client.ServerProxy(master_env["ROS_MASTER_URI"])
         code, _msg, _uri = master.lookupService("/tester", "/target")
         assert code == -1
         assert minros.ServiceProxy("/stop_target", Empty)() is not None
