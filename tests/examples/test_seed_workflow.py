@@ -295,3 +295,8 @@ def test_custom_message_in_workspace_package(desk: Desk):
     line = next(ln for ln in out.splitlines() if ln.startswith("got "))
     _got, msg_type, num, label = line.split()
     assert msg_type == "my_package/Num" and label == f"n{num}"
+    # and the command-line tools see the workspace's type too
+    echoed = desk.type("source ~/catkin_ws/devel/setup.bash\nrostopic echo -n 1 /numbers\n", timeout=30)
+    fields = dict(ln.split(": ", 1) for ln in echoed.splitlines() if ": " in ln)
+    assert int(fields["num"]) >= 0 and fields["label"].strip('"') == f"n{fields['num']}"
+    assert "---" in echoed
