@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import xmlrpc.client
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Tuple
 
@@ -121,9 +120,7 @@ def _parents(key: str) -> List[str]:
 
 def _short(value: Any) -> str:
     """A parameter value as the summary shows it: at most 20 characters, printable only."""
-    if isinstance(value, xmlrpc.client.Binary):
-        value = value.data
-    text = str(value)
+    text = str(value)  # a Binary shows its bytes decoded as latin-1, as in roslaunch
     if len(text) > 20:
         text = text[:17] + "..."
     def printable(s: str) -> bool:
