@@ -347,7 +347,7 @@ class LaunchRunner:
             raise LaunchError(
                 f"cannot launch node of type [{spec.package}/{spec.type}]: Cannot locate node of type "
                 f"[{spec.type}] in package [{spec.package}]. Make sure file exists in package path "
-                f"and permission is set to executable (chmod +x) ({exc.short})",
+                "and permission is set to executable (chmod +x)",
                 spec.filename, spec.line) from None
         try:
             prefix = shlex.split(spec.launch_prefix) if spec.launch_prefix else []
