@@ -19,8 +19,8 @@ LOG_LINE = r"\[INFO\] \[\d+\.\d+\]: "
     # seed 000: "Hello ROS!"
     ("my_publisher.py", "my_subscriber.py", r"Hello ROS!", "my_subscriber"),
 ])
-def test_seed_publisher_and_subscriber(minros_master, ros_home, publisher, subscriber, pub_text, sub_name):
-    env = ros_env(minros_master, ros_home)
+def test_seed_publisher_and_subscriber(minros_core, ros_home, publisher, subscriber, pub_text, sub_name):
+    env = ros_env(minros_core, ros_home)
     pub = Proc([PYTHON, str(SEED_DIR / publisher)], env)
     sub = Proc([PYTHON, str(SEED_DIR / subscriber)], env)
     try:
