@@ -172,9 +172,15 @@ def test_include_errors(tmp_path: Path):
                    '<arg name="y" value="2"/></include></launch>')
     with pytest.raises(LaunchError, match=r"unused args \[y\] for include of"):
         load_launch(unused)
-    missing = write(tmp_path, "missing.launch", '<launch><include file="/no/such.launch"/></launch>')
-    with pytest.raises(LaunchError, match="/no/such.launch: cannot read launch file"):
+    missing = write(tmp_path, "missing.launch", '<launch>\n<include file="/no/such.launch"/></launch>')
+    with pytest.raises(LaunchError) as err:
         load_launch(missing)
+    assert str(err.value) == (f"{missing}:2: cannot read included file [/no/such.launch]: "
+                              "cannot read launch file: No such file or directory")
+    broken = write(tmp_path, "broken.launch", "<launch>\n<param name='x'\n</launch>")
+    includer = write(tmp_path, "includer.launch", f'<launch><include file="{broken}"/></launch>')
+    with pytest.raises(LaunchError, match=rf"^{broken}:3: Invalid roslaunch XML syntax"):
+        load_launch(includer)
 
 
 def test_cyclic_include_is_detected(tmp_path: Path):

@@ -643,7 +643,12 @@ class Loader:
         if identity in self._stack:
             chain = " -> ".join(self._stack_names + [inc])
             raise self._err(scope, el, f"cyclic include of [{inc}]: {chain}")
-        root = read_launch_file(inc)
+        try:
+            root = read_launch_file(inc)
+        except LaunchError as exc:
+            if exc.line is not None:  # a syntax error inside the included file: its own place
+                raise
+            raise self._err(scope, el, f"cannot read included file [{inc}]: {exc.message}") from None
         self.config.files.append(inc)
         self._stack.append(identity)
         self._stack_names.append(inc)
