@@ -308,3 +308,16 @@ def test_killed_roslaunch_takes_its_nodes_along(tmp_path, pkg):
         wait_until(lambda: all(_gone(pid) for pid in pids), timeout=10, what="children gone")
     finally:
         proc.stop()
+
+
+def test_screen_flag_and_launch_prefix(tmp_path, pkg):
+    xml = """<launch>
+      <node pkg="launch_probe" type="probe.py" name="quiet" launch-prefix="env PROBE_ENV=prefixed"/>
+    </launch>"""
+    proc, _port = _launch(tmp_path, pkg, xml, "--screen")
+    try:
+        text = proc.read_until("PROBE", timeout=20)  # output="log" node, shown because of --screen
+    finally:
+        proc.stop()
+    line = next(ln for ln in text.splitlines() if ln.startswith("PROBE"))
+    assert line.split()[3] == "prefixed"
