@@ -93,7 +93,7 @@ def _send_all(sock: socket.socket, data: bytes) -> None:
 
 
 def _recv_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER) -> Dict[str, str]:
-    """Read one connection header from ``sock`` (blocking, honours the socket timeout)."""
+    """Read one connection header from ``sock``; the socket's timeout bounds every read."""
     data = bytearray()
     while True:
         parsed = tcpros.read_header_block(data, max_size)
@@ -103,22 +103,15 @@ def _recv_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER)
                 raise TransportInitError("unexpected data after the connection header")
             return fields
         need = 4 - len(data) if len(data) < 4 else 4 + int.from_bytes(data[:4], "little") - len(data)
-        chunk = _recv_some(sock, min(need, 65536))
+        try:
+            chunk = sock.recv(min(need, 65536))
+        except socket.timeout:
+            raise TransportInitError("timed out waiting for the connection header") from None
+        except OSError as exc:
+            raise TransportInitError(f"unable to receive the connection header: {exc}") from None
         if not chunk:
             raise TransportInitError("connection closed before the connection header was complete")
         data += chunk
-
-
-def _recv_some(sock: socket.socket, size: int) -> bytes:
-    """One recv that keeps waiting through socket timeouts unless the node shuts down."""
-    while True:
-        try:
-            return sock.recv(size)
-        except socket.timeout:
-            if _is_shutdown():
-                raise TransportTerminated("node shutdown") from None
-        except OSError as exc:
-            raise TransportTerminated(f"unable to receive data from sender: {exc}") from None
 
 
 class _FrameSource:

@@ -389,6 +389,27 @@ def test_big_request_and_response(master_env, tmp_path):
         proc.stop()
 
 
+def test_silent_server_times_out_the_handshake(master_env, monkeypatch):
+    """A peer that accepts but never sends its header cannot hang the caller."""
+    from minros import services
+
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(1)
+        port = listener.getsockname()[1]
+        master = xmlrpc.client.ServerProxy(master_env["ROS_MASTER_URI"])
+        code, msg, _ = master.registerService("/silent_node", "/silent", f"rosrpc://127.0.0.1:{port}",
+                                              "http://127.0.0.1:1/")
+        assert code == 1, msg
+        monkeypatch.setattr(services, "CONNECT_TIMEOUT", 0.3)
+        start = time.monotonic()
+        with pytest.raises(ServiceException) as info:
+            minros.ServiceProxy("/silent", _srv())(1, 2)
+        assert time.monotonic() - start < 5
+        assert str(info.value) == ("unable to connect to service: "
+                                   "timed out waiting for the connection header")
+
+
 def test_parse_rosrpc_uri():
     assert parse_rosrpc_uri("rosrpc://host:1234") == ("host", 1234)
     assert parse_rosrpc_uri("rosrpc://10.0.0.1:99/extra") == ("10.0.0.1", 99)
