@@ -193,6 +193,11 @@ def compute_param_updates(subscriptions: Registrations, param_key: str, param_va
     return updates
 
 
+def _snapshot(value: Any) -> Any:
+    """A copy of a namespace (dicts are the only values the tree mutates in place)."""
+    return copy.deepcopy(value) if type(value) is dict else value
+
+
 # ====================================================================== registrations (pure)
 
 
@@ -661,9 +666,7 @@ class MasterHandler:
 
     def _notify_param_subscribers(self, updates: List[Tuple[List[Caller], str, Any]]) -> None:
         for callers, key, value in updates:
-            if type(value) is dict:
-                # a snapshot: the tree's own dict may change before the call is made
-                value = copy.deepcopy(value)
+            value = _snapshot(value)  # the tree's own dict may change before the call is made
             for _caller_id, caller_api in callers:
                 self._pool.queue(caller_api, "paramUpdate", ("/master", key, value),
                                  coalesce=("paramUpdate", key),
@@ -728,9 +731,12 @@ class MasterHandler:
         key = _resolve_name(key, caller_id)
         with self._lock:
             try:
-                return 1, f"Parameter [{key}]", self._params.get(key)
+                value = self._params.get(key)
             except KeyError:
                 return -1, f"Parameter [{key}] is not set", 0
+            # a namespace is marshalled after the lock is released: hand out a snapshot so a
+            # concurrent setParam below it cannot change the dict mid-serialization
+            return 1, f"Parameter [{key}]", _snapshot(value)
 
     @api(0, (non_empty_str("key"),))
     def searchParam(self, caller_id: str, key: str) -> Any:
@@ -746,7 +752,7 @@ class MasterHandler:
         with self._lock:
             sub_key = _subscription_key(key)
             try:
-                value = self._params.get(sub_key)
+                value = _snapshot(self._params.get(sub_key))
             except KeyError:
                 value = {}
             self._reg.register_param_subscriber(sub_key, caller_id, caller_api)

@@ -290,3 +290,17 @@ def test_callback_pool_coalesces_only_a_backlog():
         assert len(seen) < 200
     finally:
         pool.stop()
+
+
+
+def test_namespaces_are_handed_out_as_snapshots():
+    # getParam's value is marshalled after the lock is released: a later setParam below the
+    # namespace must not change it underneath (that would break serialization mid-way)
+    h = MasterHandler(FakePool())
+    h.setParam("/w", "/ns", {"a": {"b": 1}})
+    value = h.getParam("/r", "/ns")[2]
+    subscribed = h.subscribeParam("/r", "http://r:1/", "/ns")[2]
+    h.setParam("/w", "/ns/a/c", 2)
+    h.setParam("/w", "/ns/d", 3)
+    assert value == {"a": {"b": 1}} and subscribed == {"a": {"b": 1}}
+    assert h.getParam("/r", "/ns")[2] == {"a": {"b": 1, "c": 2}, "d": 3}
