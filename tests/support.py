@@ -27,7 +27,7 @@ REFERENCE_PYTHON = "/usr/bin/python3"
 IN_CI = bool(os.environ.get("CI"))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def reference_available() -> bool:
     """Whether Debian's ROS 1 (rospy, rosmaster, genpy, tools) is installed."""
     if not os.path.exists(REFERENCE_PYTHON):

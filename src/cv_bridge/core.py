@@ -154,6 +154,7 @@ class CvBridge:
     def cv2_to_compressed_imgmsg(self, cvim: np.ndarray, dst_format: str = "jpg"):
         """Encode ``cvim`` as a sensor_msgs/CompressedImage in ``dst_format`` (jpg, png, ...)."""
         import cv2
+
         from sensor_msgs.msg import CompressedImage
 
         if not isinstance(cvim, (np.ndarray, np.generic)):

@@ -73,10 +73,11 @@ def run(command: str, argv: List[str], prog: Optional[str] = None) -> int:
         return 130
     except BrokenPipeError:
         # `rostopic echo /x | head`: the reader went away; not an error worth a traceback.
-        try:
-            sys.stdout = None  # type: ignore[assignment]
-        finally:
-            return 0
+        # Point stdout at devnull so the interpreter's final flush does not raise again.
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 def main(argv: Optional[List[str]] = None) -> int:
