@@ -15,13 +15,17 @@ PKGS="ros-core python3-rosmaster python3-roslaunch rosout
   ros-stereo-msgs python3-stereo-msgs ros-trajectory-msgs python3-trajectory-msgs
   ros-visualization-msgs python3-visualization-msgs ros-tf2-msgs python3-tf2-msgs
   ros-roscpp-msg python3-roscpp-msg ros-rosgraph-msgs python3-rosgraph-msgs
-  python3-cv-bridge python3-numpy libroscpp-dev g++ pkg-config"
+  python3-cv-bridge python3-numpy libroscpp-dev g++ pkg-config python3-catkin-pkg"
+# Tools the tests drive besides ROS: a virtual display for turtlesim's window, zsh for
+# devel/setup.zsh.
+TEST_TOOLS="xvfb zsh"
 if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msgs.msg, tf2_msgs.msg' 2>/dev/null \
-   && command -v rostopic >/dev/null && pkg-config --exists roscpp std_msgs; then
+   && command -v rostopic >/dev/null && command -v catkin_create_pkg >/dev/null \
+   && pkg-config --exists roscpp std_msgs && command -v Xvfb >/dev/null && command -v zsh >/dev/null; then
   echo "ROS 1 reference already installed"
   exit 0
 fi
 $SUDO apt-get update -q
 # shellcheck disable=SC2086
-DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $PKGS
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $PKGS $TEST_TOOLS
 /usr/bin/python3 -c 'import rospy, rosmaster, genpy' && echo "ROS 1 reference installed"
