@@ -23,6 +23,7 @@ import argparse
 import collections
 import copy
 import functools
+import logging
 import os
 import signal
 import sys
@@ -41,6 +42,11 @@ MAX_QUEUED_PER_NODE = 10000
 #: Queued calls to one node beyond which a newer update replaces a queued one for the same key.
 COALESCE_BACKLOG = 32
 ROSRPC = "rosrpc://"
+
+#: What the master did (+PUB, -SUB, +PARAM ... as in rosmaster's master.log); no handler is
+#: attached unless :func:`configure_log_file` is called, so library use stays silent.
+_log = logging.getLogger("minros.master")
+_log.propagate = False
 
 Caller = Tuple[str, str]  # (caller_id, caller_api)
 
@@ -457,9 +463,10 @@ class CallbackPool:
                 self._busy.add(api)
             try:
                 result = self._call(api, method, args)
-            except Exception as exc:  # noqa: BLE001 - a dead node is normal; logged nowhere
+            except Exception as exc:  # noqa: BLE001 - a dead node is normal: logged, not raised
                 result = exc
                 self._forget_proxy(api)
+                _log.info("%s -> %s failed: %s", method, api, exc)
             if on_result is not None:
                 try:
                     on_result(result)
@@ -655,6 +662,7 @@ class MasterHandler:
         self._uri = uri
 
     def _bump_node(self, old_api: str, caller_id: str) -> None:
+        _log.warning("new node registered with same name [%s]: shutting down %s", caller_id, old_api)
         self._pool.queue(old_api, "shutdown",
                          ("/master", f"[{caller_id}] Reason: new node registered with same name"))
 
@@ -714,6 +722,7 @@ class MasterHandler:
             updates = compute_param_updates(self._reg.param_subscribers, key, {})
             if updates:
                 self._notify_param_subscribers(updates)
+        _log.info("-PARAM [%s] by %s", key, caller_id)
         return 1, f"parameter {key} deleted", 0
 
     @api(0, (non_empty_str("key"), not_none("value")))
@@ -724,6 +733,7 @@ class MasterHandler:
             updates = compute_param_updates(self._reg.param_subscribers, key, value, caller_id)
             if updates:
                 self._notify_param_subscribers(updates)
+        _log.info("+PARAM [%s] by %s", key, caller_id)
         return 1, f"parameter {key} set", 0
 
     @api(0, (non_empty_str("key"),))
@@ -756,6 +766,7 @@ class MasterHandler:
             except KeyError:
                 value = {}
             self._reg.register_param_subscriber(sub_key, caller_id, caller_api)
+        _log.info("+CACHEDPARAM [%s] by %s", key, caller_id)
         return 1, f"Subscribed to parameter [{key}]", value
 
     @api(0, (is_api("caller_api"), non_empty_str("key")))
@@ -763,6 +774,7 @@ class MasterHandler:
         key = _resolve_name(key, caller_id)
         with self._lock:
             self._reg.unregister_param_subscriber(_subscription_key(key), caller_id, caller_api)
+        _log.info("-CACHEDPARAM [%s] by %s", key, caller_id)
         return 1, f"Unsubscribe to parameter [{key}]", 1
 
     @api(False, (non_empty_str("key"),))
@@ -783,6 +795,7 @@ class MasterHandler:
                         caller_api: str) -> Any:
         with self._lock:
             self._reg.register_service(service, caller_id, caller_api, service_api)
+        _log.info("+SERVICE [%s] %s %s", service, caller_id, caller_api)
         return 1, f"Registered [{caller_id}] as provider of [{service}]", 1
 
     @api("", (is_topic("service"),))
@@ -796,7 +809,9 @@ class MasterHandler:
     @api(0, (is_topic("service"), is_api("service_api")))
     def unregisterService(self, caller_id: str, service: str, service_api: str) -> Any:
         with self._lock:
-            return self._reg.unregister_service(service, caller_id, service_api)
+            result = self._reg.unregister_service(service, caller_id, service_api)
+        _log.info("-SERVICE [%s] %s %s", service, caller_id, service_api)
+        return result
 
     # -- topics
 
@@ -808,12 +823,15 @@ class MasterHandler:
             if topic not in self._topic_types and topic_type != ANYTYPE:
                 self._topic_types[topic] = topic_type
             pub_uris = self._reg.publishers.get_apis(topic)
+        _log.info("+SUB [%s] %s %s", topic, caller_id, caller_api)
         return 1, f"Subscribed to [{topic}]", pub_uris
 
     @api(0, (is_topic("topic"), is_api("caller_api")))
     def unregisterSubscriber(self, caller_id: str, topic: str, caller_api: str) -> Any:
         with self._lock:
-            return self._reg.unregister_subscriber(topic, caller_id, caller_api)
+            result = self._reg.unregister_subscriber(topic, caller_id, caller_api)
+        _log.info("-SUB [%s] %s %s", topic, caller_id, caller_api)
+        return result
 
     @api([], (is_topic("topic"), valid_type_name("topic_type"), is_api("caller_api")))
     def registerPublisher(self, caller_id: str, topic: str, topic_type: str,
@@ -825,6 +843,7 @@ class MasterHandler:
                 self._topic_types[topic] = topic_type
             self._notify_topic_subscribers(topic)
             sub_uris = self._reg.subscribers.get_apis(topic)
+        _log.info("+PUB [%s] %s %s", topic, caller_id, caller_api)
         return 1, f"Registered [{caller_id}] as publisher of [{topic}]", sub_uris
 
     @api(0, (is_topic("topic"), is_api("caller_api")))
@@ -833,6 +852,7 @@ class MasterHandler:
             result = self._reg.unregister_publisher(topic, caller_id, caller_api)
             if result[2]:
                 self._notify_topic_subscribers(topic)
+        _log.info("-PUB [%s] %s %s", topic, caller_id, caller_api)
         return result
 
     # -- graph introspection
@@ -921,6 +941,19 @@ class Master:
         self.pool.stop()
 
 
+def configure_log_file(path: str) -> bool:
+    """Write the master's log to ``path`` (rosmaster's master.log); False if it cannot."""
+    try:
+        os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+        handler = logging.FileHandler(path, encoding="utf-8")
+    except OSError:
+        return False
+    handler.setFormatter(logging.Formatter("[%(name)s][%(levelname)s] %(asctime)s: %(message)s"))
+    _log.addHandler(handler)
+    _log.setLevel(logging.INFO)
+    return True
+
+
 def install_stop_signals(stop: Callable[[], None]) -> None:
     """SIGINT/SIGTERM stop the master cleanly (no traceback)."""
     def handle(signum: int, frame: Any) -> None:
@@ -943,8 +976,11 @@ def main(argv: List[str] | None = None, prog: str = "minros master") -> int:
                         help="timeout of one callback to a node, in seconds")
     parser.add_argument("--master-logger-level", default=None, help="accepted and ignored")
     args, rest = parser.parse_known_args(argv)
+    log_path = ""
     for extra in rest:
-        if not extra.startswith("__log:="):
+        if extra.startswith("__log:="):
+            log_path = os.path.abspath(extra[len("__log:="):])
+        else:
             parser.error(f"unrecognized arg: {extra}")
     if not 0 < args.port < 65536:
         parser.error(f"invalid port {args.port}")
@@ -954,6 +990,10 @@ def main(argv: List[str] | None = None, prog: str = "minros master") -> int:
     except OSError as exc:
         print(f"{prog}: cannot listen on port {args.port}: {exc.strerror or exc}", file=sys.stderr)
         return 1
+    from minros.rosout import log_dir
+
+    configure_log_file(log_path or str(log_dir() / "master.log"))
+    _log.info("Master initialized: port[%s], uri[%s]", master.port, master.uri)
     install_stop_signals(master._stopped.set)
     try:
         while not master.wait(1.0):

@@ -22,6 +22,7 @@ from urllib.parse import urlparse
 #: minros implements the Noetic protocols; tools that ask for the distro get a real one.
 ROSDISTRO = "noetic"
 DEFAULT_PORT = 11311
+ROSCORE_PARAMS = ("/rosdistro", "/rosversion", "/run_id")
 DISK_USAGE_WARNING = 1 << 30
 
 
@@ -79,6 +80,18 @@ def _log_usage(directory: str) -> int:
             except OSError:
                 pass
     return total
+
+
+def _link_latest(base: str, run_dir: str) -> None:
+    """``<log dir>/latest`` -> this run's directory, as roslaunch maintains it."""
+    link = os.path.join(base, "latest")
+    try:
+        if os.path.islink(link):
+            os.unlink(link)
+        if not os.path.exists(link):
+            os.symlink(run_dir, link)
+    except OSError:
+        pass  # a read-only or odd log directory is not worth failing over
 
 
 class RosoutProcess:
@@ -165,8 +178,16 @@ def main(argv: List[str], prog: str = "minros core") -> int:
         kwargs["workers"] = max(1, args.numworkers)
     if args.timeout:
         kwargs["callback_timeout"] = args.timeout
+    import uuid
+
+    run_id = str(uuid.uuid1())
+    version = _version()
     try:
         core = master_mod.Master(port, hostname=args.host, **kwargs)
+        # set before the server starts, so that no client ever sees a master without them
+        core.handler.setParam("/roscore", "/rosdistro", ROSDISTRO + "\n")
+        core.handler.setParam("/roscore", "/rosversion", version + "\n")
+        core.handler.setParam("/roscore", "/run_id", run_id)
         core.start()
     except OSError as exc:
         print(f"{prog}: cannot listen on port {port}: {exc.strerror or exc}", file=sys.stderr)
@@ -183,16 +204,7 @@ def main(argv: List[str], prog: str = "minros core") -> int:
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
 
-    import uuid
-
     from minros.rosout import log_dir
-
-    run_id = str(uuid.uuid1())
-    version = _version()
-    handler = core.handler
-    handler.setParam("/roscore", "/rosdistro", ROSDISTRO + "\n")
-    handler.setParam("/roscore", "/rosversion", version + "\n")
-    handler.setParam("/roscore", "/run_id", run_id)
 
     base_log = str(log_dir(env))
     run_log = os.path.join(base_log, run_id)
@@ -202,6 +214,12 @@ def main(argv: List[str], prog: str = "minros core") -> int:
         print(f"{prog}: cannot create log directory {run_log}: {exc.strerror or exc}",
               file=sys.stderr)
         run_log = ""
+    if run_log:
+        master_mod.configure_log_file(os.path.join(run_log, "master.log"))
+        master_mod._log.info("Master initialized: port[%s], uri[%s]", core.port, core.uri)
+        for key in ROSCORE_PARAMS:
+            master_mod._log.info("+PARAM [%s] by /roscore", key)
+        _link_latest(base_log, run_log)
     out = sys.stdout
     if run_log:
         out.write(f"... logging to {run_log}\n")
