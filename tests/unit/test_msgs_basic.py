@@ -75,3 +75,31 @@ def test_unknown_type() -> None:
         get_message_class("std_msgs/Nope")
     with pytest.raises(ImportError):
         from std_msgs.msg import Nope  # noqa: F401
+
+
+def test_concurrent_first_use_gives_one_class_per_type() -> None:
+    import threading
+
+    from minros.msgs import MsgContext
+
+    ctx = MsgContext()
+    names = ["visualization_msgs/MarkerArray", "nav_msgs/Odometry", "sensor_msgs/PointCloud2",
+             "diagnostic_msgs/DiagnosticArray", "trajectory_msgs/JointTrajectory"]
+    results: list = []
+    errors: list = []
+    start = threading.Barrier(6)
+
+    def load() -> None:
+        try:
+            start.wait(5)
+            results.append(tuple(ctx.get_class(n) for n in names))
+        except Exception as exc:  # noqa: BLE001 - reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=load) for _ in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    assert not errors and len(results) == 6
+    assert all(r == results[0] for r in results)
