@@ -58,11 +58,11 @@ def test_hz_and_echo_keep_up(env: dict, kind: str, rate: int, echo_args: list) -
     pub = Proc([PYTHON, PUB, kind, str(rate)], env)
     try:
         pub.read_until("ready", 30)
-        hz = _run_for([str(BIN / "rostopic"), "hz", topic], env, 2.5)
+        hz = _run_for([str(BIN / "rostopic"), "hz", topic], env, 2.0)
         measured = _last_rate(hz)
         assert 0.5 * rate < measured < 1.3 * rate, hz
         start = time.monotonic()
-        echo = _run_for([str(BIN / "rostopic"), "echo", *echo_args, topic], env, 2.5)
+        echo = _run_for([str(BIN / "rostopic"), "echo", *echo_args, topic], env, 2.0)
         elapsed = time.monotonic() - start
         printed = echo.count("\n---\n")
         # the tool needs ~0.5 s to start and subscribe; then it must print at the topic's rate
