@@ -23,9 +23,11 @@ def master(port: int):
 def core(ros_home):
     port = free_port()
     proc = Proc([PYTHON, "-m", "minros", "core", "-p", str(port)], ros_env(port, ros_home))
-    head = proc.read_until("started core service [/rosout]", timeout=20)
-    yield port, proc, head
-    proc.stop()
+    try:
+        head = proc.read_until("started core service [/rosout]", timeout=20)
+        yield port, proc, head
+    finally:
+        proc.stop()
 
 
 def test_core_prints_summary_and_sets_roscore_params(core):

@@ -64,6 +64,29 @@ def _master_running(port: int) -> bool:
         return False
 
 
+class _Console:
+    """stdout that never raises: a closed terminal or pipe must not stop the clean shutdown."""
+
+    def __init__(self, stream) -> None:
+        self.stream = stream
+
+    def write(self, text: str) -> None:
+        if self.stream is None:
+            return
+        try:
+            self.stream.write(text)
+        except (OSError, ValueError):
+            self.stream = None
+
+    def flush(self) -> None:
+        if self.stream is None:
+            return
+        try:
+            self.stream.flush()
+        except (OSError, ValueError):
+            self.stream = None
+
+
 class _Style:
     def __init__(self, tty: bool) -> None:
         self.bold = "\033[1m" if tty else ""
@@ -220,7 +243,7 @@ def main(argv: List[str], prog: str = "minros core") -> int:
         for key in ROSCORE_PARAMS:
             master_mod._log.info("+PARAM [%s] by /roscore", key)
         _link_latest(base_log, run_log)
-    out = sys.stdout
+    out = _Console(sys.stdout)
     if run_log:
         out.write(f"... logging to {run_log}\n")
         out.write("Checking log directory for disk usage. This may take a while.\n"
