@@ -167,9 +167,21 @@ def test_mimic_follows_across_two_simulators(minros_core, ros_home):
                   "input:=turtlesim1/turtle1", "output:=turtlesim2/turtle1"], ros_env(port, ros_home))
     try:
         assert "Starting turtlesim with node name /turtlesim1/sim" in sims[0].startup
-        moving = probe(port, ros_home, "drive", "/turtlesim1/turtle1")["moving"]
-        assert moving["linear_velocity"] == 2.0
-        follower = probe(port, ros_home, "wait_moving", "/turtlesim2/turtle1/pose", "2.0")["pose"]
+        # Watch turtlesim2 first, then keep turtlesim1 driven until the follower moved (the
+        # mimic node may still be connecting when the driving starts).
+        watcher = Proc([PYTHON, PROBE, "wait_moving", "/turtlesim2/turtle1/pose", "2.0"],
+                       ros_env(port, ros_home))
+        driver = None
+        try:
+            watcher.read_until("READY", timeout=15)
+            driver = Proc([PYTHON, PROBE, "drive", "/turtlesim1/turtle1", "30"],
+                          ros_env(port, ros_home))
+            out = watcher.read_until("RESULT ", timeout=20)
+        finally:
+            watcher.stop()
+            if driver is not None:
+                driver.stop()
+        follower = json.loads(out.split("RESULT ", 1)[1].splitlines()[0])["pose"]
         assert follower["angular_velocity"] == 1.0
         assert follower["x"] != pytest.approx(float(CENTER), abs=1e-3)
     finally:

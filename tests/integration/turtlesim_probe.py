@@ -57,8 +57,9 @@ def pose_dict(p) -> dict:
             "angular_velocity": p.angular_velocity}
 
 
-def cmd_drive(ns: str) -> dict:
-    """Publish a Twist on <ns>/cmd_vel until <ns>/pose moves; report before/after and rate."""
+def cmd_drive(ns: str, hold: str = "0") -> dict:
+    """Publish a Twist on <ns>/cmd_vel until <ns>/pose moves (then ``hold`` seconds more);
+    report the poses before and while moving."""
     poses = Latest(f"{ns}/pose", Pose)
     first = poses.wait()
     pub = rospy.Publisher(f"{ns}/cmd_vel", Twist, queue_size=1)
@@ -72,6 +73,10 @@ def cmd_drive(ns: str) -> dict:
             break
         time.sleep(0.05)
     moving = poses.wait(lambda m: m[-1].linear_velocity == 2.0 and m[-1].x != first.x)
+    end = time.monotonic() + float(hold)
+    while time.monotonic() < end and not rospy.is_shutdown():
+        pub.publish(twist)
+        time.sleep(0.05)
     return {"first": pose_dict(first), "moving": pose_dict(moving)}
 
 
@@ -157,6 +162,8 @@ def cmd_first_twist(topic: str) -> dict:
 def cmd_wait_moving(topic: str, speed: str) -> dict:
     """Wait until a pose on ``topic`` reports linear_velocity == speed."""
     poses = Latest(topic, Pose)
+    poses.wait()
+    print("READY", flush=True)  # connected: the caller may start the motion now
     moving = poses.wait(lambda m: bool(m) and abs(m[-1].linear_velocity - float(speed)) < 1e-6)
     return {"pose": pose_dict(moving)}
 
