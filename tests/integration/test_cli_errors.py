@@ -125,6 +125,8 @@ def test_param_bad_input(graph: dict, args: list, status: int, needles: list) ->
     (["info", "/nope"], ["ERROR: Unknown topic /nope"]),
     (["type", "/nope"], ["unknown topic type [/nope]"]),
     (["echo", "--filter", "m.data ==", "/demo_chatter"], ["ERROR: invalid filter expression"]),
+    (["echo", "/pose/pose/nope"], ["ERROR: no field named [pose/nope] in topic [/pose]"]),
+    (["hz", "/demo_chatter/text"], ["ERROR: no field named [text]"]),
 ])
 def test_topic_bad_input(graph: dict, args: list, needles: list) -> None:
     done = run("rostopic", *args, env=graph)

@@ -101,10 +101,26 @@ def topic_type(master: Master, topic: str) -> Tuple[str | None, str | None, str]
     return None, None, ""
 
 
+def _field_error(master: Master, topic: str) -> str | None:
+    """Why ``topic`` cannot be a field of a published topic of an installed type (or None)."""
+    for name, type_name in sorted(master.topic_types(), reverse=True):
+        if not topic.startswith(name + "/"):
+            continue
+        field = topic[len(name) + 1:].rstrip("/").split("[")[0]
+        cls = _message_class(type_name)
+        if field and cls is not None and not _nested_ok(cls, field):
+            return f"no field named [{field}] in topic [{name}] of type [{type_name}]"
+    return None
+
+
 def wait_topic_type(master: Master, topic: str) -> Tuple[str, str, str]:
     found = topic_type(master, topic)
     if found[0]:
         return found  # type: ignore[return-value]
+    # a misspelt field of a topic that exists is an error, not something to wait for
+    problem = _field_error(master, topic)
+    if problem:
+        raise ToolError(problem)
     sys.stderr.write(f"WARNING: topic [{topic}] does not appear to be published yet\n")
     sys.stderr.flush()
     from minros import node
