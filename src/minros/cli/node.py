@@ -62,6 +62,8 @@ def get_node_names(master: Master, namespace: str | None = None) -> List[str]:
 
 
 def _remote(triplet: list) -> object:
+    if not isinstance(triplet, (list, tuple)) or len(triplet) != 3:
+        raise ToolError(f"remote call failed: malformed reply {str(triplet)[:80]}")
     code, msg, value = triplet
     if code != 1:
         raise ToolError(f"remote call failed: {msg}")
@@ -144,6 +146,8 @@ def connection_description(graph: _Graph, node_uri: str) -> str:
         businfo = _remote(call_node(node_uri, "getBusInfo", ID))
     except OSError:
         raise ToolError(f"Communication with node[{node_uri}] failed!") from None
+    if not isinstance(businfo, list) or not all(isinstance(i, list) and len(i) >= 5 for i in businfo):
+        raise ToolError(f"remote call failed: malformed getBusInfo reply from [{node_uri}]")
     if businfo:
         out += "Connections:\n"
         for info in businfo:
