@@ -232,7 +232,8 @@ def test_param_load_delete_like_rosparam(graph: Graph, tmp_path: Path) -> None:
 def test_echo_field_and_noarr_like_rostopic(graph: Graph) -> None:
     cases = [("rostopic", "echo", "-n", "1", "/pose/pose/position"),
              ("rostopic", "echo", "-n", "1", "--noarr", "/pose"),
-             ("rostopic", "echo", "-n", "1", "--nostr", "/pose/header")]
+             ("rostopic", "echo", "-n", "1", "--nostr", "/pose/header"),
+             ("rostopic", "echo", "-n", "1", "-w", "4", "/pose/pose")]
     for ours, reference in graph.many(cases):
         assert_same(ours, reference)
 
