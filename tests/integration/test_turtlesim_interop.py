@@ -31,12 +31,11 @@ def turtlesim_pythonpath(tmp_path_factory) -> str:
     pkg = out / "turtlesim"
     for kind, tool in (("msg", "genmsg_py.py"), ("srv", "gensrv_py.py")):
         files = sorted(str(p) for p in (share / kind).glob(f"*.{kind}"))
-        for f in files:
-            subprocess.run([
-                "/usr/bin/python3", f"/usr/lib/genpy/{tool}", "-p", "turtlesim",
-                "-o", str(pkg / kind), "-I", f"turtlesim:{share / 'msg'}",
-                "-I", "std_msgs:/usr/share/std_msgs/msg", f],
-                env=env, check=True, capture_output=True, timeout=60)
+        subprocess.run([
+            "/usr/bin/python3", f"/usr/lib/genpy/{tool}", "-p", "turtlesim",
+            "-o", str(pkg / kind), "-I", f"turtlesim:{share / 'msg'}",
+            "-I", "std_msgs:/usr/share/std_msgs/msg", *files],
+            env=env, check=True, capture_output=True, timeout=60)
         subprocess.run(["/usr/bin/python3", f"/usr/lib/genpy/{tool}", "--initpy", "-p",
                         "turtlesim", "-o", str(pkg / kind)],
                        env=env, check=True, capture_output=True, timeout=60)
