@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any, List, TextIO
 
@@ -81,11 +82,33 @@ class RotatingLog:
             self._file.close()
 
 
+def _exit_with_core(minros: Any) -> None:
+    """When started by ``minros core`` (which sets MINROS_CORE_PID), shut down if it dies:
+    a core killed with SIGKILL must not leave an orphaned rosout behind."""
+    try:
+        core_pid = int(os.environ.get("MINROS_CORE_PID", ""))
+    except ValueError:
+        return
+
+    def watch() -> None:
+        while os.getppid() == core_pid:
+            time.sleep(0.5)
+        try:
+            minros.signal_shutdown("minros core went away")
+        except Exception:  # noqa: BLE001 - e.g. not initialized yet: we exit below anyway
+            pass
+        time.sleep(3.0)  # a clean shutdown has this long (the master is gone: nothing to wait for)
+        os._exit(0)
+
+    threading.Thread(target=watch, name="rosout-core-watch", daemon=True).start()
+
+
 def main(argv: List[str] | None = None) -> int:
     argv = sys.argv if argv is None else argv
     import minros
     from rosgraph_msgs.msg import Log
 
+    _exit_with_core(minros)  # before init_node, which waits for a master that may be gone
     minros.init_node("rosout", argv=argv, disable_rosout=True, disable_rostime=True)
     run_id = minros.get_param("/run_id", "")
     directory = log_dir() / run_id if run_id else log_dir()

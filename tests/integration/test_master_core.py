@@ -162,3 +162,11 @@ def test_core_writes_master_log_and_latest_link(core, ros_home):
     wait_until(lambda: log.exists() and "+PUB [/rosout_agg] /rosout" in log.read_text(), 20,
                what="rosout's registration in master.log")
     assert "+PARAM [/run_id] by /roscore" in log.read_text()
+
+
+def test_rosout_exits_when_core_is_killed(core):
+    _port, proc, head = core
+    pid = int(re.search(r"process\[rosout-1\]: started with pid \[(\d+)\]", head).group(1))
+    proc.popen.kill()  # SIGKILL to the core alone: no chance to stop its child
+    proc.popen.wait(5)
+    wait_until(lambda: not _alive(pid), timeout=15, what="orphaned rosout exiting")

@@ -125,6 +125,7 @@ class RosoutProcess:
         self.log_dir = log_dir
         self.env = dict(env)
         self.env["ROS_MASTER_URI"] = uri
+        self.env["MINROS_CORE_PID"] = str(os.getpid())  # rosout exits if we die
         self.env.setdefault("PYTHONUNBUFFERED", "1")
         self.popen: subprocess.Popen | None = None
         self.count = 0
