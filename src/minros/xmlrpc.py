@@ -284,6 +284,8 @@ class XmlRpcServer:
                 self._slots.release()
                 if self._stopping.is_set():
                     return
+                # e.g. EMFILE (out of file descriptors): back off instead of spinning
+                self._stopping.wait(0.05)
                 continue
             try:
                 conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
