@@ -322,3 +322,19 @@ def test_teleop_ctrl_c_restores_the_terminal(minros_core, ros_home):
         teleop.stop()
         os.close(master_fd)
         os.close(slave_fd)
+
+
+def test_ctrl_c_while_waiting_for_the_master_is_one_line(ros_home):
+    import signal
+
+    port = free_port()  # nothing listens there
+    sim = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "turtlesim_node"],
+               headless_env(port, ros_home))
+    try:
+        sim.read_until("master may not be running yet", timeout=15)
+        os.killpg(sim.pid, signal.SIGINT)
+        sim.popen.wait(10)
+    finally:
+        out = sim.stop()
+    assert "Traceback" not in out
+    assert "turtlesim_node: init_node interrupted before it could complete" in out

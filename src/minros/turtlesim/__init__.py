@@ -4,3 +4,22 @@ Modules run with ``python -m`` (``rosrun turtlesim <name>`` maps to them): ``tur
 ``turtle_teleop_key``, ``draw_square``, ``mimic``. :mod:`minros.turtlesim.sim` is the simulation
 without ROS.
 """
+
+from __future__ import annotations
+
+import sys
+from typing import Callable
+
+
+def run_tool(name: str, main: Callable[[], int]) -> int:
+    """Run a tool's ``main`` the way a ROS user expects at the terminal: Ctrl-C ends it quietly,
+    a node that could not start says why in one line (no traceback)."""
+    from minros.exceptions import ROSInitException, ROSInterruptException
+
+    try:
+        return main()
+    except (KeyboardInterrupt, ROSInterruptException):
+        return 0
+    except ROSInitException as exc:
+        sys.stderr.write(f"{name}: {exc}\n")
+        return 1

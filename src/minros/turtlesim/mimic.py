@@ -45,4 +45,6 @@ def main(argv: List[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from minros.turtlesim import run_tool
+
+    sys.exit(run_tool("mimic", main))

@@ -406,4 +406,6 @@ def _wait(delay: float) -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from minros.turtlesim import run_tool
+
+    sys.exit(run_tool("turtlesim_node", main))
