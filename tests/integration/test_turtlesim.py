@@ -57,9 +57,11 @@ def turtlesim(minros_core, ros_home, tmp_path):
         proc.stop()
 
 
-def test_startup_lines_and_headless_notice(minros_core, ros_home):
-    proc = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "turtlesim_node"],
-                headless_env(minros_core, ros_home))
+def test_startup_lines_and_headless_notice(minros_core, ros_home, tmp_path):
+    snapshot = tmp_path / "shot.png"
+    # Private parameters from the command line: a background colour and the ~snapshot file.
+    proc = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "turtlesim_node",
+                 "_background_r:=0", f"_snapshot:={snapshot}"], headless_env(minros_core, ros_home))
     try:
         out = proc.read_until("without a window", timeout=15)
     finally:
@@ -68,6 +70,8 @@ def test_startup_lines_and_headless_notice(minros_core, ros_home):
     assert f"Spawning turtle [turtle1] at x=[{CENTER}], y=[{CENTER}], theta=[0.000000]" in out
     assert out.count("without a window") == 1
     assert "Traceback" not in out
+    frame = cv2.imread(str(snapshot))  # written at shutdown
+    assert frame is not None and tuple(frame[0, 0]) == (255, 86, 0)  # BGR of (0, 86, 255)
 
 
 def test_cmd_vel_moves_the_pose_and_pose_rate(turtlesim):
