@@ -389,3 +389,36 @@ def test_ping_all_and_service_wait(graph: Graph) -> None:
     assert ours.stdout.count("xmlrpc reply from http://localhost:") >= 2
     ours = graph.ours("rosservice", "call", "--wait", "/minros_demo/trigger")
     assert ours.stdout == 'success: True\nmessage: "triggered"\n'
+
+
+MINROS_MASTER_CASES = [
+    ("rostopic", "list", "-v"), ("rostopic", "info", "/pose"), ("rosnode", "list", "-a"),
+    ("rosnode", "info", "/rospy_demo"), ("rosservice", "list", "-n"),
+    ("rosservice", "info", "/minros_demo/set_bool"), ("rosparam", "get", "/"),
+    ("rosservice", "call", "/rospy_demo/set_bool", "true"),
+]
+
+
+def test_same_as_debian_on_minros_master(tmp_path: Path) -> None:
+    """The same comparison with minros's master in the middle."""
+    home = tmp_path / "ros_home"
+    (home / "log").mkdir(parents=True)
+    port = free_port()
+    env = ros_env(port, home)
+    renv = reference_env(env)
+    procs = [Proc([PYTHON, "-m", "minros.master", "-p", str(port)], env)]
+    try:
+        wait_for_master(port)
+        procs.append(Proc([REFERENCE_PYTHON, DEMO, "rospy_demo", "--listen", "/minros_demo_chatter"], renv))
+        procs.append(Proc([PYTHON, DEMO, "minros_demo"], env))
+        for proc in procs[1:]:
+            proc.read_until("ready", 30)
+        g = Graph(port, env, renv)
+        assert g.ours("rosparam", "set", "/k", "{a: [1, 2], b: x}").status == 0
+        wait_until(lambda: "inbound" in g.ours("rosnode", "info", "/rospy_demo").stdout, 15,
+                   interval=0.2, what="chatter connection")
+        for ours, reference in g.many(MINROS_MASTER_CASES):
+            assert_same(ours, reference)
+    finally:
+        for proc in reversed(procs):
+            proc.stop()
