@@ -7,6 +7,7 @@ read from the server's header through a probe connection (with a timeout).
 
 from __future__ import annotations
 
+import io
 import socket
 import sys
 from typing import Any, List
@@ -257,7 +258,7 @@ def call_service(master: Master, service: str, service_args: list, service_class
                      + f" (provided: {_summary(service_args)}; service arguments are: "
                      f"[{printable_message_args(request)}])") from None
     try:
-        request.serialize_to_bytes() if hasattr(request, "serialize_to_bytes") else None
+        request.serialize(io.BytesIO())  # wrong value types are reported before connecting
     except MessageException as exc:
         raise _error("Unable to send request. One of the fields has an incorrect type: "
                      + " ".join(str(exc).split())) from None

@@ -187,8 +187,11 @@ def _cmd_list(argv: List[str], prog: str) -> int:
     p.add_argument("-p", dest="publishers", action="store_true", help="list only publishers")
     p.add_argument("-s", dest="subscribers", action="store_true", help="list only subscribers")
     p.add_argument("--host", dest="hostname", action="store_true", help="group by host name")
+    p.add_argument("-b", "--bag", dest="bag", metavar="BAGFILE", help="list topics in .bag file")
     p.add_argument("namespace", nargs="*")
     args = p.parse_args(argv)
+    if args.bag:
+        raise ToolError("reading bag files is not supported by minros's rostopic")
     if len(args.namespace) > 1:
         p.error("you may only specify one input topic")
     if args.publishers and args.subscribers:
@@ -443,7 +446,7 @@ def _cmd_echo(argv: List[str], prog: str) -> int:
     if len(args.topic) > 1:
         p.error("you may only specify one input topic")
     if args.bag:
-        raise ToolError("reading bag files is not supported by this rostopic; use 'minros bag'")
+        raise ToolError("reading bag files is not supported by minros's rostopic")
     if args.all_topics:
         p.error("Display all option is only valid when echoing from bag files")
     if not args.topic:
