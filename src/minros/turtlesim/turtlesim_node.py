@@ -27,6 +27,10 @@ _BACKGROUND_PARAMS = (("background_r", sim.DEFAULT_BACKGROUND[0]),
                       ("background_b", sim.DEFAULT_BACKGROUND[2]))
 
 
+#: Minimum time between two window redraws (the simulation itself still ticks every 16 ms).
+_REDRAW_INTERVAL = 1 / 30
+
+
 def _cpp_service_class():
     """A rospy Service whose handler may return False, answered like a roscpp callback
     returning false: ``ok=0`` with an empty error text (what clients of the real turtlesim see
@@ -356,7 +360,7 @@ def main(argv: List[str] | None = None) -> int:
         rospy.loginfo(f"turtlesim runs without a window: {reason}")
 
     period = sim.UPDATE_INTERVAL_MS / 1000.0
-    next_tick = time.monotonic()
+    next_tick = next_redraw = time.monotonic()
     next_snapshot = next_tick + args.snapshot_period if snapshot and args.snapshot_period > 0 else None
     try:
         while not rospy.is_shutdown():
@@ -368,8 +372,10 @@ def main(argv: List[str] | None = None) -> int:
                 rospy.logerr_throttle(5.0, f"turtlesim: update failed: {exc}")
             if display is not None:
                 try:
-                    if node.dirty:
+                    now = time.monotonic()
+                    if node.dirty and now >= next_redraw:  # ~30 fps is plenty for a window
                         display.show(node.render())
+                        next_redraw = now + _REDRAW_INTERVAL
                     alive = display.pump()
                 except Exception as exc:  # the display went away (X server gone)
                     rospy.logwarn(f"turtlesim: window lost ({exc}); continuing without it")
