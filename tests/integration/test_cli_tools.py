@@ -103,11 +103,16 @@ def test_echo_fields_noarr_nostr_plot(graph: dict) -> None:
 
 def test_hz_bw_on_type_not_installed(graph: dict) -> None:
     proc = Proc([str(BIN / "rostopic"), "hz", "/reading", "/talker_chatter"], graph)
+    kept = Proc([str(BIN / "rostopic"), "hz", "-w", "5", "--filter", "m.name == 'probe'", "/reading"], graph)
+    dropped = Proc([str(BIN / "rostopic"), "hz", "--filter", "m.name != 'probe'", "/reading"], graph)
     try:
         text = proc.read_until("/talker_chatter", 12)
         text += proc.read_until("/reading", 5)
+        assert "window: 5" in kept.read_until("window:", 12)
+        assert "no new messages" in dropped.read_until("no new messages", 12)
     finally:
-        proc.stop()
+        for p in (proc, kept, dropped):
+            p.stop()
     assert "subscribed to [/reading]" in text and "subscribed to [/talker_chatter]" in text
     assert "topic" in text and "rate" in text and "=====" in text
     proc = Proc([str(BIN / "rostopic"), "bw", "/reading"], graph)
