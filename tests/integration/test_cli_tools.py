@@ -187,3 +187,24 @@ def test_graph_outputs(graph: dict, tmp_path: Path) -> None:
     root = ET.parse(tmp_path / "g.svg").getroot()
     titles = [t.text for t in root.iter("{http://www.w3.org/2000/svg}title")]
     assert "/talker" in titles and "/listener" in titles
+
+
+def test_kill_all(tmp_path: Path) -> None:
+    port = free_port()
+    env = ros_env(port, tmp_path)
+    master = Proc([PYTHON, "-m", "minros.master", "-p", str(port)], env)
+    nodes = []
+    try:
+        wait_for_master(port)
+        nodes = [Proc([PYTHON, DEMO, name], env) for name in ("k1", "k2")]
+        for node in nodes:
+            node.read_until("ready", 30)
+        done = run("rosnode", "kill", "-a", env=env)
+        assert done.returncode == 0, done.stderr
+        assert done.stdout == "killing:\n * /k1\n * /k2\nkilled\n"
+        wait_until(lambda: not any(n.alive() for n in nodes), 15, what="nodes exit")
+        assert run("rosnode", "list", env=env).stdout == "\n"
+    finally:
+        for node in nodes:
+            node.stop()
+        master.stop()
