@@ -11,9 +11,7 @@ import os
 import sys
 import xmlrpc.client
 from typing import Any, Dict, List, Tuple
-from urllib.parse import urlparse
 
-from minros import names
 from minros.xmlrpc import ServerProxy
 
 DEFAULT_MASTER_URI = "http://localhost:11311/"
@@ -127,12 +125,3 @@ class Master:
             except MasterException:
                 cache[node] = None
         return cache[node]
-
-
-def node_hostname(uri: str) -> str | None:
-    return urlparse(uri).hostname
-
-
-def tool_caller_id(tool: str) -> str:
-    """Caller id a tool uses for read-only master calls, e.g. ``/rostopic``."""
-    return names.SEP + tool
