@@ -162,8 +162,8 @@ def test_build_graph_hides_debug_like_rqt_graph() -> None:
     from minros.cli import graph
 
     g = graph.build_graph(STATE)
-    assert g.nodes == ["/listener", "/talker"]
-    assert g.edges == [("/talker", "/listener", "/chatter")]
+    assert g.nodes == ["/listener", "/rostopic_1_2", "/talker"]  # rqt_graph shows tool nodes too
+    assert g.edges == [("/talker", "/listener", "/chatter"), ("/talker", "/rostopic_1_2", "/chatter")]
     t = graph.build_graph(STATE, topics_view=True)
     assert t.topics == ["/chatter"]  # /unheard is a leaf topic, /lonely a dead sink
     full = graph.build_graph(STATE, show_debug=True, topics_view=True, hide_dead_sinks=False,

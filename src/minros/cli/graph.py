@@ -22,12 +22,10 @@ from minros.tools.master import Master
 #: substrings that mark debug nodes/topics (rqt_graph's "Hide Debug")
 QUIET_NAMES = ("/diag_agg", "/runtime_logger", "/pr2_dashboard", "/rviz", "/rosout", "/cpu_monitor",
                "/monitor", "/hd_monitor", "/rxloggerlevel", "/clock", "/rqt", "/statistics", "/rosapi")
-#: tool nodes hidden too (a snapshot taken by a tool should not show the tool)
-TOOL_PREFIXES = ("/rostopic_", "/rosnode_", "/rosservice_", "/rosparam-", "/rqt_graph")
 
 
 def is_quiet(name: str) -> bool:
-    return any(q in name for q in QUIET_NAMES) or name.startswith(TOOL_PREFIXES)
+    return any(q in name for q in QUIET_NAMES)
 
 
 class Graph:
