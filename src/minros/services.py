@@ -287,7 +287,7 @@ class Service:
                 if not persistent:
                     from minros.log import logerr
 
-                    logerr("incoming connection failed: connection closed before the request")
+                    logerr(f"incoming connection failed: {_PEER_GONE}")
                 return
             request = self.request_class()
             try:
