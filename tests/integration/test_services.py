@@ -254,7 +254,7 @@ def test_wait_for_service_arguments_and_timeout(master_env):
     with pytest.raises(ROSException, match=r"^timeout exceeded while waiting for service /nope$"):
         minros.wait_for_service("nope", timeout=0.5)
     elapsed = time.monotonic() - start
-    assert 0.45 <= elapsed < 3.0
+    assert 0.45 <= elapsed < 5.0
     with pytest.raises(ROSException):
         minros.wait_for_service("/nope", timeout=minros.Duration(0, 300_000_000))
 
@@ -279,7 +279,7 @@ def test_wait_for_service_returns_once_the_service_appears(master_env, tmp_path)
         ready_at = time.monotonic()
         waiter.join(30)
         assert "ok" in result, result
-        assert result["ok"] - ready_at < 2.0  # polling every 0.3 s, plus a probe
+        assert result["ok"] - ready_at < 5.0  # polling every 0.3 s, not the 30 s timeout
         assert minros.ServiceProxy("/add_two_ints", _srv())(1, 1).sum == 2
     finally:
         proc.stop()
