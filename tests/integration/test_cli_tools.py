@@ -136,7 +136,7 @@ def test_pub_modes_and_echo(graph: dict, tmp_path: Path) -> None:
     docs.write_text("data: one\n---\ndata: two\n")
     echo = Proc([str(BIN / "rostopic"), "echo", "-n", "2", "/words"], graph)
     try:
-        wait_until(lambda: "/words" in run("rostopic", "list", env=graph).stdout or True, 1)
+        # pub -f waits (up to 5 s) for a subscriber before sending the documents
         pub_done = run("rostopic", "pub", "-r", "20", "/words", "std_msgs/String", "-f", str(docs), env=graph)
         assert pub_done.returncode == 0, pub_done.stderr
         out = echo.output(timeout=15)
