@@ -3,6 +3,7 @@ tools do not have installed (decoded from the publisher's message_definition).""
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -155,8 +156,12 @@ def test_pub_stdin_latched(graph: dict) -> None:
         done = run("rostopic", "echo", "-n", "1", "/piped", env=graph)
         assert done.stdout == "x: 1.0\ny: 2.0\nz: 3.0\n---\n"
     finally:
-        proc.kill()
-        proc.communicate(timeout=5)
+        proc.send_signal(signal.SIGINT)  # a clean exit unregisters the publisher
+        try:
+            proc.communicate(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate(timeout=5)
 
 
 def test_node_and_topic_info_on_minros(graph: dict) -> None:
