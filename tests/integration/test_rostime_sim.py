@@ -10,8 +10,8 @@ import pytest
 
 from support import PYTHON, Proc, ros_env
 
-#: publishes /clock from 100 s upwards, 0.1 s of simulated time every 10 ms of wall time
-#: (10x faster than real time), after an initial delay so the node can read time 0 first
+#: publishes /clock from 100 s upwards, 0.2 s of simulated time every 10 ms of wall time
+#: (20x faster than real time); started only after the node has read time 0
 CLOCK = r'''
 import time
 import rospy
@@ -21,7 +21,7 @@ pub = rospy.Publisher("/clock", Clock, queue_size=10)
 t = rospy.Time(100)
 while not rospy.is_shutdown():
     pub.publish(Clock(clock=t))
-    t = t + rospy.Duration(0, 100000000)
+    t = t + rospy.Duration(0, 200000000)
     time.sleep(0.01)
 '''
 
@@ -73,11 +73,11 @@ def test_node_follows_clock_topic(minros_master: int, ros_home: Path, tmp_path: 
         assert "T0 0.0 NOW_IS_TIME True" in out  # no /clock message yet: simulated time is 0
         clock = Proc([PYTHON, str(clock_script)], env)
         slept = node.read_until("SLEPT", 30).splitlines()[-1]
-        # 2 s of simulated time pass in about 0.2 s of wall time
-        assert 2.0 <= value(slept, "sim") <= 2.3
+        # 2 s of simulated time pass in about 0.1 s of wall time
+        assert 2.0 <= value(slept, "sim") <= 2.6
         assert value(slept, "wall") < 1.5
         rate = node.read_until("RATE", 30).splitlines()[-1]
-        assert 1.9 <= value(rate, "sim") <= 2.3 and value(rate, "wall") < 1.5
+        assert 1.8 <= value(rate, "sim") <= 2.6 and value(rate, "wall") < 1.5
         # (TIMER, the log line and DONE come in one burst: read them in one go)
         out = node.read_until("DONE", 30)
         timer = next(x for x in out.splitlines() if x.startswith("TIMER"))
