@@ -105,18 +105,6 @@ def _log_usage(directory: str) -> int:
     return total
 
 
-def _link_latest(base: str, run_dir: str) -> None:
-    """``<log dir>/latest`` -> this run's directory, as roslaunch maintains it."""
-    link = os.path.join(base, "latest")
-    try:
-        if os.path.islink(link):
-            os.unlink(link)
-        if not os.path.exists(link):
-            os.symlink(run_dir, link)
-    except OSError:
-        pass  # a read-only or odd log directory is not worth failing over
-
-
 class RosoutProcess:
     """The rosout node as a child process, respawned (with back-off) when it dies."""
 
@@ -243,7 +231,6 @@ def main(argv: List[str], prog: str = "minros core") -> int:
         master_mod._log.info("Master initialized: port[%s], uri[%s]", core.port, core.uri)
         for key in ROSCORE_PARAMS:
             master_mod._log.info("+PARAM [%s] by /roscore", key)
-        _link_latest(base_log, run_log)
     out = _Console(sys.stdout)
     if run_log:
         out.write(f"... logging to {run_log}\n")
