@@ -771,9 +771,28 @@ def _file_documents(path: str) -> List[Any]:
         raise ToolError("invalid YAML in file: " + " ".join(str(exc).split())) from None
 
 
+def _stdin_lines() -> Any:
+    """Lines of stdin; stops at EOF or when the node shuts down (Ctrl-C while waiting)."""
+    import select
+
+    from minros import node
+
+    while not node.is_shutdown():
+        try:
+            ready, _, _ = select.select([sys.stdin], [], [], 0.5)
+        except (OSError, ValueError):
+            ready = [sys.stdin]
+        if not ready:
+            continue
+        line = sys.stdin.readline()
+        if not line:
+            return
+        yield line
+
+
 def _stdin_documents() -> Any:
     buff: List[str] = []
-    for line in sys.stdin:
+    for line in _stdin_lines():
         if line.strip() == "---":
             text = "".join(buff).rstrip()
             buff = []
