@@ -772,22 +772,33 @@ def _file_documents(path: str) -> List[Any]:
 
 
 def _stdin_lines() -> Any:
-    """Lines of stdin; stops at EOF or when the node shuts down (Ctrl-C while waiting)."""
+    """Lines of stdin; stops at EOF or when the node shuts down (Ctrl-C while waiting).
+
+    Reads the file descriptor directly: a buffered reader could hold lines that select()
+    no longer reports as readable."""
     import select
 
     from minros import node
 
+    try:
+        fd = sys.stdin.fileno()
+    except (AttributeError, OSError, ValueError):
+        yield from sys.stdin
+        return
+    pending = b""
     while not node.is_shutdown():
-        try:
-            ready, _, _ = select.select([sys.stdin], [], [], 0.5)
-        except (OSError, ValueError):
-            ready = [sys.stdin]
+        ready, _, _ = select.select([fd], [], [], 0.5)
         if not ready:
             continue
-        line = sys.stdin.readline()
-        if not line:
-            return
-        yield line
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            break
+        pending += chunk
+        *lines, pending = pending.split(b"\n")
+        for line in lines:
+            yield line.decode("utf-8", "replace") + "\n"
+    if pending:
+        yield pending.decode("utf-8", "replace")
 
 
 def _stdin_documents() -> Any:
