@@ -110,8 +110,11 @@ def test_same_answers_and_error_texts_in_all_four_combinations(env_for, scripts)
     assert "Returning [20 + 1 = 21]" in outputs["minros"]
 
 
-def test_debian_rosservice_against_minros_tutorial_server(env_for):
+def test_debian_rosservice_against_minros_tutorial_server(env_for, monkeypatch):
+    import minros
+
     python, env = env_for("minros")
+    monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])
     server = Proc([python, str(SCRIPTS / "add_two_ints_server.py")], env)
     _, ref = env_for("rospy")
     try:
@@ -123,13 +126,11 @@ def test_debian_rosservice_against_minros_tutorial_server(env_for):
             assert done.returncode == 0, done.stderr
             return done.stdout
 
-        deadline_out = ""
-        for _ in range(100):  # the node registers its services right after init_node
-            deadline_out = rosservice("list")
-            if "/add_two_ints_server/set_logger_level" in deadline_out:
-                break
-        assert deadline_out.split() == ["/add_two_ints", "/add_two_ints_server/get_loggers",
-                                        "/add_two_ints_server/set_logger_level"]
+        # the tutorial server prints nothing when ready: wait for its last service instead
+        minros.wait_for_service("/add_two_ints", timeout=20)
+        minros.wait_for_service("/add_two_ints_server/set_logger_level", timeout=20)
+        assert rosservice("list").split() == ["/add_two_ints", "/add_two_ints_server/get_loggers",
+                                              "/add_two_ints_server/set_logger_level"]
         assert rosservice("call", "/add_two_ints", "7", "8").strip() == "sum: 15"
         info = rosservice("info", "/add_two_ints")
         assert "Node: /add_two_ints_server" in info
