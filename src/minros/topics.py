@@ -15,6 +15,7 @@ from __future__ import annotations
 import collections
 import errno
 import logging
+import select
 import socket
 import struct
 import threading
@@ -249,9 +250,7 @@ class _PubConnection:
         self.stat_msgs = 0
         self.sync = queue_size is None
         self.thread: threading.Thread | None = None
-        if self.sync:
-            sock.settimeout(SYNC_SEND_TIMEOUT)
-        else:
+        if not self.sync:
             self.thread = threading.Thread(target=self._writer, daemon=True,
                                            name=f"minros-pub:{impl.resolved_name}")
             self.thread.start()
@@ -270,9 +269,9 @@ class _PubConnection:
         if self.done:
             return
         if self.sync:
-            with self.cond:
+            with self.lock:
                 try:
-                    self._send_blocking(frame)
+                    self._send_sync(frame)
                 except OSError as exc:
                     self._fail(exc)
             return
@@ -316,6 +315,31 @@ class _PubConnection:
         # The writer thread is behind: let it have the GIL now rather than after the
         # interpreter's switch interval (5 ms), or a publishing loop starves it.
         _yield_gil()
+
+    def _send_sync(self, frame: Any) -> None:
+        """queue_size=None: send the whole frame before returning, as rospy does, but give up
+        on a subscriber that takes nothing for SYNC_SEND_TIMEOUT seconds. The socket stays in
+        blocking mode (no timeout), so the common case is one non-blocking send call."""
+        rest = self._send_nowait(frame)
+        if rest is None:
+            return
+        parts = list(rest.parts)
+        deadline = time.monotonic() + SYNC_SEND_TIMEOUT
+        poller = select.poll()  # not select(): descriptors may be above FD_SETSIZE
+        poller.register(self.sock, select.POLLOUT)
+        while parts:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise TimeoutError(f"subscriber took nothing for {SYNC_SEND_TIMEOUT:.0f} s")
+            poller.poll(min(remaining, 1.0) * 1000)
+            try:
+                sent = self.sock.sendmsg(parts, (), _MSG_DONTWAIT)
+            except BlockingIOError:
+                continue
+            self.stat_bytes += sent
+            rest = _advance(parts, sent)
+            parts = list(rest.parts) if rest is not None else []
+        self.stat_msgs += 1
 
     def _send_nowait(self, frame: Any) -> Any:
         """Send what the kernel takes without blocking; return the unsent rest or None."""
@@ -393,10 +417,7 @@ class _PubConnection:
     def _watch_close(self) -> None:
         try:
             while not self.done:
-                try:
-                    data = self.sock.recv(4096)
-                except TimeoutError:  # a synchronous publisher's socket has a send timeout
-                    continue
+                data = self.sock.recv(4096)
                 if not data:
                     break
         except OSError:
