@@ -380,3 +380,40 @@ def test_master_restart_reregisters_and_reconnects(scripts, ros_home):
         for proc in (sub, pub, pub2, master):
             if proc is not None:
                 proc.stop()
+
+
+SYNC_FLOODER = r'''
+import time
+import rospy
+import minros.topics
+from std_msgs.msg import UInt8MultiArray
+minros.topics.SYNC_SEND_TIMEOUT = 1.0  # rospy's socket timeout is 60 s; shortened for the test
+rospy.init_node("sync_flooder")
+pub = rospy.Publisher("/sync_flood", UInt8MultiArray, queue_size=None)
+print("ready", flush=True)
+while pub.get_num_connections() < 1:
+    time.sleep(0.01)
+start = time.monotonic()
+for i in range(200):
+    pub.publish(UInt8MultiArray(data=bytes(100_000)))
+print("published 200 in %.1f s, connections left %d" % (time.monotonic() - start, pub.get_num_connections()), flush=True)
+'''
+
+
+def test_synchronous_publisher_gives_up_on_a_stuck_subscriber(tmp_path, minros_master, ros_home):
+    script = tmp_path / "sync_flooder.py"
+    script.write_text(SYNC_FLOODER)
+    proc = _node(script, [], minros_master, ros_home)
+    try:
+        proc.read_until("ready", 20)
+        _name, uri = _lookup(minros_master, "/sync_flooder")
+        with socket.create_connection(_tcpros_address(uri, "/sync_flood"), timeout=5) as stuck:
+            stuck.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+            stuck.sendall(tcpros.encode_header({
+                "topic": "/sync_flood", "callerid": "/stuck", "md5sum": "*", "type": "*"}))
+            out = proc.read_until("published 200", 30)
+        seconds, left = re.search(r"published 200 in ([\d.]+) s, connections left (\d+)", out).groups()
+        # blocked about the timeout once, then the dead-weight connection was dropped
+        assert 0.8 < float(seconds) < 10 and left == "0"
+    finally:
+        proc.stop()
