@@ -271,7 +271,18 @@ class _PubConnection:
         if self.sync:
             with self.lock:
                 try:
-                    self._send_sync(frame)
+                    if frame.__class__ is bytes:
+                        try:
+                            sent = self.sock.send(frame, _MSG_DONTWAIT)
+                        except BlockingIOError:
+                            sent = 0
+                        self.stat_bytes += sent
+                        if sent == len(frame):  # all of it in one call: the usual case
+                            self.stat_msgs += 1
+                        else:
+                            self._send_sync(memoryview(frame)[sent:])
+                    else:
+                        self._send_sync(frame)
                 except OSError as exc:
                     self._fail(exc)
             return
@@ -1034,10 +1045,12 @@ class Publisher(Topic):
         impl = self.impl
         if impl is None:
             raise ROSException("publish() to an unregistered() handle")
-        if not _node_mod.is_initialized():
+        if not _node_mod._initialized:
             raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
-        msg = args_kwds_to_message(self.data_class, args, kwds)
-        impl.publish(msg)
+        if len(args) == 1 and not kwds and args[0].__class__ is self.data_class:
+            impl.publish(args[0])  # the common case, without the argument juggling
+        else:
+            impl.publish(args_kwds_to_message(self.data_class, args, kwds))
 
 
 class Subscriber(Topic):
