@@ -17,6 +17,7 @@ import os
 import socket
 import sys
 import threading
+import time
 import xmlrpc.client
 from typing import Any, Callable, Dict, List, Mapping, Sequence, Tuple
 from urllib.parse import urlparse
@@ -203,6 +204,8 @@ class XmlRpcServer:
         self._sock: socket.socket | None = None
         self._slots = threading.BoundedSemaphore(max_connections)
         self._conns: Dict[int, socket.socket] = {}
+        #: connections waiting for their next request, and since when (reclaimable when full)
+        self._idle_since: Dict[int, float] = {}
         self._conns_lock = threading.Lock()
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
@@ -263,6 +266,19 @@ class XmlRpcServer:
             self._budget_used -= size
             self._budget_cond.notify_all()
 
+    def _reclaim_idle(self) -> None:
+        with self._conns_lock:
+            if not self._idle_since:
+                return
+            key = min(self._idle_since, key=self._idle_since.__getitem__)
+            del self._idle_since[key]
+            conn = self._conns.get(key)
+        if conn is not None:
+            try:
+                conn.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+
     def connection_count(self) -> int:
         with self._conns_lock:
             return len(self._conns)
@@ -273,11 +289,14 @@ class XmlRpcServer:
         sock = self._sock
         assert sock is not None
         while not self._stopping.is_set():
-            # Bound the connection threads: wait for a free slot before accepting more
-            # (further clients queue in the kernel backlog meanwhile).
-            while not self._slots.acquire(timeout=0.5):
+            # Bound the connection threads. When all are taken, close the connection that has
+            # waited longest for its next request (clients reopen a kept-alive connection the
+            # server closed: Python's and roscpp's XML-RPC clients retry once), so that a crowd
+            # of idle or silent clients cannot lock new ones out.
+            while not self._slots.acquire(timeout=0.05):
                 if self._stopping.is_set():
                     return
+                self._reclaim_idle()
             try:
                 conn, _addr = sock.accept()
             except OSError:
@@ -346,12 +365,18 @@ class XmlRpcServer:
 
     def _read_request(self, reader: Any, conn: socket.socket) -> Tuple[bytes, bool] | None:
         """Read one request; ``None`` when the peer closed between requests or stayed idle."""
+        key = id(conn)
+        with self._conns_lock:
+            self._idle_since[key] = time.monotonic()
         try:
             line = reader.readline(MAX_HEADER_LINE + 1)
+            while line in (b"\r\n", b"\n"):  # tolerate stray blank lines between requests
+                line = reader.readline(MAX_HEADER_LINE + 1)
         except socket.timeout:
             return None
-        while line in (b"\r\n", b"\n"):  # tolerate stray blank lines between requests
-            line = reader.readline(MAX_HEADER_LINE + 1)
+        finally:
+            with self._conns_lock:
+                self._idle_since.pop(key, None)
         if not line:
             return None
         if len(line) > MAX_HEADER_LINE:

@@ -211,14 +211,24 @@ def test_many_silent_clients_do_not_block_others(server):
             s.close()
 
 
-def test_connection_bound_queues_rather_than_fails():
-    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", idle_timeout=0.5, max_connections=2).start()
+def test_connection_bound_reclaims_idle_connections():
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", idle_timeout=30, max_connections=2).start()
     try:
         silent = [socket.create_connection(("127.0.0.1", srv.port), timeout=5) for _ in range(2)]
+        wait = time.monotonic() + 3
+        while srv.connection_count() < 2 and time.monotonic() < wait:
+            time.sleep(0.01)
         proxy = mx.ServerProxy(f"http://127.0.0.1:{srv.port}/", timeout=5)
         start = time.monotonic()
-        assert proxy.add(1, 2) == 3  # served once an idle slot was reclaimed
-        assert time.monotonic() - start >= 0.3
+        assert proxy.add(1, 2) == 3  # served at once: an idle connection was closed for it
+        assert time.monotonic() - start < 2.0
+        assert silent[0].recv(10) == b""  # the longest-idle one
+        assert srv.connection_count() <= 2
+        # a kept-alive client whose connection gets reclaimed simply reconnects
+        other = mx.ServerProxy(f"http://127.0.0.1:{srv.port}/", timeout=5)
+        for i in range(5):
+            assert other.add(i, 1) == i + 1
+            assert proxy.add(i, 2) == i + 2
         for s in silent:
             s.close()
     finally:
