@@ -123,3 +123,34 @@ def test_topic_api(tmp_path: Path, minros_master, ros_home):
     failures = [line for line in out.splitlines() if line.startswith("FAIL")]
     assert not failures, out
     assert len([line for line in out.splitlines() if line.startswith("OK ")]) == 13, out
+
+
+ZERO_COPY = r'''
+import threading, time
+import rospy
+from rospy.numpy_msg import numpy_msg
+from sensor_msgs.msg import Image
+got = []
+event = threading.Event()
+rospy.init_node("zero_copy")
+pub = rospy.Publisher("/frames", Image, queue_size=2)
+rospy.Subscriber("/frames", numpy_msg(Image), lambda m: (got.append(m), event.set()))
+while pub.get_num_connections() == 0:
+    time.sleep(0.01)
+pub.publish(Image(height=1080, width=1920, encoding="bgr8", step=5760,
+                  data=bytes(range(256)) * (1920 * 1080 * 3 // 256)))
+event.wait(10)
+data = got[0].data
+# the array is a view of the very buffer the socket was read into: no copy on the way
+print("RESULT", type(data).__name__, data.nbytes, int(data[257]),
+      type(data.base).__name__, type(data.base.obj).__name__, flush=True)
+'''
+
+
+def test_large_frames_reach_numpy_msg_without_copies(tmp_path: Path, minros_master, ros_home):
+    script = tmp_path / "zero_copy.py"
+    script.write_text(ZERO_COPY)
+    proc = Proc([PYTHON, str(script)], ros_env(minros_master, ros_home))
+    out = proc.read_until("RESULT", 30)
+    proc.stop()
+    assert "RESULT ndarray 6220800 1 memoryview bytearray" in out
