@@ -15,7 +15,12 @@ import importlib
 import os
 from typing import Any, Dict
 
+from minros.msgs import install_import_hook as _install_import_hook
+
 __version__ = "0.1.0"
+
+# `from my_pkg.msg import Foo` for any package on ROS_PACKAGE_PATH, without a build step.
+_install_import_hook()
 
 _EXCEPTIONS = ("ROSException", "ROSSerializationException", "ROSInitException",
                "ROSInterruptException", "ROSTimeMovedBackwardsException", "ROSInternalException",
