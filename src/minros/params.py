@@ -6,19 +6,17 @@ on the master (``subscribeParam``) and keeps a local tree fresh from the master'
 ``paramUpdate`` calls; plain ``get_param`` answers from that tree too once a key is cached, and
 ``set_param`` updates it, as rospy does.
 
-The first section holds the node context shared with ``minros.services``: both work before
-``init_node`` (caller id ``/unnamed``, master from ``__master:=`` or ``ROS_MASTER_URI``).
+The first section names the node context shared with ``minros.services`` (the node runtime's
+own functions): both work before ``init_node``.
 """
 
 from __future__ import annotations
 
-import os
-import sys
 import threading
 import warnings
 from typing import Any, Dict, List
 
-from minros import names
+from minros import names, node
 from minros.exceptions import ROSException
 
 __all__ = [
@@ -31,85 +29,17 @@ __all__ = [
     "set_param",
 ]
 
-DEFAULT_MASTER_URI = "http://localhost:11311/"
-#: seconds to wait for the master to answer one XML-RPC call
-MASTER_TIMEOUT = 10.0
-
-
 # --------------------------------------------------------------------------- node context
+# The node runtime answers these before init_node too (caller id ``/unnamed`` in the namespace,
+# master from ``__master:=`` or ROS_MASTER_URI), so this module and minros.services use it as is.
 
-def _node_module():
-    try:
-        from minros import node
-    except ImportError:  # this layer is usable (and unit-testable) without the node runtime
-        return None
-    return node
-
-
-def _caller_id() -> str:
-    node = _node_module()
-    if node is not None and hasattr(node, "get_caller_id"):
-        return node.get_caller_id()
-    return names.ns_join(names.get_ros_namespace(), "unnamed")
-
-
-def _master_uri() -> str:
-    node = _node_module()
-    if node is not None and hasattr(node, "get_master_uri"):
-        uri = node.get_master_uri()
-        if uri:
-            return uri
-    for arg in sys.argv:
-        if arg.startswith("__master:="):
-            return arg[len("__master:="):]
-    return os.environ.get("ROS_MASTER_URI", DEFAULT_MASTER_URI)
-
-
-def _node_uri() -> str | None:
-    node = _node_module()
-    if node is not None and hasattr(node, "get_node_uri"):
-        return node.get_node_uri()
-    return None
-
-
-def _mappings() -> Dict[str, str]:
-    node = _node_module()
-    if node is not None and hasattr(node, "get_mappings"):
-        return dict(node.get_mappings() or {})
-    return {}
-
-
-def _resolve(name: str) -> str:
-    """Resolve ``name`` against the caller id and apply the node's remappings (rospy rules)."""
-    node = _node_module()
-    if node is not None and hasattr(node, "resolve_name"):
-        return node.resolve_name(name)
-    return names.resolve_name(name, _caller_id(), _mappings())
-
-
-def _is_shutdown() -> bool:
-    node = _node_module()
-    if node is not None and hasattr(node, "is_shutdown"):
-        return bool(node.is_shutdown())
-    return False
-
-
-def _wait_for_shutdown(timeout: float) -> bool:
-    """Wait up to ``timeout`` seconds; True if the node shut down meanwhile."""
-    node = _node_module()
-    if node is not None and hasattr(node, "wait_for_shutdown"):
-        return bool(node.wait_for_shutdown(timeout))
-    import time
-
-    time.sleep(timeout)  # no node runtime at all: nothing can shut us down early
-    return False
-
-
-def _master(timeout: float = MASTER_TIMEOUT) -> Any:
-    """An XML-RPC proxy to the master with a bounded timeout per call."""
-    from minros.xmlrpc import ServerProxy
-
-    return ServerProxy(_master_uri(), timeout=timeout)
+_caller_id = node.get_caller_id
+_node_uri = node.get_node_uri
+_mappings = node.get_mappings
+_resolve = node.resolve_name
+_is_shutdown = node.is_shutdown
+_wait_for_shutdown = node.wait_for_shutdown
+_master = node.get_master_proxy
 
 
 def _call_master(method: str, *args: Any) -> List[Any]:
@@ -206,10 +136,8 @@ def _install_update_handler() -> None:
     with _install_lock:
         if _update_handler_installed:
             return
-        node = _node_module()
-        if node is not None and hasattr(node, "add_param_update_handler"):
-            node.add_param_update_handler(_on_param_update)
-            _update_handler_installed = True
+        node.add_param_update_handler(_on_param_update)
+        _update_handler_installed = True
 
 
 # --------------------------------------------------------------------------- public API
@@ -244,13 +172,11 @@ def get_param_cached(param_name: str, default: Any = _unspecified) -> Any:
         return _cache.get(resolved)
     except KeyError:
         pass
-    node = _node_module()
-    subscribe = getattr(node, "subscribe_param", None) if node is not None else None
-    if subscribe is None or not _node_uri():
+    if not _node_uri():
         # no node to receive paramUpdate: a plain lookup is the best we can do
         return get_param(param_name, default)
     _install_update_handler()
-    value = subscribe(resolved)
+    value = node.subscribe_param(resolved)
     _cache.set(resolved, value)
     if isinstance(value, dict) and not value:  # subscribeParam answers {} for an unset key
         if default is not _unspecified:
