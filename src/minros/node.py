@@ -9,7 +9,6 @@ master restart, and undone with one ``system.multicall`` on shutdown.
 from __future__ import annotations
 
 import atexit
-import errno
 import logging
 import os
 import signal
@@ -838,10 +837,6 @@ def _user_error(text: str) -> None:
         log.logerr(text)
     except Exception:
         sys.stderr.write(text + "\n")
-
-
-def _is_refused(exc: BaseException) -> bool:
-    return isinstance(exc, ConnectionRefusedError) or getattr(exc, "errno", None) == errno.ECONNREFUSED
 
 
 class Node:

@@ -77,13 +77,8 @@ def _log_error(text: str) -> None:
         _logger.error(text)
 
 
-def _log_warn(text: str) -> None:
-    try:
-        from minros import log
-
-        log.logwarn(text)
-    except Exception:
-        _logger.warning(text)
+#: user-visible warning line (rospy's logwarn), the node runtime's
+_log_warn = _node_mod._user_warn
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1132,12 +1127,4 @@ def get_published_topics(namespace: str = "/") -> List[List[str]]:
     return value
 
 
-def _close_socket(sock: socket.socket) -> None:
-    try:
-        sock.shutdown(socket.SHUT_RDWR)
-    except OSError:
-        pass
-    try:
-        sock.close()
-    except OSError:
-        pass
+_close_socket = _node_mod._close
