@@ -801,30 +801,29 @@ def _stdin_lines() -> Any:
         yield pending.decode("utf-8", "replace")
 
 
+def _stdin_document(text: str) -> Any:
+    """The one document in ``text`` (nothing if empty); invalid YAML is reported and skipped."""
+    try:
+        loaded = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        sys.stderr.write("Invalid YAML: " + " ".join(str(exc).split()) + "\n")
+        return
+    if loaded is not None:
+        yield loaded
+
+
 def _stdin_documents() -> Any:
     buff: List[str] = []
     for line in _stdin_lines():
         if line.strip() == "---":
             text = "".join(buff).rstrip()
             buff = []
-            try:
-                loaded = yaml.safe_load(text)
-            except yaml.YAMLError as exc:
-                sys.stderr.write("Invalid YAML: " + " ".join(str(exc).split()) + "\n")
-                continue
-            if loaded is not None:
-                yield loaded
+            yield from _stdin_document(text)
         else:
             buff.append(line)
     text = "".join(buff).strip()
     if text:
-        try:
-            loaded = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            sys.stderr.write("Invalid YAML: " + " ".join(str(exc).split()) + "\n")
-            return
-        if loaded is not None:
-            yield loaded
+        yield from _stdin_document(text)
 
 
 def _cmd_pub(argv: List[str], prog: str) -> int:
