@@ -491,7 +491,6 @@ class _PublisherImpl:
         self.headers: Dict[str, str] = {}
         self.is_latch = False
         self.latch: Any = None
-        self.latch_frame: Any = None
         self.queue_size: int | None = None
         self.queue_size_set = False
         self.tcp_nodelay = False
