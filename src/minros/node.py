@@ -23,7 +23,7 @@ from typing import Any, Callable, Dict, List, Tuple
 
 from minros import names, tcpros
 from minros import xmlrpc as minros_xmlrpc
-from minros.exceptions import ROSException, ROSInitException
+from minros.exceptions import ROSException, ROSInitException, ServiceException
 from minros.xmlrpc import ServerProxy, XmlRpcServer
 
 __all__ = [
@@ -567,9 +567,12 @@ def register_service(resolved_name: str, handler: Callable[[socket.socket, Dict[
     """Serve ``resolved_name`` on this process's TCPROS server and register it with the master.
 
     ``handler(sock, header)`` runs in the connection's thread for inbound connections whose
-    header names this service; it owns the socket from then on.
+    header names this service; it owns the socket from then on. ServiceException if this
+    process already serves ``resolved_name`` (checked under the registry lock: no two winners).
     """
     with _registry_lock:
+        if resolved_name in _services:
+            raise ServiceException(f"service [{resolved_name}] already registered")
         _services[resolved_name] = handler
     node = _node
     if node is not None:

@@ -214,8 +214,6 @@ class Service:
         self._lock = threading.Lock()
         from minros import node
 
-        if self.resolved_name in getattr(node, "_services", {}):
-            raise ServiceException(f"service [{self.resolved_name}] already registered")
         node.register_service(self.resolved_name, self._handle_connection)
 
     @property
