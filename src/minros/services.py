@@ -32,7 +32,7 @@ import warnings
 import xmlrpc.client
 from typing import Any, Callable, Dict, Tuple
 
-from minros import names, tcpros
+from minros import names, node, tcpros
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -41,7 +41,13 @@ from minros.exceptions import (
     TransportInitError,
     TransportTerminated,
 )
-from minros.params import _caller_id, _is_shutdown, _master, _resolve, _wait_for_shutdown
+
+# the node context (answers before init_node too)
+_caller_id = node.get_caller_id
+_is_shutdown = node.is_shutdown
+_master = node.get_master_proxy
+_resolve = node.resolve_name
+_wait_for_shutdown = node.wait_for_shutdown
 
 __all__ = [
     "Service",
@@ -212,15 +218,11 @@ class Service:
         self.seq = 0
         self.done = False
         self._lock = threading.Lock()
-        from minros import node
-
         node.register_service(self.resolved_name, self._handle_connection)
 
     @property
     def uri(self) -> str | None:
         """The ``rosrpc://host:port`` URI the master knows us by (None before init_node)."""
-        from minros import node
-
         try:
             host, port = node.get_tcpros_address()
         except ROSException:
@@ -234,8 +236,6 @@ class Service:
         if self.done:
             return
         self.done = True
-        from minros import node
-
         try:
             node.unregister_service(self.resolved_name)
         except Exception as exc:
@@ -243,8 +243,6 @@ class Service:
 
     def spin(self) -> None:
         """Block until this service or the node shuts down."""
-        from minros import node
-
         while not self.done and not node.wait_for_shutdown(0.5):
             pass
 
