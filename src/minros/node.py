@@ -430,7 +430,17 @@ def master_call(method: str, *args: Any) -> list:
     node = _node
     if node is not None:
         return node.master_call(method, *args)
-    return getattr(get_master_proxy(), method)(_caller_id, *args)
+    return master_call_once(method, *args)
+
+
+def master_call_once(method: str, *args: Any) -> list:
+    """``master.method(caller_id, *args)`` on a fresh connection, closed afterwards; OSError
+    when the master is unreachable."""
+    proxy = get_master_proxy()
+    try:
+        return getattr(proxy, method)(_caller_id, *args)
+    finally:
+        proxy.close()
 
 
 #: master methods whose arguments (by position after caller_id) are names to resolve

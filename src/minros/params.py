@@ -39,16 +39,7 @@ _mappings = node.get_mappings
 _resolve = node.resolve_name
 _is_shutdown = node.is_shutdown
 _wait_for_shutdown = node.wait_for_shutdown
-_master = node.get_master_proxy
-
-
-def _call_master(method: str, *args: Any) -> List[Any]:
-    """``[code, msg, value]`` of one master call; OSError when the master is unreachable."""
-    proxy = _master()
-    try:
-        return getattr(proxy, method)(_caller_id(), *args)
-    finally:
-        proxy.close()
+_call_master = node.master_call_once
 
 
 # --------------------------------------------------------------------------- the cache

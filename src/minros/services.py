@@ -45,7 +45,7 @@ from minros.exceptions import (
 # the node context (answers before init_node too)
 _caller_id = node.get_caller_id
 _is_shutdown = node.is_shutdown
-_master = node.get_master_proxy
+_call_master = node.master_call_once
 _resolve = node.resolve_name
 _wait_for_shutdown = node.wait_for_shutdown
 
@@ -357,11 +357,7 @@ def _args_kwds_to_request(request_class: type, args: tuple, kwds: dict) -> Any:
 def _lookup_service(resolved_name: str) -> str:
     """The ``rosrpc://`` URI of a service from the master (rospy's error texts)."""
     try:
-        proxy = _master()
-        try:
-            code, msg, uri = proxy.lookupService(_caller_id(), resolved_name)
-        finally:
-            proxy.close()
+        code, msg, uri = _call_master("lookupService", resolved_name)
     except OSError:
         raise ServiceException("unable to contact master") from None
     if code != 1:
@@ -508,11 +504,7 @@ class ServiceProxy:
 def _probe_service(resolved_name: str, timeout: float) -> str | None:
     """Is the service registered and accepting connections? Sends a probe header and closes."""
     try:
-        proxy = _master()
-        try:
-            code, _msg, uri = proxy.lookupService(_caller_id(), resolved_name)
-        finally:
-            proxy.close()
+        code, _msg, uri = _call_master("lookupService", resolved_name)
     except (xmlrpc.client.Error, ValueError) as exc:  # OSError (master down) goes to the caller
         raise TransportInitError(f"master lookup failed: {exc}") from None
     if code != 1:
