@@ -167,6 +167,22 @@ class _SerializerGen(_Writer):
         self.flush(ind)
         self.emit(ind, f"{self.out}({var})")
 
+    def tval(self, expr: str, bt: str) -> None:
+        """A time (unsigned secs) or duration (signed secs) as two 32-bit fields."""
+        code = "I" if bt == "time" else "i"
+        self.run.append((1, code, f"{expr}.secs"))
+        self.run.append((1, code, f"{expr}.nsecs"))
+
+    def sized(self, ind: int, var: str, n: int | None, fpath: str) -> None:
+        """The length prefix of a variable array, or the length check of a fixed one; then
+        the pending run is written, so the elements can follow."""
+        if n is None:
+            self.run.append((1, "I", f"len({var})"))
+        else:
+            self.emit(ind, f"if len({var}) != {n}:")
+            self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
+        self.flush(ind)
+
     def fields(self, spec: MsgSpec, obj: str, path: str, ind: int) -> None:
         for f in spec.fields:
             attr = python_name(f.name)
@@ -177,11 +193,9 @@ class _SerializerGen(_Writer):
                 if bt in SER_CODE:
                     self.run.append((1, SER_CODE[bt], expr))
                 elif bt in ("time", "duration"):
-                    code = "I" if bt == "time" else "i"
                     var = self.tmp("_t")
                     self.emit(ind, f"{var} = {expr}")
-                    self.run.append((1, code, f"{var}.secs"))
-                    self.run.append((1, code, f"{var}.nsecs"))
+                    self.tval(var, bt)
                 elif bt == "string":
                     self.string(ind, expr)
                 else:
@@ -195,12 +209,7 @@ class _SerializerGen(_Writer):
                 self.emit(ind, f"{var} = {expr}")
                 self.emit(ind, f"if {var}.__class__ is not bytes:")
                 self.emit(ind + 1, f"{var} = _as_bytes({var})")
-                if n is None:
-                    self.run.append((1, "I", f"len({var})"))
-                else:
-                    self.emit(ind, f"if len({var}) != {n}:")
-                    self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
-                self.flush(ind)
+                self.sized(ind, var, n, fpath)
                 self.emit(ind, f"{self.out}({var})")
             elif bt in SER_CODE:
                 code = SER_CODE[bt]
@@ -218,12 +227,7 @@ class _SerializerGen(_Writer):
             else:
                 var = self.tmp("_a")
                 self.emit(ind, f"{var} = {expr}")
-                if n is None:
-                    self.run.append((1, "I", f"len({var})"))
-                else:
-                    self.emit(ind, f"if len({var}) != {n}:")
-                    self.emit(ind + 1, f"raise _bad_length({fpath!r}, {n}, len({var}))")
-                self.flush(ind)
+                self.sized(ind, var, n, fpath)
                 item = self.tmp("_e")
                 if bt not in BUILTIN_NAMES and is_flat(self.get_spec(bt), self.get_spec):
                     # small fixed-size elements: pack them all, hand over one piece
@@ -240,9 +244,7 @@ class _SerializerGen(_Writer):
                 if bt == "string":
                     self.string(ind + 1, item)
                 elif bt in ("time", "duration"):
-                    code = "I" if bt == "time" else "i"
-                    self.run.append((1, code, f"{item}.secs"))
-                    self.run.append((1, code, f"{item}.nsecs"))
+                    self.tval(item, bt)
                 else:
                     self.fields(self.get_spec(bt), item, fpath + "[].", ind + 1)
                 self.flush(ind + 1)
@@ -295,9 +297,13 @@ class _DeserializerGen(_Writer):
         self.flush(ind)
         return var
 
+    def need(self, ind: int, nbytes: str | int, fpath: str) -> None:
+        """Check that ``nbytes`` bytes remain before reading them (a clear error, no overrun)."""
+        self.emit(ind, f"if {nbytes} > len(view) - end:")
+        self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {nbytes}, len(view) - end)")
+
     def string_body(self, ind: int, target: str, length: str, fpath: str) -> None:
-        self.emit(ind, f"if {length} > len(view) - end:")
-        self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {length}, len(view) - end)")
+        self.need(ind, length, fpath)
         if self.views:
             # the data may be a memoryview (large messages are not copied): str() decodes both
             self.emit(ind, f"{target} = str(view[end:end + {length}], 'utf-8', 'replace')")
@@ -348,8 +354,7 @@ class _DeserializerGen(_Writer):
             if bt in ("uint8", "char"):
                 if n is None:
                     count = self.length(ind)
-                    self.emit(ind, f"if {count} > len(view) - end:")
-                    self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {count}, len(view) - end)")
+                    self.need(ind, count, fpath)
                     if self.numpy:
                         self.emit(ind, f"{target} = _numpy_view('B', {count}, view, end)")
                     else:
@@ -358,8 +363,7 @@ class _DeserializerGen(_Writer):
                 else:
                     self.flush(ind)
                     if self.numpy:
-                        self.emit(ind, f"if {n} > len(view) - end:")
-                        self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {n}, len(view) - end)")
+                        self.need(ind, n, fpath)
                         self.emit(ind, f"{target} = _numpy_view('B', {n}, view, end)")
                     else:
                         name = self.struct(f"{n}s")
@@ -379,8 +383,7 @@ class _DeserializerGen(_Writer):
                 else:
                     self.flush(ind)
                     if self.numpy and bt != "bool":
-                        self.emit(ind, f"if {n * size} > len(view) - end:")
-                        self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {n * size}, len(view) - end)")
+                        self.need(ind, n * size, fpath)
                         self.emit(ind, f"{target} = _numpy_view({code!r}, {n}, view, end)")
                     else:
                         name = self.struct(f"{n}{code}")
@@ -446,8 +449,7 @@ class _DeserializerGen(_Writer):
         struct_name = call.split(".", 1)[0]
         values = self.tmp("_v")
         if count.isdigit():  # fixed length: variable ones were checked against the data already
-            self.emit(ind, f"if {count} * {size} > len(view) - end:")
-            self.emit(ind + 1, f"raise _overrun({self.type_name!r}, {fpath!r}, {count} * {size}, len(view) - end)")
+            self.need(ind, f"{count} * {size}", fpath)
         self.emit(ind, f"for {values} in {struct_name}.iter_unpack(view[end:end + {count} * {size}]):")
         for line in sub.lines:
             if line in unpack or line.startswith("end += "):
