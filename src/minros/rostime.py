@@ -14,6 +14,7 @@ import threading
 import time
 from typing import Callable, Union
 
+from minros import node
 from minros.exceptions import (
     ROSInitException,
     ROSInterruptException,
@@ -92,12 +93,7 @@ class _Clock:
 _clock = _Clock()
 
 
-def _node_is_shutdown() -> bool:
-    try:
-        from minros import node
-    except ImportError:  # node runtime not importable (unit tests of this module alone)
-        return False
-    return bool(node.is_shutdown())
+_node_is_shutdown = node.is_shutdown
 
 
 def _set_rostime(t: _MsgTime) -> None:
@@ -161,13 +157,7 @@ def _on_node_shutdown(*_args) -> None:
 
 def _start_node_time(use_sim_time: bool) -> None:
     """Called by ``init_node``: start the node clock, following /clock if ``use_sim_time``."""
-    try:
-        from minros import node
-
-        register = getattr(node, "add_shutdown_hook", None) or node.on_shutdown
-        register(_on_node_shutdown)
-    except (ImportError, AttributeError):
-        pass
+    node.add_shutdown_hook(_on_node_shutdown)
     if use_sim_time and _clock.clock_sub is None:
         from minros.topics import Subscriber
         from rosgraph_msgs.msg import Clock
@@ -217,13 +207,8 @@ def _wait_wall(seconds: float, stop: Callable[[], bool] | None) -> None:
     if seconds <= 0:
         return
     if stop is None:
-        try:
-            from minros import node
-        except ImportError:
-            node = None
-        if node is not None and hasattr(node, "wait_for_shutdown"):
-            node.wait_for_shutdown(seconds)
-            return
+        node.wait_for_shutdown(seconds)
+        return
     deadline = time.monotonic() + seconds
     with _clock.cond:
         while not _node_is_shutdown() and not (stop is not None and stop()):
