@@ -563,7 +563,10 @@ class ServerProxy:
             data = reader.read(self.max_body + 1)  # body delimited by the end of the connection
             close = True
         else:
-            length = int(length_text)
+            try:
+                length = int(length_text)
+            except ValueError:
+                raise ProtocolError(self.uri, status, "bad Content-Length", headers) from None
             if length < 0 or length > self.max_body:
                 raise ProtocolError(self.uri, 413, "response too large", headers)
             data = reader.read(length)

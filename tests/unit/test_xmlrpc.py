@@ -303,3 +303,23 @@ def test_expect_100_continue(server):
         assert s.recv(100) == b"HTTP/1.1 100 Continue\r\n\r\n"
         s.sendall(body)
         assert b"<int>3</int>" in _read_all(s)
+
+
+def test_client_reports_bad_content_length_as_protocol_error():
+    listener = socket.create_server(("127.0.0.1", 0))
+    port = listener.getsockname()[1]
+
+    def answer() -> None:
+        conn, _ = listener.accept()
+        with conn:
+            conn.recv(65536)
+            conn.sendall(b"HTTP/1.1 200 OK\r\nContent-Length: lots\r\n\r\n<methodResponse/>")
+
+    thread = threading.Thread(target=answer, daemon=True)
+    thread.start()
+    try:
+        with pytest.raises(xmlrpc.client.ProtocolError, match="bad Content-Length"):
+            mx.ServerProxy(f"http://127.0.0.1:{port}/", timeout=5).add(1, 2)
+    finally:
+        thread.join(5)
+        listener.close()
