@@ -42,11 +42,16 @@ def _xmlrpc_proxy(uri: str, timeout: float = 5.0) -> Any:
 
 
 def master_is_up(uri: str, timeout: float = 1.0) -> bool:
+    from minros.tools.master import Master
+
+    master = Master("/roslaunch", uri, timeout)
     try:
-        code, _msg, _pid = _xmlrpc_proxy(uri, timeout).getPid("/roslaunch")
-        return code == 1
+        master.getPid()  # raises unless the master answers SUCCESS
+        return True
     except Exception:
         return False
+    finally:
+        master.close()
 
 
 def is_local_host(host: str) -> bool:
