@@ -90,9 +90,8 @@ def _search(root: Path, name: str, skip_build: bool) -> List[Path]:
         if skip_build and Path(dirpath) == root:
             dirnames[:] = [d for d in dirnames if d != "build"]
         dirnames.sort()
-        for candidate in (name,):
-            if candidate in filenames or candidate in dirnames:
-                found.append(Path(dirpath) / candidate)
+        if name in filenames or name in dirnames:
+            found.append(Path(dirpath) / name)
     return found
 
 
