@@ -57,12 +57,13 @@ class RotatingLog:
         self._size = self._file.tell()
 
     def write(self, line: str) -> None:
+        size = len(line.encode("utf-8"))  # the file's size is counted in bytes, not characters
         with self._lock:
-            if self._size + len(line) > self.max_size and self._size:
+            if self._size + size > self.max_size and self._size:
                 self._rotate()
             self._file.write(line)
             self._file.flush()
-            self._size += len(line.encode("utf-8"))
+            self._size += size
 
     def _rotate(self) -> None:
         self._file.close()
