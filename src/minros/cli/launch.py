@@ -114,7 +114,9 @@ def main(argv: List[str], prog: str | None = None) -> int:
 
 
 def _master_uri(options: argparse.Namespace) -> str:
-    uri = os.environ.get("ROS_MASTER_URI") or "http://localhost:11311/"
+    from minros.tools.master import DEFAULT_MASTER_URI
+
+    uri = os.environ.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
     if options.port:
         from urllib.parse import urlparse
 
