@@ -84,22 +84,6 @@ def put_array(append: Callable[[Any], None], code: str, value: Any) -> None:
     append(data)
 
 
-def put_fixed_array(append: Callable[[Any], None], code: str, length: int, value: Any,
-                    field: str) -> None:
-    """Append a fixed-length numeric array (no count on the wire)."""
-    if value.__class__ is list or value.__class__ is tuple:
-        if len(value) != length:
-            raise bad_length(field, length, len(value))
-        append(struct.pack(f"<{length}{code}", *value))
-        return
-    if isinstance(value, (str, bytes, bytearray)):
-        raise TypeError(f"expected a sequence of numbers, got {type(value).__name__}")
-    data = _numpy_bytes(code, value)
-    if len(data) != length * _ITEM_SIZE[code]:
-        raise bad_length(field, length, len(data) // _ITEM_SIZE[code])
-    append(data)
-
-
 def as_bytes(value: Any) -> Any:
     """A ``uint8[]`` value (bytes, list of ints, numpy array, ...) as a bytes-like object."""
     cls = value.__class__
@@ -128,21 +112,6 @@ def _numpy_uint8(value: Any) -> memoryview:
             raise ValueError("a uint8[] field holds values outside 0..255")
         array = array.astype(numpy.uint8)
     return memoryview(numpy.ascontiguousarray(array).reshape(-1)).cast("B")
-
-
-def put_bytes(append: Callable[[Any], None], value: Any) -> None:
-    """Append a ``uint8[]``/``char[]``: uint32 length then the raw bytes."""
-    data = as_bytes(value)
-    append(S_I.pack(len(data)))
-    append(data)
-
-
-def put_fixed_bytes(append: Callable[[Any], None], length: int, value: Any, field: str) -> None:
-    """Append a ``uint8[N]``/``char[N]``: exactly N raw bytes."""
-    data = as_bytes(value)
-    if len(data) != length:
-        raise bad_length(field, length, len(data))
-    append(data)
 
 
 def unpack_array(code: str, count: int, view: memoryview, offset: int) -> tuple:
