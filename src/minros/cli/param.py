@@ -53,9 +53,11 @@ def _loader() -> type:
 
 
 def yaml_load(text: str) -> Any:
+    from minros.launch.rosparam_yaml import load_yaml
+
     try:
-        return yaml.load(text, Loader=_loader())  # noqa: S506 - a SafeLoader subclass
-    except (yaml.YAMLError, ValueError) as exc:
+        return load_yaml(text)  # YAML errors come back as ValueError, like bad angle values
+    except ValueError as exc:
         raise ToolError(f"invalid YAML: {_one_line(exc)}") from None
 
 
