@@ -187,6 +187,11 @@ def _split_remap(arg: str) -> List[str] | None:
     return parts
 
 
+def _is_private_param(src: str) -> bool:
+    """``_p`` (a private parameter assignment), as opposed to a name or a ``__special`` key."""
+    return len(src) > 1 and src[0] == "_" and src[1] != "_"
+
+
 def load_mappings(argv: Sequence[str]) -> Dict[str, str]:
     """Name remappings from command-line arguments (``a:=b`` and ``__key:=v``; not ``_param:=v``)."""
     mappings: Dict[str, str] = {}
@@ -200,7 +205,7 @@ def load_mappings(argv: Sequence[str]) -> Dict[str, str]:
         src, dst = parts
         if not src or not dst:
             continue
-        if len(src) > 1 and src[0] == "_" and src[1] != "_":
+        if _is_private_param(src):
             continue  # a private parameter assignment, not a name
         mappings[src] = dst
     return mappings
@@ -221,7 +226,7 @@ def load_command_line_node_params(argv: Sequence[str]) -> Dict[str, Any]:
         if parts is None:
             raise ValueError(f"invalid command-line parameter: {arg}")
         src, dst = parts
-        if src and dst and len(src) > 1 and src[0] == "_" and src[1] != "_":
+        if dst and _is_private_param(src):
             try:
                 params[src[1:]] = yaml.safe_load(dst)
             except yaml.YAMLError as exc:
