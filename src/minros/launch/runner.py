@@ -268,10 +268,6 @@ class LaunchRunner:
                               "(it is not on this machine, so roslaunch cannot start it)")
         self.out("auto-starting new master")
         argv = [sys.executable, "-m", "minros", "core", "-p", str(port)]
-        import importlib.util
-
-        if importlib.util.find_spec("minros.cli.core") is None:  # bare master until `core` exists
-            argv = [sys.executable, "-m", "minros.master", "-p", str(port)]
         env = dict(self.env, ROS_MASTER_URI=self.master_uri)
         # the master's own console output goes to a log file, as roslaunch does with rosmaster's
         self.master = LaunchProcess("master", argv, env, str(ros_home(self.env)), screen=False,
