@@ -195,3 +195,34 @@ def wait_until(predicate, timeout: float, interval: float = 0.05, what: str = "c
         if time.monotonic() >= deadline:
             raise AssertionError(f"{what} not reached within {timeout}s")
         time.sleep(interval)
+
+
+def build_roscpp(source_text: str, name: str, build_dir: Path, pkgs: Sequence[str] = ("roscpp",),
+                 required_headers: Sequence[str] = ()) -> Path:
+    """Compile a C++ ROS node with g++ and pkg-config; return the binary.
+
+    Skips locally and fails in CI when the reference's C++ toolchain or headers are missing
+    (scripts/install-ros-reference.sh installs them).
+    """
+    import shutil
+
+    require_reference()
+
+    def missing(what: str) -> None:
+        if IN_CI:
+            pytest.fail(f"{what} (scripts/install-ros-reference.sh installs it)")
+        pytest.skip(what)
+
+    if shutil.which("g++") is None or shutil.which("pkg-config") is None:
+        missing("g++/pkg-config missing")
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", *pkgs], capture_output=True,
+                           text=True, timeout=30)
+    if flags.returncode != 0 or not all(Path(h).exists() for h in required_headers):
+        missing(f"roscpp development files missing: {flags.stderr.strip()}")
+    source = build_dir / f"{name}.cpp"
+    source.write_text(source_text)
+    binary = build_dir / name
+    compiled = subprocess.run(["g++", "-O2", "-o", str(binary), str(source), *flags.stdout.split()],
+                              capture_output=True, text=True, timeout=300)
+    assert compiled.returncode == 0, compiled.stderr
+    return binary

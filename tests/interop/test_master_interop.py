@@ -10,7 +10,15 @@ from pathlib import Path
 
 import pytest
 
-from support import Proc, free_port, reference_env, require_reference, ros_env, wait_until
+from support import (
+    Proc,
+    build_roscpp,
+    free_port,
+    reference_env,
+    require_reference,
+    ros_env,
+    wait_until,
+)
 
 pytestmark = pytest.mark.interop
 
@@ -229,19 +237,7 @@ def test_rosservice(ros_core):
 
 @pytest.fixture(scope="session")
 def roscpp_binary(tmp_path_factory):
-    require_reference()
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "roscpp", "std_msgs"],
-                           capture_output=True, text=True, timeout=30)
-    if flags.returncode != 0:
-        pytest.fail(f"roscpp development files missing: {flags.stderr}")
-    work = tmp_path_factory.mktemp("roscpp")
-    source = work / "chat.cpp"
-    source.write_text(ROSCPP)
-    binary = work / "chat"
-    done = subprocess.run(["g++", "-O2", str(source), "-o", str(binary), *flags.stdout.split()],
-                          capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
-    return binary
+    return build_roscpp(ROSCPP, "chat", tmp_path_factory.mktemp("roscpp"), ("roscpp", "std_msgs"))
 
 
 @pytest.mark.timeout(300)

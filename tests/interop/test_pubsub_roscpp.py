@@ -3,14 +3,12 @@
 from __future__ import annotations
 
 import hashlib
-import shutil
-import subprocess
 from pathlib import Path
 
 import pytest
 
 from integration.pubsub_scripts import LISTENER, TALKER
-from support import IN_CI, PYTHON, Proc, reference_env, require_reference, ros_env
+from support import PYTHON, Proc, build_roscpp, reference_env, ros_env
 
 pytestmark = pytest.mark.interop
 
@@ -113,25 +111,8 @@ int main(int argc, char** argv) {
 @pytest.fixture(scope="session")
 def roscpp_node(tmp_path_factory) -> Path:
     """The C++ talker/listener, compiled once per session."""
-    require_reference()
-    if shutil.which("g++") is None or shutil.which("pkg-config") is None:
-        if IN_CI:
-            pytest.fail("g++/pkg-config missing (scripts/install-ros-reference.sh installs them)")
-        pytest.skip("g++/pkg-config missing")
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "roscpp", "std_msgs", "geometry_msgs",
-                            "sensor_msgs"], capture_output=True, text=True)
-    if flags.returncode != 0:
-        if IN_CI:
-            pytest.fail(f"roscpp development files missing: {flags.stderr}")
-        pytest.skip("roscpp development files missing")
-    build = tmp_path_factory.mktemp("roscpp")
-    source = build / "pubsub_node.cpp"
-    source.write_text(NODE_CPP)
-    binary = build / "pubsub_node"
-    compiled = subprocess.run(["g++", "-O2", "-o", str(binary), str(source), *flags.stdout.split()],
-                              capture_output=True, text=True, timeout=300)
-    assert compiled.returncode == 0, compiled.stderr
-    return binary
+    return build_roscpp(NODE_CPP, "pubsub_node", tmp_path_factory.mktemp("roscpp"),
+                        ("roscpp", "std_msgs", "geometry_msgs", "sensor_msgs"))
 
 
 @pytest.fixture

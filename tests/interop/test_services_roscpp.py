@@ -9,13 +9,12 @@ header, an empty error string when a handler returns false), which is the point.
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
-from support import IN_CI, PYTHON, Proc, reference_env, require_reference, ros_env
+from support import PYTHON, Proc, build_roscpp, reference_env, ros_env
 
 pytestmark = pytest.mark.interop
 
@@ -109,25 +108,8 @@ rospy.spin()
 @pytest.fixture(scope="module")
 def roscpp_node(tmp_path_factory) -> Path:
     """The C++ service node, compiled once per module."""
-    require_reference()
-    if shutil.which("g++") is None or shutil.which("pkg-config") is None:
-        if IN_CI:
-            pytest.fail("g++/pkg-config missing (scripts/install-ros-reference.sh installs them)")
-        pytest.skip("g++/pkg-config missing")
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "roscpp"], capture_output=True,
-                           text=True)
-    if flags.returncode != 0 or not Path("/usr/include/roscpp/GetLoggers.h").exists():
-        if IN_CI:
-            pytest.fail(f"roscpp development files missing: {flags.stderr}")
-        pytest.skip("roscpp development files missing")
-    build = tmp_path_factory.mktemp("roscpp_srv")
-    source = build / "srv_node.cpp"
-    source.write_text(NODE_CPP)
-    binary = build / "srv_node"
-    compiled = subprocess.run(["g++", "-O1", "-o", str(binary), str(source), *flags.stdout.split()],
-                              capture_output=True, text=True, timeout=300)
-    assert compiled.returncode == 0, compiled.stderr
-    return binary
+    return build_roscpp(NODE_CPP, "srv_node", tmp_path_factory.mktemp("roscpp_srv"),
+                        required_headers=("/usr/include/roscpp/GetLoggers.h",))
 
 
 def test_roscpp_client_against_minros_logger_services(roscpp_node, debian_rosmaster, ros_home,
