@@ -25,6 +25,8 @@ import threading
 import time
 from typing import Any, Dict, Tuple
 
+from minros.rosenv import ros_log_dir
+
 __all__ = [
     "DEBUG", "INFO", "WARN", "ERROR", "FATAL",
     "logdebug", "loginfo", "logwarn", "logerr", "logerror", "logfatal", "logout",
@@ -307,10 +309,7 @@ def node_log_filename(caller_id: str, mappings: Dict[str, str] | None = None,
     env = os.environ if env is None else env
     if mappings and "__log" in mappings:
         return os.path.abspath(mappings["__log"])
-    log_dir = env.get("ROS_LOG_DIR")
-    if not log_dir:
-        home = env.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
-        log_dir = os.path.join(home, "log")
+    log_dir = str(ros_log_dir(env))
     name = caller_id.replace("/", "_")
     if name.startswith("_"):
         name = name[1:]

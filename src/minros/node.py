@@ -21,7 +21,7 @@ import traceback
 import urllib.parse
 from typing import Any, Callable, Dict, List, Tuple
 
-from minros import names, tcpros
+from minros import names, rosenv, tcpros
 from minros import xmlrpc as minros_xmlrpc
 from minros.exceptions import ROSException, ROSInitException, ServiceException
 from minros.xmlrpc import ServerProxy, XmlRpcServer
@@ -57,7 +57,7 @@ __all__ = [
     "wait_for_shutdown",
 ]
 
-DEFAULT_MASTER_URI = "http://localhost:11311/"
+DEFAULT_MASTER_URI = rosenv.DEFAULT_MASTER_URI
 #: how often the master is probed to notice that it restarted
 MASTER_PROBE_INTERVAL = 1.0
 #: time allowed to read an inbound connection header
@@ -186,9 +186,7 @@ def get_bind_address() -> str:
 
 
 def _default_master_uri() -> str:
-    if "__master" in _argv_mappings:
-        return _argv_mappings["__master"]
-    return os.environ.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+    return rosenv.get_master_uri(remapped=_argv_mappings.get("__master"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -521,7 +519,7 @@ class MasterProxy:
 def get_master(env: Dict[str, str] | None = None) -> MasterProxy:
     """A MasterProxy for ROS_MASTER_URI (or ``env``'s)."""
     if env is not None and env is not os.environ:
-        uri = env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+        uri = rosenv.get_master_uri(env)
     else:
         uri = get_master_uri()
     return MasterProxy(uri)

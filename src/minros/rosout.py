@@ -20,6 +20,8 @@ import time
 from pathlib import Path
 from typing import Any, List, TextIO
 
+from minros.rosenv import ros_log_dir
+
 MAX_FILE_SIZE = 100 * 1024 * 1024
 MAX_BACKUPS = 10
 _LEVELS = {1: "DEBUG", 2: "INFO", 4: "WARN", 8: "ERROR", 16: "FATAL"}
@@ -27,12 +29,7 @@ _LEVELS = {1: "DEBUG", 2: "INFO", 4: "WARN", 8: "ERROR", 16: "FATAL"}
 
 def log_dir(env: dict | None = None) -> Path:
     """The ROS log directory (ROS_LOG_DIR, else ROS_HOME/log, else ~/.ros/log)."""
-    env = os.environ if env is None else env
-    if env.get("ROS_LOG_DIR"):
-        return Path(env["ROS_LOG_DIR"])
-    if env.get("ROS_HOME"):
-        return Path(env["ROS_HOME"]) / "log"
-    return Path.home() / ".ros" / "log"
+    return ros_log_dir(env)
 
 
 def format_line(msg: Any) -> str:

@@ -114,9 +114,9 @@ def main(argv: List[str], prog: str | None = None) -> int:
 
 
 def _master_uri(options: argparse.Namespace) -> str:
-    from minros.tools.master import DEFAULT_MASTER_URI
+    from minros.rosenv import get_master_uri
 
-    uri = os.environ.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+    uri = get_master_uri()
     if options.port:
         from urllib.parse import urlparse
 

@@ -25,6 +25,7 @@ from urllib.parse import urlparse
 
 from minros import names
 from minros.launch.config import LaunchConfig, LaunchError, NodeSpec
+from minros.rosenv import ros_home, ros_log_dir
 
 Print = Callable[[str], None]
 
@@ -68,12 +69,7 @@ def is_local_host(host: str) -> bool:
         return False
 
 
-def ros_home(env: Dict[str, str]) -> Path:
-    return Path(env.get("ROS_HOME") or Path(env.get("HOME", "~")).expanduser() / ".ros")
-
-
-def log_root(env: Dict[str, str]) -> Path:
-    return Path(env.get("ROS_LOG_DIR") or ros_home(env) / "log")
+log_root = ros_log_dir  # roslaunch's name for it
 
 
 def _die_with_parent() -> None:

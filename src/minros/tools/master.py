@@ -7,14 +7,14 @@
 
 from __future__ import annotations
 
-import os
 import sys
 import xmlrpc.client
 from typing import Any, Dict, List, Tuple
 
+from minros import rosenv
 from minros.xmlrpc import ServerProxy
 
-DEFAULT_MASTER_URI = "http://localhost:11311/"
+DEFAULT_MASTER_URI = rosenv.DEFAULT_MASTER_URI
 #: seconds to wait for any single XML-RPC answer; a tool never hangs on a dead peer
 TOOL_TIMEOUT = 5.0
 
@@ -37,10 +37,12 @@ class MasterIOError(OSError):
 
 def get_master_uri(argv: List[str] | None = None) -> str:
     """``__master:=`` beats ``ROS_MASTER_URI``; default ``http://localhost:11311/``."""
+    remapped = None
     for arg in sys.argv if argv is None else argv:
         if arg.startswith("__master:="):
-            return arg[len("__master:="):]
-    return os.environ.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+            remapped = arg[len("__master:="):]
+            break
+    return rosenv.get_master_uri(remapped=remapped)
 
 
 def call_node(uri: str, method: str, *args: Any, timeout: float = TOOL_TIMEOUT) -> list:

@@ -1,0 +1,40 @@
+"""The ROS environment rules in one place: master URI, ROS_HOME and the log directory.
+
+Every tool and node reads these the same way, as rosgraph.rosenv does: ``__master:=`` beats
+``ROS_MASTER_URI`` (default ``http://localhost:11311/``); ``ROS_HOME`` defaults to ``~/.ros``;
+``ROS_LOG_DIR`` defaults to ``$ROS_HOME/log``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Mapping, Optional
+
+DEFAULT_MASTER_PORT = 11311
+DEFAULT_MASTER_URI = f"http://localhost:{DEFAULT_MASTER_PORT}/"
+
+
+def get_master_uri(env: Optional[Mapping[str, str]] = None,
+                   remapped: Optional[str] = None) -> str:
+    """The master's URI: a ``__master:=`` value (``remapped``), else ROS_MASTER_URI, else default."""
+    if remapped:
+        return remapped
+    env = os.environ if env is None else env
+    return env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+
+
+def ros_home(env: Optional[Mapping[str, str]] = None) -> Path:
+    """ROS_HOME, else ``~/.ros`` (``~`` from ``env``'s HOME when it has one)."""
+    env = os.environ if env is None else env
+    if env.get("ROS_HOME"):
+        return Path(env["ROS_HOME"])
+    return (Path(env["HOME"]) if env.get("HOME") else Path.home()) / ".ros"
+
+
+def ros_log_dir(env: Optional[Mapping[str, str]] = None) -> Path:
+    """ROS_LOG_DIR, else ``$ROS_HOME/log``."""
+    env = os.environ if env is None else env
+    if env.get("ROS_LOG_DIR"):
+        return Path(env["ROS_LOG_DIR"])
+    return ros_home(env) / "log"
