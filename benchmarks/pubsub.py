@@ -12,14 +12,18 @@ Scenarios
 * ping-pong round trip of a 20-byte std_msgs/String (each side answers from its receive
   callback, subscriber tcp_nodelay), publisher queue_size=10 and queue_size=None; the CPU
   time the pinging process spends per round trip is shown too (steadier than wall time on a
-  shared machine). "raw" is one bidirectional TCP connection with a length prefix and
-  blocking send/recv in one thread: the floor; ROS needs two connections (one per topic);
+  shared machine). Two raw-socket floors, both with a 4-byte length prefix and nothing else:
+  "raw" has ROS's topology (each direction its own connection, as each topic is, and each
+  side answering from a receive thread, as a subscriber callback does); "raw-1" is one
+  bidirectional connection with blocking send/recv in the main thread, the absolute floor;
 * small-message flood: std_msgs/String "x"*20 published as fast as possible for N seconds,
   messages per second *received*;
 * 640x480 and 1920x1080 bgr8 sensor_msgs/Image floods, frames per second received.
 
 This same file is also the worker: ``--role ...`` runs one side of a scenario, in whichever
-Python runs it (the venv's for minros, /usr/bin/python3 for rospy), and prints one JSON line.
+Python runs it (the venv's for minros and raw, /usr/bin/python3 for rospy), and prints one JSON
+line. ``--minros-python`` picks another interpreter for minros and raw, e.g. a venv made from
+/usr/bin/python3 so that minros and rospy run on the very same interpreter build.
 """
 
 from __future__ import annotations
@@ -226,6 +230,75 @@ def role_raw_ping(args) -> None:
                       "cpu_us": cpu / (args.count + 200) * 1e6}), flush=True)
 
 
+def _raw_answer_loop(incoming, outgoing, on_frame) -> None:
+    """A subscriber's receive thread reduced to sockets: read length-prefixed frames from
+    ``incoming`` and hand each to ``on_frame`` (which may send on ``outgoing``)."""
+    head = bytearray(4)
+    body = bytearray(1 << 16)
+    try:
+        while True:
+            _recv_exact(incoming, memoryview(head))
+            (size,) = struct.unpack("<I", head)
+            _recv_exact(incoming, memoryview(body)[:size])
+            if on_frame(bytes(head) + bytes(body[:size])):
+                return
+    except (ConnectionError, OSError):
+        pass
+
+
+def role_raw_pubsub_echo(args) -> None:
+    """The echo of the ping-pong with ROS's topology and no middleware: the ping arrives on
+    one connection (its "topic"), a receive thread answers on a second one."""
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    server.bind(("127.0.0.1", args.port))
+    server.listen(2)
+    print(json.dumps({"ready": True}), flush=True)
+    incoming, _ = server.accept()
+    outgoing, _ = server.accept()
+    for sock in (incoming, outgoing):
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    thread = threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, outgoing.sendall))
+    thread.start()
+    thread.join()
+
+
+def role_raw_pubsub_ping(args) -> None:
+    outgoing = socket.create_connection(("127.0.0.1", args.port))
+    time.sleep(0.2)  # accepted first: the echo tells the two apart by order
+    incoming = socket.create_connection(("127.0.0.1", args.port))
+    for sock in (incoming, outgoing):
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    payload = struct.pack("<I", 20) + struct.pack("<I", 16) + b"x" * 16
+    times: list = []
+    state = {"t": 0.0, "n": 0, "cpu": 0.0}
+    total = args.count + 200
+    done = threading.Event()
+
+    def on_pong(_frame) -> bool:
+        now = time.perf_counter()
+        state["n"] += 1
+        if state["n"] > 200:
+            times.append(now - state["t"])
+        if state["n"] >= total:
+            done.set()
+            return True
+        state["t"] = time.perf_counter()
+        outgoing.sendall(payload)
+        return False
+
+    threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, on_pong), daemon=True).start()
+    cpu = time.process_time()
+    state["t"] = time.perf_counter()
+    outgoing.sendall(payload)
+    if not done.wait(60):
+        raise SystemExit(f"ping-pong stalled after {state['n']} round trips")
+    cpu = time.process_time() - cpu
+    print(json.dumps({"median_us": statistics.median(times) * 1e6,
+                      "mean_us": statistics.mean(times) * 1e6,
+                      "cpu_us": cpu / total * 1e6}), flush=True)
+
+
 def role_raw_flood_sub(args) -> None:
     server = socket.socket()
     server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -269,7 +342,8 @@ def role_raw_flood_pub(args) -> None:
 ROLES = {
     "echo": role_echo, "ping": role_ping, "flood-pub": role_flood_pub, "flood-sub": role_flood_sub,
     "raw-echo": role_raw_echo, "raw-ping": role_raw_ping, "raw-flood-pub": role_raw_flood_pub,
-    "raw-flood-sub": role_raw_flood_sub,
+    "raw-flood-sub": role_raw_flood_sub, "raw-pubsub-echo": role_raw_pubsub_echo,
+    "raw-pubsub-ping": role_raw_pubsub_ping,
 }
 
 # --------------------------------------------------------------------------------- roscpp
@@ -434,7 +508,7 @@ class Runner:
 
     def contenders(self) -> list:
         names = ["minros"] + (["rospy"] if self.reference else []) + \
-                (["roscpp"] if self.roscpp else []) + ["raw"]
+                (["roscpp"] if self.roscpp else []) + ["raw", "raw-1"]
         if self.args.only:
             names = [n for n in names if n in self.args.only.split(",")]
         return names
@@ -442,7 +516,7 @@ class Runner:
     def command(self, who: str, role: str, extra: list) -> tuple:
         if who == "roscpp":
             return [self.roscpp, *extra], self.env(True)
-        python = REFERENCE_PYTHON if who == "rospy" else VENV_PYTHON
+        python = REFERENCE_PYTHON if who == "rospy" else self.args.minros_python
         return [python, os.path.abspath(__file__), "--role", role, *extra], self.env(who == "rospy")
 
     def pair(self, who: str, first: tuple, second: tuple, timeout: float = 90,
@@ -477,12 +551,13 @@ class Runner:
                 p1.kill()
 
     def latency(self, who: str, queue: str):
-        if who == "raw":
+        if who in ("raw", "raw-1"):
             if queue == "none":
                 return None
             port = _free_port()
-            r = self.pair(who, self.command(who, "raw-echo", ["--port", str(port)]),
-                          self.command(who, "raw-ping", ["--port", str(port), "--count", str(self.args.count)]))
+            kind = "raw-pubsub" if who == "raw" else "raw"
+            r = self.pair(who, self.command(who, f"{kind}-echo", ["--port", str(port)]),
+                          self.command(who, f"{kind}-ping", ["--port", str(port), "--count", str(self.args.count)]))
         elif who == "roscpp":
             if queue == "none":
                 return None
@@ -496,6 +571,8 @@ class Runner:
         return r.get("median_us")
 
     def flood(self, who: str, kind: str):
+        if who == "raw-1":  # a flood is one connection one way: "raw" already is the floor
+            return None
         seconds = str(self.args.seconds)
         if who == "raw":
             port = _free_port()
@@ -515,11 +592,11 @@ class Runner:
         return r.get("rate")
 
     def idle_memory(self, who: str):
-        if who in ("raw", "roscpp"):
+        if who in ("raw", "raw-1", "roscpp"):
             return None
         code = ("import rospy, time\nrospy.init_node('bench_idle', anonymous=True)\ntime.sleep(1.0)\n"
                 "print([l.split()[1] for l in open('/proc/self/status') if l.startswith('VmRSS')][0])\n")
-        python = REFERENCE_PYTHON if who == "rospy" else VENV_PYTHON
+        python = REFERENCE_PYTHON if who == "rospy" else self.args.minros_python
         out = subprocess.run([python, "-c", code], env=self.env(who == "rospy"), capture_output=True,
                              text=True, timeout=60).stdout.split()
         return float(out[-1]) / 1024 if out else None
@@ -549,6 +626,12 @@ def _fmt(value) -> str:
     return f"{value:,.0f}" if value >= 100 else f"{value:.1f}"
 
 
+def _python_version(python: str) -> str:
+    out = subprocess.run([python, "-c", "import sys; print(sys.version.split()[0])"],
+                         capture_output=True, text=True)
+    return f"{python} {out.stdout.strip()}"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--role", choices=sorted(ROLES), help=argparse.SUPPRESS)
@@ -559,6 +642,8 @@ def main(argv=None) -> int:
     parser.add_argument("--seconds", type=float, default=2.0, help="duration of each flood")
     parser.add_argument("--count", type=int, default=2000, help="round trips per latency run")
     parser.add_argument("--only", default="", help="comma-separated contenders")
+    parser.add_argument("--minros-python", default=VENV_PYTHON,
+                        help="interpreter of the minros and raw workers (default: the venv's)")
     parser.add_argument("--scenarios", default="", help="comma-separated: " +
                         ",".join(s[1] for s in SCENARIOS))
     args = parser.parse_args(argv)
@@ -585,14 +670,15 @@ def main(argv=None) -> int:
         header = ["scenario", *contenders]
         if "rospy" in contenders:
             header.append("minros/rospy")
-        if "raw" in contenders:
-            header.append("minros/raw")
+        for other in ("raw", "raw-1"):
+            if other in contenders:
+                header.append(f"minros/{other}")
         rows = []
         for title, key, _fn, _better in scenarios:
             med = {c: statistics.median(results[(key, c)]) if results[(key, c)] else None
                    for c in contenders}
             row = [title] + [_fmt(med[c]) for c in contenders]
-            for other in ("rospy", "raw"):
+            for other in ("rospy", "raw", "raw-1"):
                 if other in contenders:
                     ok = med.get("minros") and med.get(other)
                     row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
@@ -602,14 +688,16 @@ def main(argv=None) -> int:
             med = {c: statistics.median(runner.cpu[("10", c)]) if runner.cpu.get(("10", c)) else None
                    for c in contenders}
             row = ["CPU per round trip, ping side, q=10 (µs)"] + [_fmt(med[c]) for c in contenders]
-            for other in ("rospy", "raw"):
+            for other in ("rospy", "raw", "raw-1"):
                 if other in contenders:
                     ok = med.get("minros") and med.get(other)
                     row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
             rows.insert(2 if len(rows) > 1 else 1, row)
         widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
         print(f"pubsub benchmark: {args.rounds} interleaved rounds, median; master: "
-              f"{'Debian rosmaster' if runner.reference else 'minros'}; {os.cpu_count()} CPUs")
+              f"{'Debian rosmaster' if runner.reference else 'minros'}; {os.cpu_count()} CPUs; "
+              f"minros on {_python_version(args.minros_python)}, rospy on "
+              f"{_python_version(REFERENCE_PYTHON) if runner.reference else '-'}")
         print("| " + " | ".join(h.ljust(w) for h, w in zip(header, widths)) + " |")
         print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
         for row in rows:

@@ -153,18 +153,20 @@ def serialize_frame(msg: Any) -> Any:
             raise ROSSerializationException(str(exc)) from None
         parts = chunks.parts
     else:
-        parts = [b""]  # slot for the length prefix
+        parts = []
         try:
             parts_of(parts.append)
         except _SERIALIZE_ERRORS:
-            try:  # again through serialize(), whose error names the bad field
-                msg.serialize(_Discard)
-            except SerializationError as exc:
-                raise ROSSerializationException(str(exc)) from None
-            except _SERIALIZE_ERRORS as exc:
-                raise ROSSerializationException(str(exc)) from None
+            _raise_field_error(msg)
             raise
-        del parts[0]
+        if not msg._zero_copy:
+            # no array fields that could be views of big buffers (strings, numbers, nested
+            # messages): one join, the usual case for every small message
+            body = b"".join(parts)
+            size = len(body)
+            if size <= _JOIN_LIMIT:
+                return _U32.pack(size) + body
+            return (_U32.pack(size), body)
     size = 0
     for part in parts:
         size += len(part) if part.__class__ is bytes else memoryview(part).nbytes
@@ -186,6 +188,17 @@ def serialize_frame(msg: Any) -> Any:
     if small:
         out.append(b"".join(small))
     return tuple(out)
+
+
+def _raise_field_error(msg: Any) -> None:
+    """Serialize ``msg`` again through serialize(), whose error names the bad field, and raise
+    that as ROSSerializationException."""
+    try:
+        msg.serialize(_Discard)
+    except SerializationError as exc:
+        raise ROSSerializationException(str(exc)) from None
+    except _SERIALIZE_ERRORS as exc:
+        raise ROSSerializationException(str(exc)) from None
 
 
 def _frame_len(frame: Any) -> int:
@@ -260,11 +273,13 @@ class _PubConnection:
     # -- sending ---------------------------------------------------------------------------
 
     def write(self, frame: Any) -> None:
-        """Queue (or directly send) one frame; never blocks a queued publisher."""
+        """Send one frame: queued publishers never block (the frame waits in the queue for the
+        writer thread), queue_size=None ones send it all before returning, as rospy does."""
         if self.done:
             return
-        if self.sync:
-            with self.lock:
+        with self.lock:
+            if not self.queue and not self.busy:
+                # the socket is idle: hand the bytes to the kernel now, without blocking
                 try:
                     if frame.__class__ is bytes:
                         try:
@@ -274,38 +289,19 @@ class _PubConnection:
                         self.stat_bytes += sent
                         if sent == len(frame):  # all of it in one call: the usual case
                             self.stat_msgs += 1
-                        else:
-                            self._send_sync(memoryview(frame)[sent:])
+                            return
+                        rest = _Partial(memoryview(frame)[sent:])
                     else:
-                        self._send_sync(frame)
+                        rest = self._send_nowait(frame)
+                        if rest is None:
+                            return
+                    if self.sync:
+                        self._send_sync(rest)
+                        return
                 except OSError as exc:
                     self._fail(exc)
-            return
-        with self.lock:
-            if not self.queue and not self.busy:
-                # fast path: the socket is idle, try to hand the bytes to the kernel now
-                if frame.__class__ is bytes:
-                    try:
-                        sent = self.sock.send(frame, _MSG_DONTWAIT)
-                    except BlockingIOError:
-                        sent = 0
-                    except OSError as exc:
-                        self._fail(exc)
-                        return
-                    self.stat_bytes += sent
-                    if sent == len(frame):
-                        self.stat_msgs += 1
-                        return
-                    sent = _Partial(memoryview(frame)[sent:])
-                else:
-                    try:
-                        sent = self._send_nowait(frame)
-                    except OSError as exc:
-                        self._fail(exc)
-                        return
-                    if sent is None:
-                        return
-                self.queue.append(sent)
+                    return
+                self.queue.append(rest)
                 self.cond.notify()
                 return
             queue = self.queue
@@ -322,13 +318,10 @@ class _PubConnection:
         # interpreter's switch interval (5 ms), or a publishing loop starves it.
         _yield_gil()
 
-    def _send_sync(self, frame: Any) -> None:
-        """queue_size=None: send the whole frame before returning, as rospy does, but give up
+    def _send_sync(self, rest: _Partial) -> None:
+        """queue_size=None: send the unsent ``rest`` of a frame before returning, but give up
         on a subscriber that takes nothing for SYNC_SEND_TIMEOUT seconds. The socket stays in
-        blocking mode (no timeout), so the common case is one non-blocking send call."""
-        rest = self._send_nowait(frame)
-        if rest is None:
-            return
+        blocking mode (no timeout), so the common case never gets here."""
         parts = list(rest.parts)
         deadline = time.monotonic() + SYNC_SEND_TIMEOUT
         poller = select.poll()  # not select(): descriptors may be above FD_SETSIZE
@@ -342,6 +335,8 @@ class _PubConnection:
                 sent = self.sock.sendmsg(parts, (), _MSG_DONTWAIT)
             except BlockingIOError:
                 continue
+            if sent:
+                deadline = time.monotonic() + SYNC_SEND_TIMEOUT  # it is reading: keep waiting
             self.stat_bytes += sent
             rest = _advance(parts, sent)
             parts = list(rest.parts) if rest is not None else []
@@ -757,22 +752,23 @@ class _SubConnection:
     def _receive_loop(self) -> None:
         impl = self.impl
         reader = self.reader
-        sock = self.sock
         header = self.header
         latching = header.get("latching", "0") == "1"
         data_class = impl.data_class
+        deliver = impl.deliver
         frames = self.pending
-        recv_into = sock.recv_into
+        recv_into = self.sock.recv_into
+        received_frames = reader.received_frames
+        recv_buffer = reader.recv_buffer
         while True:
             if frames:
                 queue_size = impl.queue_size
                 if queue_size is not None and len(frames) > queue_size:
                     frames = frames[-queue_size:]  # older ones dropped, as in rospy
-                msgs = []
                 for frame in frames:
                     self.stat_msgs += 1
+                    msg = data_class()
                     try:
-                        msg = data_class()
                         msg.deserialize(frame)
                     except Exception as exc:
                         _log_error(f"[{impl.resolved_name}] error deserializing incoming message "
@@ -782,21 +778,19 @@ class _SubConnection:
                         msg._connection_header = header
                     except AttributeError:
                         pass
-                    msgs.append(msg)
-                if msgs:
                     if latching:
-                        self.latch = msgs[-1]
+                        self.latch = msg
                     if self.done:
                         return
-                    impl.deliver(msgs)
+                    deliver(msg)
             if self.done:
                 return
-            n = recv_into(reader.recv_buffer())
+            n = recv_into(recv_buffer())
             if not n:
                 reader.eof()
                 return
             self.stat_bytes += n
-            frames = reader.received_frames(n)
+            frames = received_frames(n)
 
 
 class _GiveUp(Exception):
@@ -872,18 +866,17 @@ class _SubscriberImpl:
                     return
         raise KeyError("no matching cb")
 
-    def deliver(self, msgs: list) -> None:
-        callbacks = self.callbacks
-        for msg in msgs:
-            for cb, cb_args in callbacks:
-                try:
-                    if cb_args is not None:
-                        cb(msg, cb_args)
-                    else:
-                        cb(msg)
-                except Exception:
-                    if not _node_mod.is_shutdown():
-                        _log_error(f"bad callback: {cb}\n{traceback.format_exc()}")
+    def deliver(self, msg: Any) -> None:
+        """Run every callback on ``msg`` (in the connection's receive thread, as rospy does)."""
+        for cb, cb_args in self.callbacks:
+            try:
+                if cb_args is None:
+                    cb(msg)
+                else:
+                    cb(msg, cb_args)
+            except Exception:
+                if not _node_mod.is_shutdown():
+                    _log_error(f"bad callback: {cb}\n{traceback.format_exc()}")
 
     @staticmethod
     def _invoke(msg: Any, cb: Callable, cb_args: Any) -> None:
