@@ -4,16 +4,23 @@
 # then runs the whole suite. Usage: bash scripts/test.sh [pytest args...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-PY=${PYTHON:-python3}
-if [ ! -x .venv/bin/python ]; then
-  "$PY" -m venv .venv
-fi
-.venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e '.[test]'
 if [ "$(id -u)" -eq 0 ] || sudo -n true 2>/dev/null; then
   bash scripts/install-ros-reference.sh
 else
   echo "note: not root, Debian's ROS 1 reference not installed; interop tests will skip" >&2
 fi
+# The venv is built on the reference's interpreter when there is one, so that benchmarks set
+# minros against rospy on the same Python build; a venv never sees Debian's dist-packages,
+# so the two installations stay apart. PYTHON=... picks another interpreter.
+if [ -z "${PYTHON:-}" ] && [ -x /usr/bin/python3 ] && /usr/bin/python3 -c 'import ensurepip' 2>/dev/null; then
+  PY=/usr/bin/python3
+else
+  PY=${PYTHON:-python3}
+fi
+if [ ! -x .venv/bin/python ]; then
+  "$PY" -m venv .venv
+fi
+.venv/bin/python -m pip install -q --upgrade pip
+.venv/bin/python -m pip install -q -e '.[test]'
 .venv/bin/ruff check src tests benchmarks
 .venv/bin/python -m pytest "$@"
