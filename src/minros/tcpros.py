@@ -284,7 +284,10 @@ class FrameReader:
                 new_size = min(self._big_len, len(big) * 2)
                 big.extend(bytes(new_size - len(big)))
             return memoryview(big)[self._big_fill:]
-        if self._end == len(self._buf):
+        end = self._end
+        if not end:  # everything consumed: the usual case between small messages
+            return self._view
+        if end == len(self._buf):
             self._compact()
         return self._view[self._end:]
 
