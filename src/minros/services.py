@@ -67,6 +67,20 @@ CONNECT_TIMEOUT = 10.0
 _PEER_GONE = "unable to receive data from sender, check sender's logs for details"
 #: sockets wake up this often to notice node shutdown while waiting for a peer
 _POLL = 1.0
+#: a send gives up on a peer that took no byte for this long (the bound topics.SYNC_SEND_TIMEOUT
+#: puts on synchronous publishing). rospy's sendall waits forever; as long as the peer keeps
+#: taking bytes, however slowly, a send goes on.
+SEND_STALL_TIMEOUT = 60.0
+#: buffers handed to one sendmsg call (Linux takes up to IOV_MAX = 1024)
+_MAX_IOV = 512
+#: frames up to this size are joined into one bytes object (one send call); larger ones keep
+#: their big pieces and go out as scatter-gather, never copied into one buffer
+_JOIN_LIMIT = 65536
+#: serialized pieces smaller than this are joined with their neighbours (fewer buffers)
+_SMALL_PART = 4096
+_HAS_SENDMSG = hasattr(socket.socket, "sendmsg")
+#: the ok byte that starts a successful service response
+_OK = b"\x01"
 
 _logger = logging.getLogger("rospy.service")
 
@@ -91,11 +105,43 @@ def parse_rosrpc_uri(uri: str) -> Tuple[str, int]:
 
 # --------------------------------------------------------------------------- socket helpers
 
-def _send_all(sock: socket.socket, data: bytes) -> None:
-    try:
-        sock.sendall(data)
-    except OSError as exc:
-        raise TransportTerminated(f"unable to send data: {exc}") from None
+def _send_all(sock: socket.socket, data: Any) -> None:
+    """Send ``data`` (bytes, or a list of buffers sent in order) completely.
+
+    The socket's timeout (``_POLL`` on an exchange) only paces the waiting, so that node
+    shutdown is noticed: ``sendall`` would apply it to the whole transfer and fail a big
+    message to a slow reader. The send goes on while the peer takes bytes and raises
+    TransportTerminated when the node shuts down, the peer is gone, or the peer took nothing
+    for SEND_STALL_TIMEOUT seconds.
+    """
+    if not isinstance(data, list):
+        data = [data]
+    parts = [memoryview(part) for part in data if len(part)]  # an empty one would never go
+    first = 0  # parts[first:] are unsent; parts[first] may have been sliced
+    deadline = time.monotonic() + SEND_STALL_TIMEOUT
+    while first < len(parts):
+        if _is_shutdown():
+            raise TransportTerminated("node shutdown")
+        try:
+            if _HAS_SENDMSG and first + 1 < len(parts):
+                sent = sock.sendmsg(parts[first:first + _MAX_IOV])
+            else:
+                sent = sock.send(parts[first])
+        except socket.timeout:  # not writable for _POLL seconds
+            if time.monotonic() >= deadline:
+                raise TransportTerminated(f"peer took no data for {SEND_STALL_TIMEOUT:g} s") from None
+            continue
+        except OSError as exc:
+            raise TransportTerminated(f"unable to send data: {exc}") from None
+        if sent:
+            deadline = time.monotonic() + SEND_STALL_TIMEOUT
+        while sent:
+            size = parts[first].nbytes
+            if sent < size:
+                parts[first] = parts[first][sent:]
+                break
+            sent -= size
+            first += 1
 
 
 def _recv_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER) -> Dict[str, str]:
@@ -142,6 +188,9 @@ class _FrameSource:
                         raise TransportTerminated("node shutdown") from None
                 except OSError as exc:
                     raise TransportTerminated(f"unable to receive data from sender: {exc}") from None
+            # release the view now: the reader grows a big frame's buffer in the next
+            # recv_buffer(), which a live export of it would make fail (BufferError)
+            del target
             if not n:
                 reader.eof()  # FrameError (a TransportException) when cut mid-frame
                 return None
@@ -262,6 +311,7 @@ class Service:
             _close(sock)
 
     def _serve(self, sock: socket.socket, header: Dict[str, str]) -> None:
+        sock.settimeout(_POLL)  # every wait, sending or receiving, wakes up to check for shutdown
         error = tcpros.service_header_error(header, self.resolved_name, self.service_class._md5sum)
         if error is None and self.done:
             error = f"[{_caller_id()}] is not a provider of  [{self.resolved_name}]"
@@ -275,7 +325,6 @@ class Service:
         if header.get("probe") == "1":  # wait_for_service checking we are alive
             return
         persistent = header.get("persistent", "").lower() in ("1", "true")
-        sock.settimeout(_POLL)
         source = _FrameSource(sock, tcpros.FrameReader(buff_size=max(self.buff_size, 16)))
         while not self.done:
             frame = source.next()
@@ -294,19 +343,31 @@ class Service:
                 logerr(f"[{self.resolved_name}] error deserializing incoming request: {exc}")
                 return
             request._connection_header = header
-            _send_all(sock, self._respond(request))
+            try:
+                _send_all(sock, self._respond(request))
+            except TransportTerminated as exc:
+                if not _is_shutdown():
+                    # the client left (or stalled) mid-response: one line, then the next one
+                    # (rospy sends the error through the error handler and logs twice)
+                    from minros.log import logerr
+
+                    logerr(f"incoming connection failed: [{self.resolved_name}] response to "
+                           f"[{header.get('callerid', '')}] not delivered: {exc}")
+                return
             if not persistent:
                 return
 
-    def _respond(self, request: Any) -> bytes:
-        """The bytes answering ``request``: ok + response, or not-ok + error text."""
+    def _respond(self, request: Any) -> Any:
+        """What answers ``request`` (bytes or buffers for ``_send_all``): ok + response, or
+        not-ok + error text."""
         try:
             response = _convert_return_to_response(self.handler(request), self.response_class)
             with self._lock:
                 self.seq += 1
             buff = _Buffer()
             response.serialize(buff)
-            return tcpros.encode_service_response(buff.getvalue())
+            # ok byte + length, then the response as written (not copied into one buffer)
+            return buff.frame(_OK + tcpros.frame_prefix(buff.size))
         except ServiceException as exc:
             return tcpros.encode_service_error(f"service cannot process request: {exc}")
         except Exception as exc:
@@ -319,18 +380,57 @@ class Service:
 
 
 class _Buffer:
-    """The smallest ``write``-able sink for ``Message.serialize``: joins chunks once."""
+    """Write-only sink for ``Message.serialize`` that keeps what is written without joining it.
 
-    __slots__ = ("_parts",)
+    Big pieces (array and string fields) are kept as they are, without a copy; runs of small
+    ones are joined as they come, so a message of many small fields does not hold thousands
+    of objects. The frame is sent right after serialization, in the same thread, so pieces of
+    mutable buffers need no snapshot.
+    """
+
+    __slots__ = ("_parts", "_small", "_small_size", "size")
 
     def __init__(self) -> None:
         self._parts: list = []
+        self._small: list = []
+        self._small_size = 0
+        self.size = 0
 
     def write(self, data: Any) -> None:
-        self._parts.append(bytes(data))
+        if data.__class__ is not bytes:
+            view = memoryview(data)
+            if view.format != "B" or view.ndim != 1:
+                # byte-wise, so that a partial send can slice it (cast needs C order)
+                view = view.cast("B") if view.c_contiguous else memoryview(view.tobytes())
+            data = view
+        size = len(data)
+        self.size += size
+        if size < _SMALL_PART:
+            self._small.append(data)
+            self._small_size += size
+            if self._small_size >= _JOIN_LIMIT:
+                self._flush()
+            return
+        self._flush()
+        self._parts.append(data)
 
-    def getvalue(self) -> bytes:
-        return b"".join(self._parts)
+    def _flush(self) -> None:
+        if self._small:
+            self._parts.append(b"".join(self._small))
+            self._small = []
+            self._small_size = 0
+
+    def frame(self, prefix: bytes) -> list:
+        """``prefix`` + everything written, as a list of buffers for ``_send_all``."""
+        self._flush()
+        parts = self._parts
+        if self.size <= _JOIN_LIMIT:
+            return [b"".join([prefix, *parts])]  # one small send
+        if parts[0].__class__ is bytes and len(parts[0]) < _SMALL_PART:
+            parts[0] = prefix + parts[0]
+        else:
+            parts.insert(0, prefix)
+        return parts
 
 
 # --------------------------------------------------------------------------- client
@@ -456,16 +556,17 @@ class ServiceProxy:
             raise TypeError(f"request object type [{request.__class__}] does not match service type [{self.request_class}]")
         buff = _Buffer()
         request.serialize(buff)
-        payload = buff.getvalue()
+        frame = buff.frame(tcpros.frame_prefix(buff.size))
         with self._lock:
             if self._sock is None:
                 self._open()
             try:
                 self.seq += 1
                 assert self._sock is not None and self._source is not None
-                _send_all(self._sock, tcpros.encode_frame(payload))
-                frame = self._source.next()
-                if frame is None:
+                _send_all(self._sock, frame)
+                del frame  # its joined small fields need not live while the response comes in
+                reply = self._source.next()
+                if reply is None:
                     raise TransportTerminated(_PEER_GONE)
             except TransportException as exc:
                 self._drop()
@@ -480,7 +581,7 @@ class ServiceProxy:
             header = self._server_header
             if not self.persistent:
                 self._drop()
-        ok, data = frame
+        ok, data = reply
         if not ok:
             # rospy (Python 3) formats the raw bytes of the error string, so its text reads
             # "... responded with an error: b'...'"; the same words here keep tools identical
