@@ -809,25 +809,31 @@ class SlaveApi:
 # the node
 
 
-def _recv_exact(sock: socket.socket, size: int) -> bytes:
+def _recv_header_bytes(sock: socket.socket, size: int) -> bytes:
     buf = bytearray(size)
     view = memoryview(buf)
     got = 0
     while got < size:
-        n = sock.recv_into(view[got:])
+        try:
+            n = sock.recv_into(view[got:])
+        except socket.timeout:
+            raise tcpros.HeaderError("timed out waiting for the connection header") from None
+        except OSError as exc:
+            raise tcpros.HeaderError(f"unable to receive the connection header: {exc}") from None
         if not n:
-            raise tcpros.HeaderError(
-                f"connection closed after {got} of {size} header bytes")
+            raise tcpros.HeaderError(f"connection closed after {got} of {size} header bytes")
         got += n
     return bytes(buf)
 
 
 def read_inbound_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER) -> Dict[str, str]:
-    """Read exactly one connection header from ``sock`` (nothing beyond it)."""
-    (size,) = struct.unpack("<I", _recv_exact(sock, 4))
+    """Read exactly one connection header from ``sock`` (nothing beyond it), for both sides of
+    a topic or service handshake. The socket's timeout bounds every read; every failure is a
+    HeaderError naming it."""
+    (size,) = struct.unpack("<I", _recv_header_bytes(sock, 4))
     if size > max_size:
         raise tcpros.HeaderError(f"connection header of {size} bytes exceeds the limit of {max_size}")
-    return tcpros.decode_header(_recv_exact(sock, size))
+    return tcpros.decode_header(_recv_header_bytes(sock, size))
 
 
 def _user_warn(text: str) -> None:

@@ -144,28 +144,6 @@ def _send_all(sock: socket.socket, data: Any) -> None:
             first += 1
 
 
-def _recv_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER) -> Dict[str, str]:
-    """Read one connection header from ``sock``; the socket's timeout bounds every read."""
-    data = bytearray()
-    while True:
-        parsed = tcpros.read_header_block(data, max_size)
-        if parsed is not None:
-            fields, used = parsed
-            if used != len(data):  # a peer never sends anything before it has our header
-                raise TransportInitError("unexpected data after the connection header")
-            return fields
-        need = 4 - len(data) if len(data) < 4 else 4 + int.from_bytes(data[:4], "little") - len(data)
-        try:
-            chunk = sock.recv(min(need, 65536))
-        except socket.timeout:
-            raise TransportInitError("timed out waiting for the connection header") from None
-        except OSError as exc:
-            raise TransportInitError(f"unable to receive the connection header: {exc}") from None
-        if not chunk:
-            raise TransportInitError("connection closed before the connection header was complete")
-        data += chunk
-
-
 class _FrameSource:
     """Frames from one socket, one at a time (FrameReader may parse several per recv)."""
 
@@ -525,7 +503,7 @@ class ServiceProxy:
             raise ServiceException(f"unable to connect to service: {exc}") from None
         try:
             _send_all(sock, tcpros.encode_header(self._header_fields()))
-            header = _recv_header(sock)
+            header = node.read_inbound_header(sock)
             if "error" in header:
                 raise TransportInitError("remote error reported: {}".format(header["error"]))
             for required in ("md5sum", "type"):
