@@ -342,6 +342,8 @@ class Service:
             response = _convert_return_to_response(self.handler(request), self.response_class)
             with self._lock:
                 self.seq += 1
+                seq = self.seq
+            tcpros.stamp_header(response, seq)
             buff = _Buffer()
             response.serialize(buff)
             # ok byte + length, then the response as written (not copied into one buffer)
@@ -532,6 +534,10 @@ class ServiceProxy:
         request = _args_kwds_to_request(self.request_class, args, kwds)
         if getattr(request, "_type", None) != self.request_class._type:
             raise TypeError(f"request object type [{request.__class__}] does not match service type [{self.request_class}]")
+        with self._lock:
+            self.seq += 1
+            seq = self.seq
+        tcpros.stamp_header(request, seq)
         buff = _Buffer()
         request.serialize(buff)
         frame = buff.frame(tcpros.frame_prefix(buff.size))
@@ -539,7 +545,6 @@ class ServiceProxy:
             if self._sock is None:
                 self._open()
             try:
-                self.seq += 1
                 assert self._sock is not None and self._source is not None
                 _send_all(self._sock, frame)
                 del frame  # its joined small fields need not live while the response comes in

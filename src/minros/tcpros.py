@@ -16,7 +16,7 @@ allocated for it, and large frames grow their buffer only as their bytes actuall
 from __future__ import annotations
 
 import struct
-from typing import Dict, List, Mapping, Tuple, Union
+from typing import Any, Dict, List, Mapping, Tuple, Union
 
 from minros.exceptions import TransportException
 
@@ -34,6 +34,7 @@ __all__ = [
     "encode_service_error",
     "encode_service_response",
     "frame_prefix",
+    "stamp_header",
     "publisher_header_error",
     "read_header_block",
     "service_header_error",
@@ -206,6 +207,16 @@ def service_header_error(header: Mapping[str, str], service: str, md5sum: str) -
 
 # ---------------------------------------------------------------------------------------------
 # framing
+
+
+def stamp_header(msg: Any, seq: int) -> None:
+    """What rospy does to every message it sends (topic, request or response): a message with
+    a std_msgs/Header gets the sender's sequence number, and a None frame_id becomes "0"."""
+    if getattr(msg, "_has_header", False):
+        header = msg.header
+        header.seq = seq
+        if header.frame_id is None:
+            header.frame_id = "0"
 
 
 def frame_prefix(size: int) -> bytes:

@@ -554,11 +554,7 @@ class _PublisherImpl:
     def _serialize(self, msg: Any) -> Any:
         """Called with the lock held: Header.seq auto-fill, then one serialization."""
         self.seq += 1
-        if getattr(msg, "_has_header", False):
-            header = msg.header
-            header.seq = self.seq
-            if header.frame_id is None:
-                header.frame_id = "0"
+        tcpros.stamp_header(msg, self.seq)
         frame = serialize_frame(msg)
         self.message_data_sent += _frame_len(frame) - 4
         return frame
@@ -574,13 +570,10 @@ class _PublisherImpl:
             conns = self.connections
             if not conns:
                 return
-            # Header auto-fill, then one serialization for every connection (inlined _serialize)
+            # Header auto-fill, then one serialization for every connection
             self.seq += 1
             if getattr(msg, "_has_header", False):
-                header = msg.header
-                header.seq = self.seq
-                if header.frame_id is None:
-                    header.frame_id = "0"
+                tcpros.stamp_header(msg, self.seq)
             frame = serialize_frame(msg)
             self.message_data_sent += (len(frame) if frame.__class__ is bytes else _frame_len(frame)) - 4
             for conn in conns:
