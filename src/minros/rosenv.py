@@ -2,7 +2,8 @@
 
 Every tool and node reads these the same way, as rosgraph.rosenv does: ``__master:=`` beats
 ``ROS_MASTER_URI`` (default ``http://localhost:11311/``); ``ROS_HOME`` defaults to ``~/.ros``;
-``ROS_LOG_DIR`` defaults to ``$ROS_HOME/log``.
+``ROS_LOG_DIR`` defaults to ``$ROS_HOME/log``, where each roscore/roslaunch run has a
+directory named by its run_id and ``latest`` links to the newest one.
 """
 
 from __future__ import annotations
@@ -38,3 +39,18 @@ def ros_log_dir(env: Optional[Mapping[str, str]] = None) -> Path:
     if env.get("ROS_LOG_DIR"):
         return Path(env["ROS_LOG_DIR"])
     return ros_home(env) / "log"
+
+
+def renew_latest_log_dir(run_dir: Path) -> None:
+    """Point ``<log dir>/latest`` at ``run_dir`` (a run's directory), as roscore and roslaunch
+    do; a ``latest`` that is a real file or directory is left alone. Never fails the caller:
+    a log link is not worth stopping a launch for."""
+    latest = Path(run_dir).parent / "latest"
+    try:
+        if latest.is_symlink():
+            latest.unlink()
+        elif latest.exists():
+            return
+        latest.symlink_to(run_dir)
+    except OSError:
+        pass

@@ -189,8 +189,11 @@ def test_required_node_exit_stops_the_launch(tmp_path, pkg):
     assert "[stays-1] killing on exit" in out
     assert all(_gone(pid) for pid in _pids(out))
     # output="log" (the default): the node's stdout is in <log dir>/<run_id>/<name>-stdout.log
-    logs = list((tmp_path / "home" / "log").glob("*/boss-2-stdout.log"))
+    log_root = tmp_path / "home" / "log"
+    logs = [p for p in log_root.glob("*/boss-2-stdout.log") if p.parent.name != "latest"]
     assert len(logs) == 1 and logs[0].read_text().startswith("PROBE ")
+    # as roslaunch: <log dir>/latest links to this run's directory
+    assert (log_root / "latest").is_symlink() and (log_root / "latest").resolve() == logs[0].parent
     assert f"log file: {logs[0].parent / 'boss-2'}*.log" in out
 
 

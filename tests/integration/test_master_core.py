@@ -161,6 +161,8 @@ def test_core_writes_master_log(core, ros_home):
     wait_until(lambda: log.exists() and "+PUB [/rosout_agg] /rosout" in log.read_text(), 20,
                what="rosout's registration in master.log")
     assert "+PARAM [/run_id] by /roscore" in log.read_text()
+    latest = ros_home / "log" / "latest"  # roscore's link to the newest run
+    assert latest.is_symlink() and latest.resolve() == run_dir.resolve()
 
 
 def test_rosout_exits_when_core_is_killed(core):

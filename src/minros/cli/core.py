@@ -16,8 +16,11 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 from typing import List
 from urllib.parse import urlparse
+
+from minros.rosenv import renew_latest_log_dir
 
 #: minros implements the Noetic protocols; tools that ask for the distro get a real one.
 ROSDISTRO = "noetic"
@@ -227,6 +230,7 @@ def main(argv: List[str], prog: str = "minros core") -> int:
               file=sys.stderr)
         run_log = ""
     if run_log:
+        renew_latest_log_dir(Path(run_log))
         master_mod.configure_log_file(os.path.join(run_log, "master.log"))
         master_mod._log.info("Master initialized: port[%s], uri[%s]", core.port, core.uri)
         for key in ROSCORE_PARAMS:

@@ -25,7 +25,7 @@ from urllib.parse import urlparse
 
 from minros import names
 from minros.launch.config import LaunchConfig, LaunchError, NodeSpec
-from minros.rosenv import ros_home, ros_log_dir
+from minros.rosenv import renew_latest_log_dir, ros_home, ros_log_dir
 
 Print = Callable[[str], None]
 
@@ -293,6 +293,11 @@ class LaunchRunner:
             self.out(f"setting /run_id to {self.run_id}")
             proxy.setParam("/roslaunch", "/run_id", self.run_id)
         self.log_dir = log_root(self.env) / self.run_id
+        try:
+            self.log_dir.mkdir(parents=True, exist_ok=True)
+        except OSError:
+            return  # the nodes report it when they open their log files
+        renew_latest_log_dir(self.log_dir)
 
     def _load_parameters(self) -> None:
         proxy = self._proxy()
