@@ -255,6 +255,30 @@ def test_existing_master_is_used_and_left_running(tmp_path, pkg, minros_master):
     wait_for_master(port, timeout=2)  # still up
 
 
+def test_master_remap_argument_beats_the_environment(tmp_path, pkg, minros_master):
+    # as real roslaunch (rosgraph.get_master_uri): __master:= wins over ROS_MASTER_URI, and the
+    # nodes it starts are pointed at that master too
+    xml = """<launch><param name="x" value="1"/>
+      <node pkg="launch_probe" type="names_node.py" name="names" output="screen">
+        <param name="priv" value="p"/>
+      </node></launch>"""
+    launch_file = tmp_path / "test.launch"
+    launch_file.write_text(xml)
+    env = ros_env(free_port(), tmp_path / "home", {"ROS_PACKAGE_PATH": str(pkg.parent)})
+    proc = Proc([str(BIN / "roslaunch"), str(launch_file),
+                 f"__master:=http://localhost:{minros_master}"], env)
+    head = ""
+    try:
+        head = proc.read_until("NAMES /names", timeout=30)
+        master = xmlrpc.client.ServerProxy(f"http://localhost:{minros_master}")
+        assert master.getParam("/t", "/x")[2] == 1
+        assert master.lookupNode("/t", "/names")[0] == 1
+    finally:
+        out = head + proc.stop()
+    assert "auto-starting new master" not in out
+    assert f"ROS_MASTER_URI=http://localhost:{minros_master}/" in out
+
+
 def test_bad_nodes_are_reported_and_the_rest_runs(tmp_path, pkg):
     (pkg / "scripts" / "noexec.py").write_text(PROBE)
     xml = """<launch>

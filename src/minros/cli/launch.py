@@ -116,7 +116,9 @@ def main(argv: List[str], prog: str | None = None) -> int:
 def _master_uri(options: argparse.Namespace) -> str:
     from minros.rosenv import get_master_uri
 
-    uri = get_master_uri()
+    # as rosgraph.get_master_uri in roslaunch: __master:= on the command line beats the env
+    remapped = [a.split(":=", 1)[1] for a in options.positional if a.startswith("__master:=")]
+    uri = get_master_uri(remapped=remapped[-1] if remapped else None)
     if options.port:
         from urllib.parse import urlparse
 
