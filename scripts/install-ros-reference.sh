@@ -17,13 +17,13 @@ PKGS="ros-core python3-rosmaster python3-roslaunch rosout
   ros-roscpp-msg python3-roscpp-msg ros-rosgraph-msgs python3-rosgraph-msgs
   python3-cv-bridge python3-numpy libroscpp-dev g++ pkg-config python3-catkin-pkg"
 # Tools the tests drive besides ROS: a virtual display for turtlesim's window, zsh for
-# devel/setup.zsh; python3-venv so that minros's own venv can be built on the same
-# interpreter as the reference (scripts/test.sh).
-TEST_TOOLS="xvfb zsh python3-venv"
+# devel/setup.zsh; python3-venv and python3-tk so that minros's own venv can be built on the
+# same interpreter as the reference (scripts/test.sh), turtlesim's Tk window included.
+TEST_TOOLS="xvfb zsh python3-venv python3-tk"
 if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msgs.msg, tf2_msgs.msg' 2>/dev/null \
    && command -v rostopic >/dev/null && command -v catkin_create_pkg >/dev/null \
    && pkg-config --exists roscpp std_msgs && command -v Xvfb >/dev/null && command -v zsh >/dev/null \
-   && /usr/bin/python3 -c 'import ensurepip' 2>/dev/null; then
+   && /usr/bin/python3 -c 'import ensurepip, tkinter' 2>/dev/null; then
   echo "ROS 1 reference already installed"
   exit 0
 fi

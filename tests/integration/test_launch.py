@@ -23,8 +23,10 @@ import os, signal, sys, time
 args = sys.argv[1:]
 if "--ignore-sigint" in args:  # before the PROBE line: the test signals right after seeing it
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-print("PROBE", os.getpid(), os.environ.get("ROS_NAMESPACE", "-"), os.environ.get("PROBE_ENV", "-"),
-      os.getcwd(), " ".join(args), flush=True)
+# one write() per line: the tests run nodes with PYTHONUNBUFFERED=1, where print() writes
+# piece by piece and two nodes sharing the screen could interleave inside a line
+os.write(1, ("PROBE %d %s %s %s %s\\n" % (os.getpid(), os.environ.get("ROS_NAMESPACE", "-"),
+             os.environ.get("PROBE_ENV", "-"), os.getcwd(), " ".join(args))).encode())
 if "--pidfile" in args:
     with open(args[args.index("--pidfile") + 1], "a") as f:
         f.write("%d\\n" % os.getpid())
@@ -40,10 +42,12 @@ except KeyboardInterrupt:
 
 # A rospy node that reports how it resolves names and its private parameter.
 NAMES_NODE = """#!/usr/bin/env python
+import sys
 import rospy
 rospy.init_node("names_node")
-print("NAMES", rospy.get_name(), rospy.resolve_name("chatter"), rospy.resolve_name("other"),
-      rospy.get_param("~priv"), flush=True)
+sys.stdout.write("NAMES %s %s %s %s\\n" % (rospy.get_name(), rospy.resolve_name("chatter"),
+                 rospy.resolve_name("other"), rospy.get_param("~priv")))  # one write() (see PROBE)
+sys.stdout.flush()
 rospy.spin()
 """
 
