@@ -190,6 +190,22 @@ def _recv_exact(sock, view) -> None:
         got += n
 
 
+def _raw_answer_loop(incoming, outgoing, on_frame) -> None:
+    """A subscriber's receive thread reduced to sockets: read length-prefixed frames from
+    ``incoming`` and hand each to ``on_frame`` (which may send on ``outgoing``)."""
+    head = bytearray(4)
+    body = bytearray(1 << 16)
+    try:
+        while True:
+            _recv_exact(incoming, memoryview(head))
+            (size,) = struct.unpack("<I", head)
+            _recv_exact(incoming, memoryview(body)[:size])
+            if on_frame(bytes(head) + bytes(body[:size])):
+                return
+    except (ConnectionError, OSError):
+        pass
+
+
 def role_raw_echo(args) -> None:
     server = socket.socket()
     server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -198,16 +214,7 @@ def role_raw_echo(args) -> None:
     print(json.dumps({"ready": True}), flush=True)
     conn, _ = server.accept()
     conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    head = bytearray(4)
-    body = bytearray(1 << 16)
-    try:
-        while True:
-            _recv_exact(conn, memoryview(head))
-            (size,) = struct.unpack("<I", head)
-            _recv_exact(conn, memoryview(body)[:size])
-            conn.sendall(bytes(head) + bytes(body[:size]))
-    except (ConnectionError, OSError):
-        pass
+    _raw_answer_loop(conn, conn, conn.sendall)
 
 
 def role_raw_ping(args) -> None:
@@ -228,22 +235,6 @@ def role_raw_ping(args) -> None:
     print(json.dumps({"median_us": statistics.median(times) * 1e6,
                       "mean_us": statistics.mean(times) * 1e6,
                       "cpu_us": cpu / (args.count + 200) * 1e6}), flush=True)
-
-
-def _raw_answer_loop(incoming, outgoing, on_frame) -> None:
-    """A subscriber's receive thread reduced to sockets: read length-prefixed frames from
-    ``incoming`` and hand each to ``on_frame`` (which may send on ``outgoing``)."""
-    head = bytearray(4)
-    body = bytearray(1 << 16)
-    try:
-        while True:
-            _recv_exact(incoming, memoryview(head))
-            (size,) = struct.unpack("<I", head)
-            _recv_exact(incoming, memoryview(body)[:size])
-            if on_frame(bytes(head) + bytes(body[:size])):
-                return
-    except (ConnectionError, OSError):
-        pass
 
 
 def role_raw_pubsub_echo(args) -> None:

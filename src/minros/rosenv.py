@@ -9,6 +9,7 @@ directory named by its run_id and ``latest`` links to the newest one.
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import Mapping, Optional
 
@@ -43,14 +44,15 @@ def ros_log_dir(env: Optional[Mapping[str, str]] = None) -> Path:
 
 def renew_latest_log_dir(run_dir: Path) -> None:
     """Point ``<log dir>/latest`` at ``run_dir`` (a run's directory), as roscore and roslaunch
-    do; a ``latest`` that is a real file or directory is left alone. Never fails the caller:
-    a log link is not worth stopping a launch for."""
+    do. A ``latest`` that is a real file or directory is left alone; failures print rosgraph's
+    INFO line and never stop the caller (a log link is not worth stopping a launch for)."""
     latest = Path(run_dir).parent / "latest"
     try:
         if latest.is_symlink():
             latest.unlink()
         elif latest.exists():
+            sys.stderr.write("INFO: cannot create a symlink to latest log directory\n")
             return
         latest.symlink_to(run_dir)
-    except OSError:
-        pass
+    except OSError as exc:
+        sys.stderr.write(f"INFO: cannot create a symlink to latest log directory: {exc}\n")

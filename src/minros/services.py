@@ -535,16 +535,15 @@ class ServiceProxy:
         if getattr(request, "_type", None) != self.request_class._type:
             raise TypeError(f"request object type [{request.__class__}] does not match service type [{self.request_class}]")
         with self._lock:
-            self.seq += 1
-            seq = self.seq
-        tcpros.stamp_header(request, seq)
-        buff = _Buffer()
-        request.serialize(buff)
-        frame = buff.frame(tcpros.frame_prefix(buff.size))
-        with self._lock:
             if self._sock is None:
                 self._open()
             try:
+                # as rospy: a request is numbered once connected, and sent in that order
+                self.seq += 1
+                tcpros.stamp_header(request, self.seq)
+                buff = _Buffer()
+                request.serialize(buff)
+                frame = buff.frame(tcpros.frame_prefix(buff.size))
                 assert self._sock is not None and self._source is not None
                 _send_all(self._sock, frame)
                 del frame  # its joined small fields need not live while the response comes in

@@ -143,30 +143,28 @@ def serialize_frame(msg: Any) -> Any:
     """Serialize ``msg`` into one frame: ``bytes`` for small messages, else a tuple of buffers
     (length prefix first) that ``sendmsg`` writes without joining them."""
     parts_of = getattr(msg, "_serialize_parts", None)
-    if parts_of is None:  # not a minros message class (AnyMsg, hand-written genpy-style)
-        chunks = _Chunks()
-        try:
-            msg.serialize(chunks)
-        except ROSSerializationException:
-            raise
-        except _SERIALIZE_ERRORS as exc:
-            raise ROSSerializationException(str(exc)) from None
-        parts = chunks.parts
+    if parts_of is None:  # not a minros message class (AnyMsg)
+        parts = _parts_written_by(msg)
     else:
         parts = []
         try:
             parts_of(parts.append)
+        except NotImplementedError:
+            # a hand-written genpy-style class: it subclasses Message but only its
+            # serialize() is real (the base _serialize_parts is a stub)
+            parts = _parts_written_by(msg)
         except _SERIALIZE_ERRORS:
             _raise_field_error(msg)
             raise
-        if not msg._zero_copy:
-            # no array fields that could be views of big buffers (strings, numbers, nested
-            # messages): one join, the usual case for every small message
-            body = b"".join(parts)
-            size = len(body)
-            if size <= _JOIN_LIMIT:
-                return _U32.pack(size) + body
-            return (_U32.pack(size), body)
+        else:
+            if not msg._zero_copy:
+                # no array fields that could be views of big buffers (strings, numbers, nested
+                # messages): one join, the usual case for every small message
+                body = b"".join(parts)
+                size = len(body)
+                if size <= _JOIN_LIMIT:
+                    return _U32.pack(size) + body
+                return (_U32.pack(size), body)
     size = 0
     for part in parts:
         size += len(part) if part.__class__ is bytes else memoryview(part).nbytes
@@ -188,6 +186,19 @@ def serialize_frame(msg: Any) -> Any:
     if small:
         out.append(b"".join(small))
     return tuple(out)
+
+
+def _parts_written_by(msg: Any) -> list:
+    """What ``msg.serialize(buff)`` writes, as a list of ``bytes`` (copies: a frame may wait in
+    a queue after publish returns)."""
+    chunks = _Chunks()
+    try:
+        msg.serialize(chunks)
+    except ROSSerializationException:
+        raise
+    except _SERIALIZE_ERRORS as exc:
+        raise ROSSerializationException(str(exc)) from None
+    return chunks.parts
 
 
 def _raise_field_error(msg: Any) -> None:
@@ -441,6 +452,14 @@ class _PubConnection:
         threading.Thread(target=self.impl._remove_connection, args=(self,), daemon=True).start()
 
     def close(self) -> None:
+        if self.done:
+            return
+        # First wake a send in progress (a queue_size=None publish to a slow reader holds the
+        # lock for as long as the reader keeps taking bytes): it fails with EPIPE at once.
+        try:
+            self.sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
         with self.cond:
             if self.done:
                 return
@@ -760,8 +779,8 @@ class _SubConnection:
                     frames = frames[-queue_size:]  # older ones dropped, as in rospy
                 for frame in frames:
                     self.stat_msgs += 1
-                    msg = data_class()
                     try:
+                        msg = data_class()
                         msg.deserialize(frame)
                     except Exception as exc:
                         _log_error(f"[{impl.resolved_name}] error deserializing incoming message "

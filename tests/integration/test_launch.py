@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import re
 import signal
+import subprocess
 import sys
 import time
 import xmlrpc.client
@@ -281,6 +282,18 @@ def test_master_remap_argument_beats_the_environment(tmp_path, pkg, minros_maste
         out = head + proc.stop()
     assert "auto-starting new master" not in out
     assert f"ROS_MASTER_URI=http://localhost:{minros_master}/" in out
+
+
+def test_master_remap_argument_without_a_value_is_an_error(tmp_path, pkg):
+    launch_file = tmp_path / "test.launch"
+    launch_file.write_text('<launch><param name="x" value="1"/></launch>')
+    env = ros_env(free_port(), tmp_path / "home", {"ROS_PACKAGE_PATH": str(pkg.parent)})
+    done = subprocess.run([str(BIN / "roslaunch"), str(launch_file), "__master:="], env=env,
+                          capture_output=True, text=True, timeout=30)
+    assert done.returncode == 1
+    assert done.stderr.strip() == ("roslaunch: error: __master remapping argument '__master:=' "
+                                   "improperly specified")
+    assert "Traceback" not in done.stderr + done.stdout
 
 
 def test_bad_nodes_are_reported_and_the_rest_runs(tmp_path, pkg):

@@ -151,3 +151,65 @@ def test_connection_stream_is_byte_exact_under_backpressure(queue_size):
     conn.close()
     b.close()
     assert received == payloads
+
+
+def test_close_interrupts_a_synchronous_send_to_a_slow_reader():
+    """queue_size=None holds the connection while a reader keeps taking bytes; unregister and
+    shutdown must still close it at once (the trickling reader never lets the send finish)."""
+    import socket
+    import threading
+    import time
+
+    a, b = socket.socketpair()
+    conn = topics._PubConnection(_Impl(), a, ("local", 0), {"callerid": "/s"}, None)
+    stop = threading.Event()
+
+    def trickle():
+        while not stop.wait(0.05):
+            try:
+                b.recv(4096)
+            except OSError:
+                return
+
+    reader = threading.Thread(target=trickle, daemon=True)
+    reader.start()
+    sender = threading.Thread(target=conn.write, args=(bytes(8 << 20),), daemon=True)
+    sender.start()
+    try:
+        deadline = time.monotonic() + 5
+        while conn.stat_bytes == 0 and time.monotonic() < deadline:  # the send is under way
+            time.sleep(0.01)
+        assert conn.stat_bytes > 0 and sender.is_alive()
+        closer = threading.Thread(target=conn.close, daemon=True)
+        closer.start()
+        closer.join(3)
+        assert not closer.is_alive(), "close() waited for the slow reader"
+        sender.join(3)
+        assert not sender.is_alive() and conn.done
+    finally:
+        stop.set()
+        b.close()
+
+
+def test_hand_written_genpy_style_class_is_published_through_its_serialize():
+    """A class written by hand against genpy.Message (only serialize/deserialize defined), as
+    rospy accepts: the frame is what its serialize() writes."""
+    import genpy
+
+    class Hand(genpy.Message):
+        __slots__ = ["data"]
+        _type = "std_msgs/String"
+        _md5sum = "992ce8a1687cec8c8bd883ec73ca41d1"
+        _has_header = False
+        _full_text = "string data\n"
+        _slot_types = ["string"]
+
+        def __init__(self, data=""):
+            self.data = data
+
+        def serialize(self, buff):
+            raw = self.data.encode()
+            buff.write(struct.pack("<I", len(raw)))
+            buff.write(raw)
+
+    assert topics.serialize_frame(Hand("hi")) == struct.pack("<II", 6, 2) + b"hi"
