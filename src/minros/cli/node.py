@@ -7,6 +7,7 @@ timeout, so a dead node makes ``ping``/``info`` report a failure instead of hang
 from __future__ import annotations
 
 import errno
+import optparse
 import re
 import socket
 import sys
@@ -15,7 +16,7 @@ from typing import Dict, List, Tuple
 from urllib.parse import urlparse
 
 from minros import names
-from minros.tools.common import ToolError, dispatch, parser, resolve, run_tool
+from minros.tools.common import ToolError, dispatch, resolve, run_tool
 from minros.tools.master import Master, MasterException, call_node
 
 NAME = "rosnode"
@@ -34,6 +35,24 @@ Commands:
 
 Type rosnode <command> -h for more detailed usage, e.g. 'rosnode ping -h'
 """
+
+
+class _HelpFormatter(optparse.IndentedHelpFormatter):
+    """optparse's layout, except the usage line starts "usage:" where rosnode prints "Usage:":
+    every minros tool's ``--help`` says "usage:" (tests/integration/test_cli_errors.py checks it
+    for all of them). Dropping this class makes rosnode's help and usage errors identical."""
+
+    def format_usage(self, usage: str) -> str:
+        return f"usage: {usage}\n"
+
+
+def _options(prog: str, usage: str) -> optparse.OptionParser:
+    """rosnode parses its arguments with optparse; using it too gives the same ``-h`` text and
+    the same usage / ``rosnode: error: ...`` lines (exit status 2) for bad arguments.
+
+    ``prog`` is "<tool> <command>"; the usage names both, the error line only the tool."""
+    tool = prog.rsplit(" ", 1)[0] if " " in prog else prog
+    return optparse.OptionParser(usage=f"usage: {prog}{usage}", prog=tool, formatter=_HelpFormatter())
 
 
 class _Graph:
@@ -74,15 +93,16 @@ def _remote(triplet: list) -> object:
 # list
 
 def _cmd_list(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [namespace]")
-    p.add_argument("-u", dest="list_uri", action="store_true", help="list XML-RPC URIs")
-    p.add_argument("-a", "--all", dest="list_all", action="store_true", help="list all information")
-    p.add_argument("namespace", nargs="*")
-    args = p.parse_args(argv)
-    if len(args.namespace) > 1:
+    p = _options(prog, "")
+    p.add_option("-u", dest="list_uri", action="store_true", default=False, help="list XML-RPC URIs")
+    p.add_option("-a", "--all", dest="list_all", action="store_true", default=False,
+                 help="list all information")
+    options, args = p.parse_args(argv)
+    if len(args) > 1:
         p.error("invalid args: you may only specify one namespace")
-    namespace = resolve("rostopic", args.namespace[0]) if args.namespace else None
-    print(_list_text(_Graph(), namespace, args.list_uri, args.list_all))
+    # rosnode resolves the namespace as the caller 'rostopic' (relative to ROS_NAMESPACE)
+    namespace = resolve("rostopic", args[0]) if args else None
+    print(_list_text(_Graph(), namespace, options.list_uri, options.list_all))
     return 0
 
 
@@ -169,15 +189,14 @@ def connection_description(graph: _Graph, node_uri: str) -> str:
 
 
 def _cmd_info(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] node1 [node2...]")
-    p.add_argument("-q", "--quiet", action="store_true",
-                   help="Prints only basic information such as pubs/subs and does not contact nodes for more information")
-    p.add_argument("nodes", nargs="*")
-    args = p.parse_args(argv)
-    if not args.nodes:
+    p = _options(prog, " [options] node1 [node2...]")
+    p.add_option("-q", "--quiet", dest="quiet", action="store_true", default=False,
+                 help="Prints only basic information such as pubs/subs and does not contact nodes for more information")
+    options, nodes = p.parse_args(argv)
+    if not nodes:
         p.error("You must specify at least one node name")
     graph = _Graph()
-    for node in args.nodes:
+    for node in nodes:
         node = resolve("rosnode", node)
         print("-" * 80)
         print(info_description(graph.master, node))
@@ -186,7 +205,7 @@ def _cmd_info(argv: List[str], prog: str) -> int:
             sys.stdout.flush()
             print(f"cannot contact [{node}]: unknown node", file=sys.stderr)
             continue
-        if not args.quiet:
+        if not options.quiet:
             print(f"\ncontacting node {uri} ...")
             print(connection_description(graph, uri))
     return 0
@@ -261,28 +280,44 @@ def ping_all(graph: _Graph, verbose: bool = False) -> Tuple[List[str], List[str]
 
 
 def _cmd_ping(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] <node>")
-    p.add_argument("--all", "-a", dest="ping_all", action="store_true", help="ping all nodes")
-    p.add_argument("-c", dest="ping_count", type=int, metavar="COUNT",
-                   help="number of pings to send. Not available with --all")
-    p.add_argument("node", nargs="*")
-    args = p.parse_args(argv)
+    p = _options(prog, " [options] <node>")
+    p.add_option("--all", "-a", dest="ping_all", action="store_true", default=False, help="ping all nodes")
+    p.add_option("-c", dest="ping_count", type="int", metavar="COUNT", default=None,
+                 help="number of pings to send. Not available with --all")
+    options, args = p.parse_args(argv)
     graph = _Graph()
-    if args.ping_all:
-        if args.node:
-            p.error(f"Invalid arguments '{' '.join(args.node)}' used with --all")
-        if args.ping_count:
+    if options.ping_all:
+        if args:
+            p.error(f"Invalid arguments '{' '.join(args)}' used with --all")
+        if options.ping_count:
             p.error("-c may not be used with --all")
         ping_all(graph, verbose=True)
         return 0
-    if not args.node:
-        p.error("Please enter a node to ping")
-    if len(args.node) > 1:
+    if not args:
+        _missing_ping_target(p, graph)
+    if len(args) > 1:
         p.error("you may only specify one input node")
-    node = resolve("rosnode", args.node[0])
+    node = resolve("rosnode", args[0])
     print(f"rosnode: node is [{node}]")
-    ping(graph, node, max_count=args.ping_count, verbose=True)
+    ping(graph, node, max_count=options.ping_count, verbose=True)
     return 0
+
+
+def _missing_ping_target(p: optparse.OptionParser, graph: _Graph) -> None:
+    """``ping`` without a node: the usage error, listing the nodes when the master answers.
+
+    Debian's rosnode then prints the usage error a second time (its parser's exit is caught
+    by the fallback meant for an unreachable master); the texts are kept identical."""
+    from minros.tools.master import MasterError, MasterFailure, MasterIOError
+
+    try:
+        nodes = get_node_names(graph.master)
+    except (MasterIOError, MasterError, MasterFailure):
+        p.error("Please enter a node to ping")
+    p.print_usage(sys.stderr)
+    sys.stderr.write(f"{p.get_prog_name()}: error: Please enter a node to ping. Available nodes are:\n"
+                     + "\n".join(nodes) + "\n")
+    p.error("Please enter a node to ping")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -307,16 +342,15 @@ def kill_nodes(graph: _Graph, nodes: List[str]) -> Tuple[List[str], List[str]]:
 
 
 def _cmd_kill(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [node]...")
-    p.add_argument("-a", "--all", dest="kill_all", action="store_true", help="kill all nodes")
-    p.add_argument("nodes", nargs="*")
-    args = p.parse_args(argv)
+    p = _options(prog, " [node]...")
+    p.add_option("-a", "--all", dest="kill_all", action="store_true", default=False, help="kill all nodes")
+    options, nodes = p.parse_args(argv)
     graph = _Graph()
-    if args.kill_all:
-        if args.nodes:
+    if options.kill_all:
+        if nodes:
             p.error("invalid arguments with kill all (-a) option")
         targets = get_node_names(graph.master)
-    elif not args.nodes:
+    elif not nodes:
         node_list = get_node_names(graph.master)
         if not node_list:
             print("No nodes running", file=sys.stderr)
@@ -340,7 +374,7 @@ def _cmd_kill(argv: List[str], prog: str) -> int:
             sys.stdout.flush()
         targets = [node_list[selection - 1]]
     else:
-        targets = [resolve(ID, n) for n in args.nodes]
+        targets = [resolve(ID, n) for n in nodes]
         known = get_node_names(graph.master)
         unknown = [n for n in targets if n not in known]
         if unknown:
@@ -363,14 +397,13 @@ def _cmd_kill(argv: List[str], prog: str) -> int:
 
 
 def _cmd_machine(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [machine-name]")
-    p.add_argument("machine", nargs="*")
-    args = p.parse_args(argv)
-    if len(args.machine) > 1:
+    p = _options(prog, " [machine-name]")
+    _, args = p.parse_args(argv)
+    if len(args) > 1:
         p.error("please enter only one machine name")
     graph = _Graph()
-    nodes = get_node_names(graph.master)
-    if not args.machine:
+    if not args:
+        nodes = get_node_names(graph.master)
         machines: List[str] = []
         for node in nodes:
             uri = graph.node_uri(node)
@@ -379,11 +412,14 @@ def _cmd_machine(argv: List[str], prog: str) -> int:
                 machines.append(host)
         print("\n".join(sorted(machines)))
         return 0
-    machine = args.machine[0]
+    machine = args[0]
+    # the name is resolved before the master is asked (as rosnode: a bad name is reported
+    # even when no master runs)
     try:
         wanted = {info[4][0] for info in socket.getaddrinfo(machine, 0, 0, 0, socket.SOL_TCP)}
-    except OSError:
+    except (OSError, UnicodeError):
         raise ToolError(f"cannot resolve machine name [{machine}] to address") from None
+    nodes = get_node_names(graph.master)
     matches = []
     for node in nodes:
         uri = graph.node_uri(node)
@@ -429,7 +465,7 @@ def cleanup_master(graph: _Graph, dead: List[str]) -> None:
 
 
 def _cmd_cleanup(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=prog)
+    p = _options(prog, "")
     p.parse_args(argv)
     graph = _Graph()
     _pinged, unpinged = ping_all(graph)
