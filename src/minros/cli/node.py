@@ -37,22 +37,13 @@ Type rosnode <command> -h for more detailed usage, e.g. 'rosnode ping -h'
 """
 
 
-class _HelpFormatter(optparse.IndentedHelpFormatter):
-    """optparse's layout, except the usage line starts "usage:" where rosnode prints "Usage:":
-    every minros tool's ``--help`` says "usage:" (tests/integration/test_cli_errors.py checks it
-    for all of them). Dropping this class makes rosnode's help and usage errors identical."""
-
-    def format_usage(self, usage: str) -> str:
-        return f"usage: {usage}\n"
-
-
 def _options(prog: str, usage: str) -> optparse.OptionParser:
     """rosnode parses its arguments with optparse; using it too gives the same ``-h`` text and
     the same usage / ``rosnode: error: ...`` lines (exit status 2) for bad arguments.
 
     ``prog`` is "<tool> <command>"; the usage names both, the error line only the tool."""
     tool = prog.rsplit(" ", 1)[0] if " " in prog else prog
-    return optparse.OptionParser(usage=f"usage: {prog}{usage}", prog=tool, formatter=_HelpFormatter())
+    return optparse.OptionParser(usage=f"usage: {prog}{usage}", prog=tool)
 
 
 class _Graph:
