@@ -91,6 +91,47 @@ def role_echo(args) -> None:
     rospy.spin()
 
 
+class _RoundTrips:
+    """The pinging side's clock, the same code for every contender: ``on_pong`` records one
+    round trip and sends the next ping (from the receive thread, as a callback does)."""
+
+    WARMUP = 200
+
+    def __init__(self, count: int, send) -> None:
+        self.total = count + self.WARMUP
+        self.send = send
+        self.times: list = []
+        self.n = 0
+        self.t = 0.0
+        self.cpu = 0.0
+        self.done = threading.Event()
+
+    def start(self) -> None:
+        self.cpu = time.process_time()
+        self.t = time.perf_counter()
+        self.send()
+
+    def on_pong(self, _msg=None) -> bool:
+        now = time.perf_counter()
+        self.n += 1
+        if self.n > self.WARMUP:
+            self.times.append(now - self.t)
+        if self.n >= self.total:
+            self.done.set()
+            return True
+        self.t = time.perf_counter()
+        self.send()
+        return False
+
+    def report(self) -> None:
+        if not self.done.wait(60):
+            raise SystemExit(f"ping-pong stalled after {self.n} round trips")
+        cpu = time.process_time() - self.cpu
+        print(json.dumps({"median_us": statistics.median(self.times) * 1e6,
+                          "mean_us": statistics.mean(self.times) * 1e6,
+                          "cpu_us": cpu / self.total * 1e6}), flush=True)
+
+
 def role_ping(args) -> None:
     import warnings
 
@@ -101,34 +142,12 @@ def role_ping(args) -> None:
     rospy.init_node("bench_ping", anonymous=True)
     pub = rospy.Publisher("/bench_ping", String, queue_size=_queue(args.queue), tcp_nodelay=True)
     msg = String("x" * 16)  # 20 bytes on the wire
-    times: list = []
-    done = threading.Event()
-    state = {"t": 0.0, "n": 0}
-    total = args.count + 200  # the first 200 warm up
-
-    def on_pong(_msg) -> None:
-        now = time.perf_counter()
-        state["n"] += 1
-        if state["n"] > 200:
-            times.append(now - state["t"])
-        if state["n"] >= total:
-            done.set()
-            return
-        state["t"] = time.perf_counter()
-        pub.publish(msg)
-
-    rospy.Subscriber("/bench_pong", String, on_pong, tcp_nodelay=True)
+    clock = _RoundTrips(args.count, lambda: pub.publish(msg))
+    rospy.Subscriber("/bench_pong", String, clock.on_pong, tcp_nodelay=True)
     _wait_connections(pub)
     time.sleep(0.5)  # the echo's publisher needs our subscription too
-    state["t"] = time.perf_counter()
-    cpu = time.process_time()
-    pub.publish(msg)
-    if not done.wait(60):
-        raise SystemExit(f"ping-pong stalled after {state['n']} round trips")
-    cpu = time.process_time() - cpu
-    print(json.dumps({"median_us": statistics.median(times) * 1e6,
-                      "mean_us": statistics.mean(times) * 1e6,
-                      "cpu_us": cpu / total * 1e6}), flush=True)
+    clock.start()
+    clock.report()
     rospy.signal_shutdown("done")
 
 
@@ -261,33 +280,11 @@ def role_raw_pubsub_ping(args) -> None:
     for sock in (incoming, outgoing):
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     payload = struct.pack("<I", 20) + struct.pack("<I", 16) + b"x" * 16
-    times: list = []
-    state = {"t": 0.0, "n": 0, "cpu": 0.0}
-    total = args.count + 200
-    done = threading.Event()
-
-    def on_pong(_frame) -> bool:
-        now = time.perf_counter()
-        state["n"] += 1
-        if state["n"] > 200:
-            times.append(now - state["t"])
-        if state["n"] >= total:
-            done.set()
-            return True
-        state["t"] = time.perf_counter()
-        outgoing.sendall(payload)
-        return False
-
-    threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, on_pong), daemon=True).start()
-    cpu = time.process_time()
-    state["t"] = time.perf_counter()
-    outgoing.sendall(payload)
-    if not done.wait(60):
-        raise SystemExit(f"ping-pong stalled after {state['n']} round trips")
-    cpu = time.process_time() - cpu
-    print(json.dumps({"median_us": statistics.median(times) * 1e6,
-                      "mean_us": statistics.mean(times) * 1e6,
-                      "cpu_us": cpu / total * 1e6}), flush=True)
+    clock = _RoundTrips(args.count, lambda: outgoing.sendall(payload))
+    threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, clock.on_pong),
+                     daemon=True).start()
+    clock.start()
+    clock.report()
 
 
 def role_raw_flood_sub(args) -> None:
