@@ -7,6 +7,7 @@ reads one or more YAML documents from a file or stdin (``-``) with ``_ns`` suppo
 
 from __future__ import annotations
 
+import optparse
 import os
 import sys
 import xmlrpc.client
@@ -15,7 +16,7 @@ from typing import Any, List, Tuple
 import yaml
 
 from minros import names
-from minros.tools.common import ToolError, dispatch, parser, resolve, run_tool
+from minros.tools.common import ToolError, dispatch, option_parser, resolve, run_tool
 from minros.tools.master import Master
 
 NAME = "rosparam"
@@ -173,14 +174,15 @@ def _pretty_print(value: dict, indent: str = "") -> None:
 # commands
 
 def _cmd_get(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] parameter")
-    p.add_argument("-p", dest="pretty", action="store_true", help="pretty print. WARNING: not YAML-safe")
-    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
-    p.add_argument("parameter", nargs="?")
-    args = p.parse_args(argv)
-    if args.parameter is None:
+    p = option_parser(prog, " [options] parameter")
+    p.add_option("-p", dest="pretty", default=False, action="store_true", help="pretty print. WARNING: not YAML-safe")
+    p.add_option("-v", dest="verbose", default=False, action="store_true", help="turn on verbose output")
+    args, parameters = p.parse_args(argv)
+    if not parameters:
         p.error("invalid arguments. Please specify a parameter name")
-    name = resolve(NAME, args.parameter)
+    if len(parameters) > 1:
+        p.error("too many arguments")
+    name = resolve(NAME, parameters[0])
     if args.verbose:
         print(f"getting parameter [{name}]")
     value = _master().getParam(name)
@@ -198,11 +200,13 @@ def _cmd_get(argv: List[str], prog: str) -> int:
 
 
 def _cmd_dump(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] file [namespace]")
-    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
-    p.add_argument("file", nargs="?")
-    p.add_argument("namespace", nargs="?", default="")
-    args = p.parse_args(argv)
+    p = option_parser(prog, " [options] file [namespace]")
+    p.add_option("-v", dest="verbose", default=False, action="store_true", help="turn on verbose output")
+    args, positional = p.parse_args(argv)
+    if len(positional) > 2:
+        p.error("too many arguments")
+    args.file = positional[0] if positional else None
+    args.namespace = positional[1] if len(positional) > 1 else ""
     if args.verbose:
         print(f"dumping namespace [{args.namespace}] to file [{args.file}]")
     ns = resolve(NAME, args.namespace)
@@ -221,11 +225,15 @@ def _cmd_dump(argv: List[str], prog: str) -> int:
     return 0
 
 
-def _split_set_args(argv: List[str]) -> Tuple[List[str], List[str]]:
-    """Negative numbers are values, not options (as rosparam's own parser does)."""
+def _split_set_args(argv: List[str], p: optparse.OptionParser | None = None) -> Tuple[List[str], List[str]]:
+    """Negative numbers are values, not options (as rosparam's own parser does); an option
+    where -t/-b expect their file is a usage error reported through ``p``."""
+    p = p or option_parser(f"{NAME} set")
     opts, positional = [], []
     skip = False
     for arg in argv:
+        if skip and arg.startswith("-"):
+            p.error("-t and --textfile options require an argument")  # rosparam's words, also for -b
         if skip:
             opts.append(arg)
             skip = False
@@ -242,14 +250,14 @@ def _split_set_args(argv: List[str]) -> Tuple[List[str], List[str]]:
 
 
 def _cmd_set(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] parameter value")
-    p.add_argument("-t", "--textfile", dest="text_file", metavar="TEXT_FILE",
-                   help="set parameters to contents of text file")
-    p.add_argument("-b", "--binfile", dest="bin_file", metavar="BINARY_FILE",
-                   help="set parameters to contents of binary file")
-    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
-    opts, positional = _split_set_args(argv)
-    args = p.parse_args(opts)
+    p = option_parser(prog, " [options] parameter value")
+    p.add_option("-t", "--textfile", dest="text_file", default=None, metavar="TEXT_FILE",
+                 help="set parameters to contents of text file")
+    p.add_option("-b", "--binfile", dest="bin_file", default=None, metavar="BINARY_FILE",
+                 help="set parameters to contents of binary file")
+    p.add_option("-v", dest="verbose", default=False, action="store_true", help="turn on verbose output")
+    opts, positional = _split_set_args(argv, p)
+    args, _none = p.parse_args(opts)
     if args.text_file and args.bin_file:
         p.error("you may only specify one of --textfile or --binfile")
     if not positional:
@@ -280,13 +288,15 @@ def _cmd_set(argv: List[str], prog: str) -> int:
 
 
 def _cmd_load(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] file [namespace]")
-    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
-    p.add_argument("file", nargs="?")
-    p.add_argument("namespace", nargs="?")
-    args = p.parse_args(argv)
-    if args.file is None:
+    p = option_parser(prog, " [options] file [namespace]")
+    p.add_option("-v", dest="verbose", default=False, action="store_true", help="turn on verbose output")
+    args, positional = p.parse_args(argv)
+    if not positional:
         p.error("invalid arguments. Please specify a file name or - for stdin")
+    if len(positional) > 2:
+        p.error("too many arguments")
+    args.file = positional[0]
+    args.namespace = positional[1] if len(positional) > 1 else None
     default_ns = resolve(NAME, args.namespace) if args.namespace else names.get_ros_namespace()
     if args.file == "-":
         if args.verbose:
@@ -310,15 +320,14 @@ def _cmd_load(argv: List[str], prog: str) -> int:
 
 
 def _cmd_delete(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] parameter")
-    p.add_argument("-v", dest="verbose", action="store_true", help="turn on verbose output")
-    p.add_argument("parameter", nargs="*")
-    args = p.parse_args(argv)
-    if not args.parameter:
+    p = option_parser(prog, " [options] parameter")
+    p.add_option("-v", dest="verbose", default=False, action="store_true", help="turn on verbose output")
+    args, parameters = p.parse_args(argv)
+    if not parameters:
         p.error("invalid arguments. Please specify a parameter name")
-    if len(args.parameter) > 1:
+    if len(parameters) > 1:
         p.error("too many arguments")
-    name = resolve(NAME, args.parameter[0])
+    name = resolve(NAME, parameters[0])
     master = _master()
     if name == "/":
         master.setParam("/", {})
@@ -332,12 +341,12 @@ def _cmd_delete(argv: List[str], prog: str) -> int:
 
 
 def _cmd_list(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [namespace]")
-    p.add_argument("namespace", nargs="*")
-    args = p.parse_args(argv)
-    if len(args.namespace) > 1:
+    p = option_parser(prog, " [namespace]")
+    _options, namespaces = p.parse_args(argv)
+    if len(namespaces) > 1:
+        # rosparam only objects to exactly two (three or more silently list everything)
         p.error("too many arguments")
-    ns = resolve(NAME, args.namespace[0]) if args.namespace else "/"
+    ns = resolve(NAME, namespaces[0]) if namespaces else "/"
     print("\n".join(list_params(_master(), ns)))
     return 0
 

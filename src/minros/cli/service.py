@@ -15,7 +15,7 @@ from typing import Any, List
 import yaml
 
 from minros import names, tcpros
-from minros.tools.common import ToolError, dispatch, parser, resolve, run_tool
+from minros.tools.common import ToolError, dispatch, option_parser, resolve, run_tool
 from minros.tools.master import Master, MasterError
 
 NAME = "rosservice"
@@ -120,28 +120,26 @@ def get_service_args(master: Master, service: str) -> str:
 
 
 def _one_service(argv: List[str], prog: str, what: str) -> str:
-    p = parser(prog, usage=f"{prog} /service")
-    p.add_argument("service", nargs="*")
-    args = p.parse_args(argv)
-    if not args.service:
+    p = option_parser(prog, " /service")
+    _options, services = p.parse_args(argv)
+    if not services:
         p.error("service must be specified")
-    if len(args.service) > 1:
+    if len(services) > 1:
         p.error("you may only specify one input service")
-    return resolve(NAME, args.service[0])
+    return resolve(NAME, services[0])
 
 
 # ---------------------------------------------------------------------------------------------
 # commands
 
 def _cmd_list(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [/namespace]")
-    p.add_argument("-n", "--nodes", dest="print_nodes", action="store_true",
-                   help="print nodes that provide service(s)")
-    p.add_argument("namespace", nargs="*")
-    args = p.parse_args(argv)
-    if len(args.namespace) > 1:
+    p = option_parser(prog, " [/namespace]")
+    p.add_option("-n", "--nodes", dest="print_nodes", default=False, action="store_true",
+                 help="print nodes that provide service(s)")
+    args, namespaces = p.parse_args(argv)
+    if len(namespaces) > 1:
         p.error("you may only specify one input namespace")
-    namespace = resolve(NAME, args.namespace[0]) if args.namespace else None
+    namespace = resolve(NAME, namespaces[0]) if namespaces else None
     srvs = get_service_list(_master(), namespace=namespace, include_nodes=args.print_nodes)
     if args.print_nodes:
         for name, nodes in sorted(srvs, key=lambda s: s[0]):
@@ -189,14 +187,13 @@ def _cmd_args(argv: List[str], prog: str) -> int:
 
 
 def _cmd_info(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} /service")
-    p.add_argument("service", nargs="*")
-    args = p.parse_args(argv)
-    if len(args.service) > 1:
+    p = option_parser(prog, " /service")
+    _options, services = p.parse_args(argv)
+    if len(services) > 1:
         p.error("you may only specify one service")
-    if not args.service:
+    if not services:
         p.error("you must specify a service name")
-    service = resolve(NAME, args.service[0])
+    service = resolve(NAME, services[0])
     master = _master()
     node = get_service_node(master, service)
     if not node:
@@ -229,14 +226,13 @@ def find_services(master: Master, service_type: str) -> List[str]:
 
 
 def _cmd_find(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} msg-type")
-    p.add_argument("type", nargs="*")
-    args = p.parse_args(argv)
-    if not args.type:
+    p = option_parser(prog, " msg-type")
+    _options, types = p.parse_args(argv)
+    if not types:
         p.error("please specify a message type")
-    if len(args.type) > 1:
+    if len(types) > 1:
         p.error("you may only specify one message type")
-    print("\n".join(find_services(_master(), args.type[0])))
+    print("\n".join(find_services(_master(), types[0])))
     return 0
 
 
@@ -299,15 +295,14 @@ def _stdin_documents() -> Any:
 
 
 def _cmd_call(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} /service [args...]")
-    p.add_argument("-v", dest="verbose", action="store_true", help="print verbose output")
-    p.add_argument("--wait", action="store_true", help="wait for service to be advertised")
-    p.add_argument("service", nargs="?")
-    p.add_argument("args", nargs="*")
+    p = option_parser(prog, " /service [args...]")
+    p.add_option("-v", dest="verbose", default=False, action="store_true", help="print verbose output")
+    p.add_option("--wait", dest="wait", default=False, action="store_true",
+                 help="wait for service to be advertised")
     # values such as -1 are arguments of the call, not options
     opts = [a for a in argv if a.startswith("-") and not a[1:2].isdigit() and a not in ("-", "-.")]
     rest = [a for a in argv if a not in opts]
-    args = p.parse_args(opts)
+    args, _none = p.parse_args(opts)
     if not rest:
         p.error("service must be specified")
     service = resolve(NAME, rest[0])
@@ -344,4 +339,8 @@ COMMANDS = {"list": _cmd_list, "info": _cmd_info, "type": _cmd_type, "uri": _cmd
 
 
 def main(argv: List[str], prog: str = "rosservice") -> int:
+    if argv[:1] in (["-h"], ["--help"]):
+        # rosservice has no -h of its own: like any unknown command, the usage and EX_USAGE
+        print(USAGE)
+        return 64
     return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE, usage_status=64), io_status=2)

@@ -7,6 +7,7 @@ that are not installed locally.
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import sys
@@ -18,7 +19,7 @@ from urllib.parse import urlparse
 import yaml
 
 from minros import names
-from minros.tools.common import ToolError, dispatch, flush_stdout, parser, resolve, run_tool
+from minros.tools.common import ToolError, dispatch, flush_stdout, option_parser, resolve, run_tool
 from minros.tools.master import Master, MasterError
 
 NAME = "rostopic"
@@ -29,7 +30,7 @@ Commands:
 \trostopic delay\tdisplay delay of topic from timestamp in header
 \trostopic echo\tprint messages to screen
 \trostopic find\tfind topics by type
-\trostopic hz\tdisplay publishing rate of topic
+\trostopic hz\tdisplay publishing rate of topic\x20\x20\x20\x20
 \trostopic info\tprint information about active topic
 \trostopic list\tlist active topics
 \trostopic pub\tpublish data to topic
@@ -181,19 +182,31 @@ def _print_list(master: Master, pubs: list, subs: list, pubs_only: bool, subs_on
     print("\n".join(f"{indent}{t}" for t in sorted(topics)))
 
 
+def _no_bags(path: str) -> None:
+    """minros's rostopic reads no bag files; a missing one is reported as rostopic does."""
+    if not os.path.exists(path):
+        raise ToolError(f"bag file [{path}] does not exist")
+    raise ToolError("reading bag files is not supported by minros's rostopic")
+
+
 def _cmd_list(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [/namespace]")
-    p.add_argument("-v", "--verbose", action="store_true", help="list full details about each topic")
-    p.add_argument("-p", dest="publishers", action="store_true", help="list only publishers")
-    p.add_argument("-s", dest="subscribers", action="store_true", help="list only subscribers")
-    p.add_argument("--host", dest="hostname", action="store_true", help="group by host name")
-    p.add_argument("-b", "--bag", dest="bag", metavar="BAGFILE", help="list topics in .bag file")
-    p.add_argument("namespace", nargs="*")
-    args = p.parse_args(argv)
-    if args.bag:
-        raise ToolError("reading bag files is not supported by minros's rostopic")
+    p = option_parser(prog, " [/namespace]")
+    p.add_option("-b", "--bag", dest="bag", default=None, metavar="BAGFILE", help="list topics in .bag file")
+    p.add_option("-v", "--verbose", dest="verbose", default=False, action="store_true",
+                 help="list full details about each topic")
+    p.add_option("-p", dest="publishers", default=False, action="store_true", help="list only publishers")
+    p.add_option("-s", dest="subscribers", default=False, action="store_true", help="list only subscribers")
+    p.add_option("--host", dest="hostname", default=False, action="store_true", help="group by host name")
+    args, namespace = p.parse_args(argv)
+    args.namespace = namespace
     if len(args.namespace) > 1:
         p.error("you may only specify one input topic")
+    if args.bag:
+        # the usage errors rostopic gives with a bag come first
+        for flag, given in (("-s", args.subscribers), ("-p", args.publishers), ("--host", args.hostname)):
+            if given:
+                p.error(f"{flag} option is not valid with bags")
+        _no_bags(args.bag)
     if args.publishers and args.subscribers:
         p.error("you may only specify one of -p, -s")
     master = _master()
@@ -258,14 +271,13 @@ def info_text(master: Master, topic: str) -> str:
 
 def _one_topic(argv: List[str], prog: str, missing: str = "topic must be specified",
                many: str = "you may only specify one input topic") -> str:
-    p = parser(prog, usage=f"{prog} /topic")
-    p.add_argument("topic", nargs="*")
-    args = p.parse_args(argv)
-    if not args.topic:
+    p = option_parser(prog, " /topic")
+    _options, topics = p.parse_args(argv)
+    if not topics:
         p.error(missing)
-    if len(args.topic) > 1:
+    if len(topics) > 1:
         p.error(many)
-    return resolve(NAME, args.topic[0])
+    return resolve(NAME, topics[0])
 
 
 def _cmd_info(argv: List[str], prog: str) -> int:
@@ -275,7 +287,8 @@ def _cmd_info(argv: List[str], prog: str) -> int:
 
 
 def _cmd_type(argv: List[str], prog: str) -> int:
-    p = parser(prog)
+    # rostopic parses 'type' with argparse (its usage and errors name "rostopic type")
+    p = argparse.ArgumentParser(prog=prog)
     p.add_argument("topic_or_field", help="Topic or field name")
     args = p.parse_args(argv)
     topic = resolve(NAME, args.topic_or_field)
@@ -299,14 +312,13 @@ def _cmd_type(argv: List[str], prog: str) -> int:
 
 
 def _cmd_find(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} msg-type")
-    p.add_argument("type", nargs="*")
-    args = p.parse_args(argv)
-    if not args.type:
+    p = option_parser(prog, " msg-type")
+    _options, types = p.parse_args(argv)
+    if not types:
         p.error("please specify a message type")
-    if len(args.type) > 1:
+    if len(types) > 1:
         p.error("you may only specify one message type")
-    print("\n".join(t for t, ty in _master().topic_types() if ty == args.type[0]))
+    print("\n".join(t for t, ty in _master().topic_types() if ty == types[0]))
     return 0
 
 
@@ -426,30 +438,32 @@ def _compile_filter(expr: str | None) -> Callable | None:
 
 
 def _cmd_echo(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] /topic")
-    p.add_argument("-b", "--bag", dest="bag", metavar="BAGFILE", help="echo messages from .bag file")
-    p.add_argument("-p", dest="plot", action="store_true", help="echo in a plotting friendly format")
-    p.add_argument("-w", dest="fixed_numeric_width", metavar="NUM_WIDTH", help="fixed width for numeric values")
-    p.add_argument("--filter", dest="filter_expr", metavar="FILTER-EXPRESSION",
-                   help="Python expression to filter messages that are printed. Expression can use "
-                        "Python builtins as well as m (the message) and topic (the topic name).")
-    p.add_argument("--nostr", action="store_true", help="exclude string fields")
-    p.add_argument("--noarr", action="store_true", help="exclude arrays")
-    p.add_argument("-c", "--clear", action="store_true", help="clear screen before printing next message")
-    p.add_argument("-a", "--all", dest="all_topics", action="store_true",
-                   help="display all message in bag, only valid with -b option")
-    p.add_argument("-n", dest="msg_count", metavar="COUNT", help="number of messages to echo")
-    p.add_argument("--offset", dest="offset_time", action="store_true",
-                   help="display time as offsets from current time (in seconds)")
-    p.add_argument("topic", nargs="*")
-    args = p.parse_args(argv)
-    if len(args.topic) > 1:
+    p = option_parser(prog, " [options] /topic")
+    p.add_option("-b", "--bag", dest="bag", default=None, metavar="BAGFILE", help="echo messages from .bag file")
+    p.add_option("-p", dest="plot", default=False, action="store_true", help="echo in a plotting friendly format")
+    p.add_option("-w", dest="fixed_numeric_width", default=None, metavar="NUM_WIDTH",
+                 help="fixed width for numeric values")
+    p.add_option("--filter", dest="filter_expr", default=None, metavar="FILTER-EXPRESSION",
+                 help="Python expression to filter messages that are printed. Expression can use "
+                      "Python builtins as well as m (the message) and topic (the topic name).")
+    p.add_option("--nostr", dest="nostr", default=False, action="store_true", help="exclude string fields")
+    p.add_option("--noarr", dest="noarr", default=False, action="store_true", help="exclude arrays")
+    p.add_option("-c", "--clear", dest="clear", default=False, action="store_true",
+                 help="clear screen before printing next message")
+    p.add_option("-a", "--all", dest="all_topics", default=False, action="store_true",
+                 help="display all message in bag, only valid with -b option")
+    p.add_option("-n", dest="msg_count", default=None, metavar="COUNT", help="number of messages to echo")
+    p.add_option("--offset", dest="offset_time", default=False, action="store_true",
+                 help="display time as offsets from current time (in seconds)")
+    args, topics = p.parse_args(argv)
+    # the checks in rostopic's order, so the same mistake gets the same message
+    if len(topics) > 1:
         p.error("you may only specify one input topic")
-    if args.bag:
-        raise ToolError("reading bag files is not supported by minros's rostopic")
-    if args.all_topics:
+    if args.all_topics and not args.bag:
         p.error("Display all option is only valid when echoing from bag files")
-    if not args.topic:
+    if args.offset_time and args.bag:
+        p.error("offset time option is not valid with bag files")
+    if not topics and not args.all_topics:
         p.error("topic must be specified")
     try:
         args.msg_count = int(args.msg_count) if args.msg_count else None
@@ -462,7 +476,9 @@ def _cmd_echo(argv: List[str], prog: str) -> int:
     if width is not None and width < 2:
         p.error("Fixed width for numeric values must be at least 2")
     args.fixed_numeric_width = width
-    topic = resolve(NAME, args.topic[0])
+    if args.bag:
+        _no_bags(args.bag)
+    topic = resolve(NAME, topics[0])
     filter_fn = _compile_filter(args.filter_expr)
     master = _check_master()
     _init_node()
@@ -541,24 +557,23 @@ def _use_sim_time(master: Master) -> bool:
 
 
 def _cmd_hz(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] /topic_0 [/topic_1 [topic_2 [..]]]")
-    p.add_argument("-w", "--window", dest="window_size", default="-1", metavar="WINDOW",
-                   help="window size, in # of messages, for calculating rate")
-    p.add_argument("--filter", dest="filter_expr", metavar="EXPR",
-                   help="only measure messages matching the specified Python expression")
-    p.add_argument("--wall-time", dest="use_wtime", action="store_true",
-                   help="calculates rate using wall time which can be helpful when clock isn't published during simulation")
-    p.add_argument("--tcpnodelay", dest="tcp_nodelay", action="store_true",
-                   help="use the TCP_NODELAY transport hint when subscribing to topics")
-    p.add_argument("topics", nargs="*")
-    args = p.parse_args(argv)
-    if not args.topics:
+    p = option_parser(prog, " [options] /topic_0 [/topic_1 [topic_2 [..]]]")
+    p.add_option("-w", "--window", dest="window_size", default="-1", metavar="WINDOW",
+                 help="window size, in # of messages, for calculating rate")
+    p.add_option("--filter", dest="filter_expr", default=None, metavar="EXPR",
+                 help="only measure messages matching the specified Python expression")
+    p.add_option("--wall-time", dest="use_wtime", default=False, action="store_true",
+                 help="calculates rate using wall time which can be helpful when clock isn't published during simulation")
+    p.add_option("--tcpnodelay", dest="tcp_nodelay", default=False, action="store_true",
+                 help="use the TCP_NODELAY transport hint when subscribing to topics")
+    args, names_given = p.parse_args(argv)
+    if not names_given:
         p.error("topic must be specified")
     try:
         window = int(args.window_size)
     except ValueError:
         p.error("window size must be an integer")
-    topics = [resolve(NAME, t) for t in args.topics]
+    topics = [resolve(NAME, t) for t in names_given]
     filter_fn = _compile_filter(args.filter_expr)
     master = _check_master()
     _init_node()
@@ -632,21 +647,20 @@ def _format_bw(sizes: List[int], times: List[float], now: float) -> str | None:
 
 
 def _cmd_bw(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} /topic")
-    p.add_argument("-w", "--window", dest="window_size", metavar="WINDOW",
-                   help="window size, in # of messages, for calculating rate")
-    p.add_argument("topic", nargs="*")
-    args = p.parse_args(argv)
-    if not args.topic:
+    p = option_parser(prog, " /topic")
+    p.add_option("-w", "--window", dest="window_size", default=None, metavar="WINDOW",
+                 help="window size, in # of messages, for calculating rate")
+    args, topics = p.parse_args(argv)
+    if not topics:
         p.error("topic must be specified")
-    if len(args.topic) > 1:
+    if len(topics) > 1:
         p.error("you may only specify one input topic")
     try:
         window = int(args.window_size) if args.window_size is not None else 100
     except ValueError:
         p.error("window size must be an integer")
     window = window or 100
-    topic = resolve(NAME, args.topic[0])
+    topic = resolve(NAME, topics[0])
     master = _check_master()
     _type, real_topic, _field = wait_topic_type(master, topic)
     _init_node()
@@ -679,7 +693,9 @@ def _cmd_bw(argv: List[str], prog: str) -> int:
 
 
 def _cmd_delay(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} [options] /topic")
+    # rostopic parses 'delay' with argparse, its errors naming only the tool
+    tool = prog.rsplit(" ", 1)[0]
+    p = argparse.ArgumentParser(usage=f"{prog} [options] /topic", prog=tool)
     p.add_argument("topic", help="topic name to be calcurated the delay")
     p.add_argument("-w", "--window", dest="window_size", default=-1, type=int,
                    help="window size, in # of messages, for calculating rate")
@@ -827,18 +843,19 @@ def _stdin_documents() -> Any:
 
 
 def _cmd_pub(argv: List[str], prog: str) -> int:
-    p = parser(prog, usage=f"{prog} /topic type [args...]")
-    p.add_argument("-v", dest="verbose", action="store_true", help="print verbose output")
-    p.add_argument("-r", "--rate", dest="rate",
-                   help="publishing rate (hz).  For -f and stdin input, this defaults to 10.  Otherwise it is not set.")
-    p.add_argument("-1", "--once", dest="once", action="store_true", help="publish one message and exit")
-    p.add_argument("-f", "--file", dest="file", metavar="FILE", help="read args from YAML file (Bagy)")
-    p.add_argument("-l", "--latch", dest="latch", action="store_true",
-                   help="enable latching for -f, -r and piped input.  This latches the first message.")
-    p.add_argument("-s", "--substitute-keywords", dest="substitute_keywords", action="store_true",
-                   help="When publishing with a rate, performs keyword ('now' or 'auto') substitution for each message")
-    p.add_argument("--use-rostime", dest="use_rostime", action="store_true",
-                   help="use rostime for time stamps, else walltime is used")
+    p = option_parser(prog, " /topic type [args...]")
+    p.add_option("-v", dest="verbose", default=False, action="store_true", help="print verbose output")
+    p.add_option("-r", "--rate", dest="rate", default=None,
+                 help="publishing rate (hz).  For -f and stdin input, this defaults to 10.  Otherwise it is not set.")
+    p.add_option("-1", "--once", dest="once", default=False, action="store_true",
+                 help="publish one message and exit")
+    p.add_option("-f", "--file", dest="file", default=None, metavar="FILE", help="read args from YAML file (Bagy)")
+    p.add_option("-l", "--latch", dest="latch", default=False, action="store_true",
+                 help="enable latching for -f, -r and piped input.  This latches the first message.")
+    p.add_option("-s", "--substitute-keywords", dest="substitute_keywords", default=False, action="store_true",
+                 help="When publishing with a rate, performs keyword ('now' or 'auto') substitution for each message")
+    p.add_option("--use-rostime", dest="use_rostime", default=False, action="store_true",
+                 help="use rostime for time stamps, else walltime is used")
     # negative numbers such as -7 or -0.5 are message values, not options ('-1' is --once, as in
     # rostopic; '--' ends the options)
     options: List[str] = []
@@ -858,7 +875,7 @@ def _cmd_pub(argv: List[str], prog: str) -> int:
                 options.append(argv[i + 1])
                 i += 1
         i += 1
-    args = p.parse_args(options)
+    args, _none = p.parse_args(options)
     rate: float | None = None
     if args.rate is not None:
         if args.once:
@@ -976,4 +993,8 @@ COMMANDS = {"list": _cmd_list, "info": _cmd_info, "type": _cmd_type, "find": _cm
 
 
 def main(argv: List[str], prog: str = "rostopic") -> int:
+    if argv[:1] in (["-h"], ["--help"]):
+        # rostopic has no -h of its own: like any unknown command, the usage and EX_USAGE
+        print(USAGE)
+        return 64
     return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE, usage_status=64))

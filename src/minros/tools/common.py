@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import optparse
 import os
 import sys
 from typing import Callable, Dict, List
@@ -30,6 +31,17 @@ class ArgParser(argparse.ArgumentParser):
 
 def parser(prog: str, usage: str | None = None, description: str | None = None) -> ArgParser:
     return ArgParser(prog=prog, usage=usage, description=description)
+
+
+def option_parser(prog: str, usage: str = "") -> optparse.OptionParser:
+    """The optparse parser Debian's rostopic, rosservice, rosparam and rosnode build: with it
+    the ``-h`` text and the usage errors ("Usage: <tool> <command>...", a blank line,
+    "<tool>: error: ...", exit status 2) come out byte for byte the same.
+
+    ``prog`` is "<tool> <command>"; the usage line names both, the error line only the tool.
+    Add options with ``add_option(..., default=...)``; optparse defaults are ``None``."""
+    tool = prog.rsplit(" ", 1)[0] if " " in prog else prog
+    return optparse.OptionParser(usage=f"usage: {prog}{usage}", prog=tool)
 
 
 def strip_ros_args(argv: List[str]) -> List[str]:
