@@ -62,6 +62,8 @@ TOPIC_CASES = [
     ("rostopic", "pub", "--bogus", "/a", "std_msgs/String", "hi"),
     ("rostopic", "pub", "/a", "std_msgs/String", "-r"), ("rostopic", "pub", "--help"),
     ("rostopic", "echo", "-b", "/nonexistent.bag", "/a"), ("rostopic", "list", "-b", "/nonexistent.bag"),
+    ("rostopic", "pub", "-r", "-1", "/a", "std_msgs/String", "hi"), ("rostopic", "pub", "/a", "std_msgs/String", "-f"),
+    ("rostopic", "echo", "/a", "-h"), ("rostopic", "find", "--help"), ("rostopic", "echo", "-w", "0", "/a"),
 ]
 SERVICE_CASES = [
     ("rosservice",), ("rosservice", "-h"), ("rosservice", "bogus"),
@@ -71,7 +73,8 @@ SERVICE_CASES = [
     ("rosservice", "find", "-h"), ("rosservice", "find"), ("rosservice", "find", "a", "b"),
     ("rosservice", "find", "--bogus", "std_srvs/Empty"),
     ("rosservice", "call", "-h"), ("rosservice", "call"), ("rosservice", "call", "-v"),
-    ("rosservice", "call", "--bogus", "/a"), ("rosservice", "call", "--wait"),
+    ("rosservice", "call", "--bogus", "/a"), ("rosservice", "call", "--wait"), ("rosservice", "call", "/nope", "-h"),
+    ("rosservice", "list", "-n", "a", "b"),
 ] + [("rosservice", command, *args) for command in ("type", "uri", "node", "args")
      for args in (("-h",), (), ("a", "b"), ("--bogus", "/a"))]
 PARAM_CASES = [
@@ -84,7 +87,8 @@ PARAM_CASES = [
     ("rosparam", "load", "-h"), ("rosparam", "load"), ("rosparam", "load", "a", "b", "c"), ("rosparam", "load", "--bogus", "a"),
     ("rosparam", "delete", "-h"), ("rosparam", "delete"), ("rosparam", "delete", "a", "b"), ("rosparam", "delete", "-x", "a"),
     ("rosparam", "list", "-h"), ("rosparam", "list", "a", "b"), ("rosparam", "list", "--bogus"),
-    ("rosparam", "get", "--help"),
+    ("rosparam", "get", "--help"), ("rosparam", "set", "-v"), ("rosparam", "get", "-p"),
+    ("rosparam", "dump", "-v", "a", "b", "c"), ("rosparam", "load", "-v"), ("rosparam", "delete", "--help"),
 ]
 CASES = TOPIC_CASES + SERVICE_CASES + PARAM_CASES
 #: usage errors come before the master is asked: the same texts when no master runs
