@@ -16,7 +16,7 @@ from typing import Dict, List, Tuple
 from urllib.parse import urlparse
 
 from minros import names
-from minros.tools.common import ToolError, dispatch, resolve, run_tool
+from minros.tools.common import ToolError, dispatch, option_parser, resolve, run_tool
 from minros.tools.master import Master, MasterException, call_node
 
 NAME = "rosnode"
@@ -35,15 +35,6 @@ Commands:
 
 Type rosnode <command> -h for more detailed usage, e.g. 'rosnode ping -h'
 """
-
-
-def _options(prog: str, usage: str) -> optparse.OptionParser:
-    """rosnode parses its arguments with optparse; using it too gives the same ``-h`` text and
-    the same usage / ``rosnode: error: ...`` lines (exit status 2) for bad arguments.
-
-    ``prog`` is "<tool> <command>"; the usage names both, the error line only the tool."""
-    tool = prog.rsplit(" ", 1)[0] if " " in prog else prog
-    return optparse.OptionParser(usage=f"usage: {prog}{usage}", prog=tool)
 
 
 class _Graph:
@@ -84,7 +75,7 @@ def _remote(triplet: list) -> object:
 # list
 
 def _cmd_list(argv: List[str], prog: str) -> int:
-    p = _options(prog, "")
+    p = option_parser(prog, "")
     p.add_option("-u", dest="list_uri", action="store_true", default=False, help="list XML-RPC URIs")
     p.add_option("-a", "--all", dest="list_all", action="store_true", default=False,
                  help="list all information")
@@ -180,7 +171,7 @@ def connection_description(graph: _Graph, node_uri: str) -> str:
 
 
 def _cmd_info(argv: List[str], prog: str) -> int:
-    p = _options(prog, " [options] node1 [node2...]")
+    p = option_parser(prog, " [options] node1 [node2...]")
     p.add_option("-q", "--quiet", dest="quiet", action="store_true", default=False,
                  help="Prints only basic information such as pubs/subs and does not contact nodes for more information")
     options, nodes = p.parse_args(argv)
@@ -271,7 +262,7 @@ def ping_all(graph: _Graph, verbose: bool = False) -> Tuple[List[str], List[str]
 
 
 def _cmd_ping(argv: List[str], prog: str) -> int:
-    p = _options(prog, " [options] <node>")
+    p = option_parser(prog, " [options] <node>")
     p.add_option("--all", "-a", dest="ping_all", action="store_true", default=False, help="ping all nodes")
     p.add_option("-c", dest="ping_count", type="int", metavar="COUNT", default=None,
                  help="number of pings to send. Not available with --all")
@@ -333,7 +324,7 @@ def kill_nodes(graph: _Graph, nodes: List[str]) -> Tuple[List[str], List[str]]:
 
 
 def _cmd_kill(argv: List[str], prog: str) -> int:
-    p = _options(prog, " [node]...")
+    p = option_parser(prog, " [node]...")
     p.add_option("-a", "--all", dest="kill_all", action="store_true", default=False, help="kill all nodes")
     options, nodes = p.parse_args(argv)
     graph = _Graph()
@@ -388,7 +379,7 @@ def _cmd_kill(argv: List[str], prog: str) -> int:
 
 
 def _cmd_machine(argv: List[str], prog: str) -> int:
-    p = _options(prog, " [machine-name]")
+    p = option_parser(prog, " [machine-name]")
     _, args = p.parse_args(argv)
     if len(args) > 1:
         p.error("please enter only one machine name")
@@ -456,7 +447,7 @@ def cleanup_master(graph: _Graph, dead: List[str]) -> None:
 
 
 def _cmd_cleanup(argv: List[str], prog: str) -> int:
-    p = _options(prog, "")
+    p = option_parser(prog, "")
     p.parse_args(argv)
     graph = _Graph()
     _pinged, unpinged = ping_all(graph)
