@@ -15,7 +15,9 @@ Scenarios
   shared machine). Two raw-socket floors, both with a 4-byte length prefix and nothing else:
   "raw" has ROS's topology (each direction its own connection, as each topic is, and each
   side answering from a receive thread, as a subscriber callback does); "raw-1" is one
-  bidirectional connection with blocking send/recv in the main thread, the absolute floor;
+  bidirectional connection with blocking send/recv in the main thread, the absolute floor.
+  "py-min" is "raw" plus the least any Python client must do per message: decode the
+  String into an object and encode it again (no middleware, no checks, no queues);
 * small-message flood: std_msgs/String "x"*20 published as fast as possible for N seconds,
   messages per second *received*;
 * 640x480 and 1920x1080 bgr8 sensor_msgs/Image floods, frames per second received.
@@ -256,6 +258,29 @@ def role_raw_ping(args) -> None:
                       "cpu_us": cpu / (args.count + 200) * 1e6}), flush=True)
 
 
+class _MinimalString:
+    """std_msgs/String with nothing but what any Python client must do per message."""
+
+    __slots__ = ("data",)
+
+    def __init__(self, data: str = "") -> None:
+        self.data = data
+
+
+_U32 = struct.Struct("<I")
+_U32_PAIR = struct.Struct("<II")
+
+
+def _decode_string(frame: bytes) -> _MinimalString:
+    (size,) = _U32.unpack_from(frame, 4)
+    return _MinimalString(frame[8:8 + size].decode())
+
+
+def _encode_string(msg: _MinimalString) -> bytes:
+    raw = msg.data.encode()
+    return _U32_PAIR.pack(len(raw) + 4, len(raw)) + raw
+
+
 def role_raw_pubsub_echo(args) -> None:
     """The echo of the ping-pong with ROS's topology and no middleware: the ping arrives on
     one connection (its "topic"), a receive thread answers on a second one."""
@@ -268,7 +293,11 @@ def role_raw_pubsub_echo(args) -> None:
     outgoing, _ = server.accept()
     for sock in (incoming, outgoing):
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    thread = threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, outgoing.sendall))
+    answer = outgoing.sendall
+    if args.messages:  # py-min: decode the String and encode it again, as any client must
+        def answer(frame: bytes) -> None:
+            outgoing.sendall(_encode_string(_decode_string(frame)))
+    thread = threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, answer))
     thread.start()
     thread.join()
 
@@ -280,8 +309,16 @@ def role_raw_pubsub_ping(args) -> None:
     for sock in (incoming, outgoing):
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     payload = struct.pack("<I", 20) + struct.pack("<I", 16) + b"x" * 16
-    clock = _RoundTrips(args.count, lambda: outgoing.sendall(payload))
-    threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, clock.on_pong),
+    if args.messages:  # py-min: messages in and out, as in role_ping
+        msg = _MinimalString("x" * 16)
+        clock = _RoundTrips(args.count, lambda: outgoing.sendall(_encode_string(msg)))
+
+        def on_frame(frame: bytes) -> bool:
+            return clock.on_pong(_decode_string(frame))
+    else:
+        clock = _RoundTrips(args.count, lambda: outgoing.sendall(payload))
+        on_frame = clock.on_pong
+    threading.Thread(target=_raw_answer_loop, args=(incoming, outgoing, on_frame),
                      daemon=True).start()
     clock.start()
     clock.report()
@@ -496,7 +533,7 @@ class Runner:
 
     def contenders(self) -> list:
         names = ["minros"] + (["rospy"] if self.reference else []) + \
-                (["roscpp"] if self.roscpp else []) + ["raw", "raw-1"]
+                (["roscpp"] if self.roscpp else []) + ["py-min", "raw", "raw-1"]
         if self.args.only:
             names = [n for n in names if n in self.args.only.split(",")]
         return names
@@ -539,13 +576,15 @@ class Runner:
                 p1.kill()
 
     def latency(self, who: str, queue: str):
-        if who in ("raw", "raw-1"):
+        if who in ("py-min", "raw", "raw-1"):
             if queue == "none":
                 return None
             port = _free_port()
-            kind = "raw-pubsub" if who == "raw" else "raw"
-            r = self.pair(who, self.command(who, f"{kind}-echo", ["--port", str(port)]),
-                          self.command(who, f"{kind}-ping", ["--port", str(port), "--count", str(self.args.count)]))
+            kind = "raw" if who == "raw-1" else "raw-pubsub"
+            extra = ["--messages"] if who == "py-min" else []
+            r = self.pair(who, self.command(who, f"{kind}-echo", ["--port", str(port), *extra]),
+                          self.command(who, f"{kind}-ping", ["--port", str(port), *extra,
+                                                              "--count", str(self.args.count)]))
         elif who == "roscpp":
             if queue == "none":
                 return None
@@ -559,7 +598,7 @@ class Runner:
         return r.get("median_us")
 
     def flood(self, who: str, kind: str):
-        if who == "raw-1":  # a flood is one connection one way: "raw" already is the floor
+        if who in ("raw-1", "py-min"):  # a flood is one connection one way: "raw" already is the floor
             return None
         seconds = str(self.args.seconds)
         if who == "raw":
@@ -580,7 +619,7 @@ class Runner:
         return r.get("rate")
 
     def idle_memory(self, who: str):
-        if who in ("raw", "raw-1", "roscpp"):
+        if who in ("py-min", "raw", "raw-1", "roscpp"):
             return None
         code = ("import rospy, time\nrospy.init_node('bench_idle', anonymous=True)\ntime.sleep(1.0)\n"
                 "print([l.split()[1] for l in open('/proc/self/status') if l.startswith('VmRSS')][0])\n")
@@ -626,6 +665,7 @@ def main(argv=None) -> int:
     parser.add_argument("--queue", default="10", help=argparse.SUPPRESS)
     parser.add_argument("--kind", default="small", help=argparse.SUPPRESS)
     parser.add_argument("--port", type=int, default=0, help=argparse.SUPPRESS)
+    parser.add_argument("--messages", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (median shown)")
     parser.add_argument("--seconds", type=float, default=2.0, help="duration of each flood")
     parser.add_argument("--count", type=int, default=2000, help="round trips per latency run")
@@ -658,7 +698,7 @@ def main(argv=None) -> int:
         header = ["scenario", *contenders]
         if "rospy" in contenders:
             header.append("minros/rospy")
-        for other in ("raw", "raw-1"):
+        for other in ("py-min", "raw", "raw-1"):
             if other in contenders:
                 header.append(f"minros/{other}")
         rows = []
@@ -666,7 +706,7 @@ def main(argv=None) -> int:
             med = {c: statistics.median(results[(key, c)]) if results[(key, c)] else None
                    for c in contenders}
             row = [title] + [_fmt(med[c]) for c in contenders]
-            for other in ("rospy", "raw", "raw-1"):
+            for other in ("rospy", "py-min", "raw", "raw-1"):
                 if other in contenders:
                     ok = med.get("minros") and med.get(other)
                     row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
@@ -676,7 +716,7 @@ def main(argv=None) -> int:
             med = {c: statistics.median(runner.cpu[("10", c)]) if runner.cpu.get(("10", c)) else None
                    for c in contenders}
             row = ["CPU per round trip, ping side, q=10 (µs)"] + [_fmt(med[c]) for c in contenders]
-            for other in ("rospy", "raw", "raw-1"):
+            for other in ("rospy", "py-min", "raw", "raw-1"):
                 if other in contenders:
                     ok = med.get("minros") and med.get(other)
                     row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
