@@ -255,16 +255,19 @@ class FrameReader:
     Small frames are parsed out of one preallocated buffer and returned as ``bytes``. A frame
     larger than the buffer is received straight into its own ``bytearray`` (no further copy)
     and that bytearray is handed over, so message fields may keep views of it (zero-copy).
+    With ``reuse_big=True`` the consumer promises to be done with each big frame before it
+    asks for the next receive buffer, and same-size big frames share one bytearray.
 
     ``ok_byte=True`` reads service responses: each frame is then ``(ok, payload)``.
     ``max_frame`` can be changed between frames (e.g. header limit first, then messages).
     """
 
     __slots__ = ("_buf", "_view", "_start", "_end", "_big", "_big_len", "_big_fill",
-                 "_big_ok", "max_frame", "ok_byte", "_ready", "bytes_received", "_error")
+                 "_big_ok", "max_frame", "ok_byte", "_ready", "bytes_received", "_error",
+                 "reuse_big", "_spare")
 
     def __init__(self, max_frame: int = DEFAULT_MAX_FRAME, buff_size: int = DEFAULT_BUFF_SIZE,
-                 ok_byte: bool = False) -> None:
+                 ok_byte: bool = False, reuse_big: bool = False) -> None:
         # The shared buffer only ever holds small frames; anything larger goes to a buffer of
         # its own, so a huge buff_size (rospy users pass 2**24 for images) must not turn big
         # frames into copies out of the shared buffer.
@@ -282,6 +285,11 @@ class FrameReader:
         self._ready: List = []
         self.bytes_received = 0
         self._error: FrameError | None = None
+        # reuse_big=True: the consumer is done with a big frame before it asks for more data
+        # (a subscriber whose messages copy their fields out), so the next big frame of the
+        # same size is received into the same bytearray: no allocation and zero-fill per image
+        self.reuse_big = reuse_big
+        self._spare: bytearray | None = None
 
     # -- I/O side --------------------------------------------------------------------------
 
@@ -435,7 +443,12 @@ class FrameReader:
             if prefix + size > len(buf):
                 # does not fit the shared buffer: move what we have into its own buffer
                 have = end - body
-                big = bytearray(min(size, max(_FIRST_CHUNK, have)))
+                big = self._spare
+                # (never while it waits in _ready: handed out means handed out)
+                if big is not None and len(big) == size and not any(f is big for f in ready):
+                    self._spare = None
+                else:
+                    big = bytearray(min(size, max(_FIRST_CHUNK, have)))
                 big[:have] = view[body:end]
                 self._big = big
                 self._big_len = size
@@ -458,6 +471,8 @@ class FrameReader:
     def _finish_big(self) -> None:
         big = self._big
         self._big = None
+        if self.reuse_big:
+            self._spare = big
         if self.ok_byte:
             self._ready.append((bool(self._big_ok), big))
         else:

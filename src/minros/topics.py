@@ -735,7 +735,8 @@ class _SubConnection:
             "callerid": _node_mod.get_caller_id(),
         }))
         # one reader for the header and the messages behind it (they may share a segment)
-        reader = tcpros.FrameReader(buff_size=max(impl.buff_size, 4096))
+        reader = tcpros.FrameReader(buff_size=max(impl.buff_size, 4096),
+                                    reuse_big=not getattr(data_class, "_keeps_buffer", True))
         frames: list = []
         while not frames:
             n = sock.recv_into(reader.recv_buffer())

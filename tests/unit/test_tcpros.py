@@ -276,3 +276,50 @@ def test_good_frames_before_a_bad_one_are_delivered_first():
         reader.frames()
     with pytest.raises(FrameError):
         reader.recv_buffer()
+
+
+def _big_frames(reader: FrameReader, payloads: list) -> list:
+    """Push each payload as one frame the way a subscriber does: the frames one received_frames
+    call returns are used up before the next receive buffer is asked for."""
+    got = []
+    for payload in payloads:
+        data = memoryview(struct.pack("<I", len(payload)) + payload)
+        while len(data):
+            target = reader.recv_buffer()
+            n = min(len(target), len(data), 50_000)  # several receives per frame
+            target[:n] = data[:n]
+            data = data[n:]
+            for frame in reader.received_frames(n):
+                got.append((frame, bytes(frame)))  # what a copying consumer keeps
+    return got
+
+
+def test_reuse_big_receives_same_size_frames_into_one_buffer():
+    reader = FrameReader(buff_size=4096, reuse_big=True)
+    payloads = [bytes([i]) * 300_000 for i in range(3)] + [b"\x07" * 200_000]
+    got = _big_frames(reader, payloads)
+    assert [copy for _, copy in got] == payloads  # each copy was taken before the next frame
+    frames = [frame for frame, _ in got]
+    assert frames[0] is frames[1] is frames[2]  # same size: one bytearray
+    assert frames[3] is not frames[0]  # another size: a buffer of its own
+
+
+def test_big_frames_get_their_own_buffer_by_default_and_when_not_handed_out():
+    reader = FrameReader(buff_size=4096)  # views into frames may live on (numpy_msg)
+    frames = [frame for frame, _ in _big_frames(reader, [b"a" * 300_000, b"b" * 300_000])]
+    assert frames[0] is not frames[1] and bytes(frames[0][:1]) == b"a"
+    reader = FrameReader(buff_size=4096, reuse_big=True)
+    size = 300_000
+    both = b"".join(struct.pack("<I", size) + bytes([c]) * size for c in b"xy")
+    first, second = reader.feed(both)  # both frames complete before either is handed out
+    assert first is not second and bytes(first[:1]) == b"x" and bytes(second[:1]) == b"y"
+
+
+def test_only_messages_that_copy_their_fields_let_a_subscriber_reuse_buffers():
+    from minros.msgs import numpy_msg
+    from minros.topics import AnyMsg
+    from sensor_msgs.msg import Image
+
+    assert Image._keeps_buffer is False
+    assert numpy_msg(Image)._keeps_buffer is True
+    assert getattr(AnyMsg, "_keeps_buffer", True) is True

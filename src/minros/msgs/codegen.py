@@ -530,6 +530,7 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
         out.append(f'    """{spec.full_name} whose numeric arrays are numpy views of the received bytes."""')
         out.append("")
         out.append(f"    __slots__ = {attrs!r}  # as rospy's numpy_msg: same fields, re-declared")
+        out.append("    _keeps_buffer = True  # its arrays are views of the received bytes")
     else:
         out.append(f"class {name}(_Message):")
         out.append(f'    """{spec.full_name} (md5sum {md5sum})."""')
@@ -539,6 +540,7 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
         out.append(f"    _md5sum = {md5sum!r}")
         out.append(f"    _has_header = {spec.has_header!r}")
         out.append(f"    _zero_copy = {de.views!r}  # True: deserialize() reads big input in place (memoryview)")
+        out.append("    _keeps_buffer = False  # every field is copied out of the received bytes")
         out.append(f"    _full_text = {_text_literal(full_text, 8)}")
         out.append(f"    _slot_types = {spec.types!r}")
         if module:

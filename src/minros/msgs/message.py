@@ -41,6 +41,9 @@ class Message:
     _full_text = ""
     _has_header = False
     _zero_copy = True
+    #: whether a deserialized message may keep references into the received bytes (numpy_msg
+    #: views do); False lets a subscriber reuse one receive buffer for its big frames
+    _keeps_buffer = True
     _slot_types: List[str] = []
 
     def __init__(self, *args: Any, **kwds: Any) -> None:
