@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 import sys
 from pathlib import Path
-from typing import Mapping, Optional
+from typing import Iterable, Mapping, Optional
 
 DEFAULT_MASTER_PORT = 11311
 DEFAULT_MASTER_URI = f"http://localhost:{DEFAULT_MASTER_PORT}/"
@@ -24,6 +24,14 @@ def get_master_uri(env: Optional[Mapping[str, str]] = None,
         return remapped
     env = os.environ if env is None else env
     return env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+
+
+def remapped_master(argv: Iterable[str]) -> Optional[str]:
+    """The value of the first ``__master:=`` argument (the one rosgraph reads), or None."""
+    for arg in argv:
+        if arg.startswith("__master:="):
+            return arg[len("__master:="):]
+    return None
 
 
 def ros_home(env: Optional[Mapping[str, str]] = None) -> Path:

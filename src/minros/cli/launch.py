@@ -114,16 +114,15 @@ def main(argv: List[str], prog: str | None = None) -> int:
 
 
 def _master_uri(options: argparse.Namespace) -> str:
-    from minros.rosenv import get_master_uri
+    from minros.rosenv import get_master_uri, remapped_master
 
     # as rosgraph.get_master_uri in roslaunch: the first __master:= on the command line beats
     # the environment, and one without a value is an error
-    remapped = next((a for a in options.positional if a.startswith("__master:=")), None)
-    value = None
-    if remapped is not None:
-        value = remapped.split(":=", 1)[1].strip()
-        if not value or ":=" in value:
-            raise LaunchError(f"__master remapping argument '{remapped}' improperly specified")
+    value = remapped_master(options.positional)
+    if value is not None:
+        if not value.strip() or ":=" in value:
+            raise LaunchError(f"__master remapping argument '__master:={value}' improperly specified")
+        value = value.strip()
     uri = get_master_uri(remapped=value)
     if options.port:
         from urllib.parse import urlparse

@@ -37,12 +37,7 @@ class MasterIOError(OSError):
 
 def get_master_uri(argv: List[str] | None = None) -> str:
     """``__master:=`` beats ``ROS_MASTER_URI``; default ``http://localhost:11311/``."""
-    remapped = None
-    for arg in sys.argv if argv is None else argv:
-        if arg.startswith("__master:="):
-            remapped = arg[len("__master:="):]
-            break
-    return rosenv.get_master_uri(remapped=remapped)
+    return rosenv.get_master_uri(remapped=rosenv.remapped_master(sys.argv if argv is None else argv))
 
 
 def call_node(uri: str, method: str, *args: Any, timeout: float = TOOL_TIMEOUT) -> list:
