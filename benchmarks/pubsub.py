@@ -211,6 +211,16 @@ def _recv_exact(sock, view) -> None:
         got += n
 
 
+def _raw_listen(port: int, backlog: int) -> socket.socket:
+    """The raw workers' listening socket; the driver starts the other side on the ready line."""
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    server.bind(("127.0.0.1", port))
+    server.listen(backlog)
+    print(json.dumps({"ready": True}), flush=True)
+    return server
+
+
 def _raw_answer_loop(incoming, outgoing, on_frame) -> None:
     """A subscriber's receive thread reduced to sockets: read length-prefixed frames from
     ``incoming`` and hand each to ``on_frame`` (which may send on ``outgoing``)."""
@@ -228,11 +238,7 @@ def _raw_answer_loop(incoming, outgoing, on_frame) -> None:
 
 
 def role_raw_echo(args) -> None:
-    server = socket.socket()
-    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    server.bind(("127.0.0.1", args.port))
-    server.listen(1)
-    print(json.dumps({"ready": True}), flush=True)
+    server = _raw_listen(args.port, 1)
     conn, _ = server.accept()
     conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     _raw_answer_loop(conn, conn, conn.sendall)
@@ -284,11 +290,7 @@ def _encode_string(msg: _MinimalString) -> bytes:
 def role_raw_pubsub_echo(args) -> None:
     """The echo of the ping-pong with ROS's topology and no middleware: the ping arrives on
     one connection (its "topic"), a receive thread answers on a second one."""
-    server = socket.socket()
-    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    server.bind(("127.0.0.1", args.port))
-    server.listen(2)
-    print(json.dumps({"ready": True}), flush=True)
+    server = _raw_listen(args.port, 2)
     incoming, _ = server.accept()
     outgoing, _ = server.accept()
     for sock in (incoming, outgoing):
@@ -325,11 +327,7 @@ def role_raw_pubsub_ping(args) -> None:
 
 
 def role_raw_flood_sub(args) -> None:
-    server = socket.socket()
-    server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    server.bind(("127.0.0.1", args.port))
-    server.listen(1)
-    print(json.dumps({"ready": True}), flush=True)
+    server = _raw_listen(args.port, 1)
     conn, _ = server.accept()
     head = bytearray(4)
     body = bytearray(8 << 20)

@@ -68,13 +68,20 @@ def pkg(tmp_path: Path) -> Path:
     return root
 
 
-def _launch(tmp_path: Path, pkg: Path, xml: str, *extra: str, port=None):
+def _launch_args(tmp_path: Path, pkg: Path, xml: str, *extra: str, port=None, port_option=True):
+    """roslaunch's argv and environment for ``xml``: ROS_MASTER_URI names ``port``, which is
+    also passed as ``-p`` unless ``port_option`` is False."""
     port = port or free_port()
     launch_file = tmp_path / "test.launch"
     launch_file.write_text(xml)
     env = ros_env(port, tmp_path / "home", {"ROS_PACKAGE_PATH": str(pkg.parent)})
-    proc = Proc([str(BIN / "roslaunch"), str(launch_file), "-p", str(port), *extra], env)
-    return proc, port
+    argv = [str(BIN / "roslaunch"), str(launch_file), *(["-p", str(port)] if port_option else []), *extra]
+    return argv, env, port
+
+
+def _launch(tmp_path: Path, pkg: Path, xml: str, *extra: str, port=None):
+    argv, env, port = _launch_args(tmp_path, pkg, xml, *extra, port=port)
+    return Proc(argv, env), port
 
 
 def _pids(output: str):
@@ -267,11 +274,9 @@ def test_master_remap_argument_beats_the_environment(tmp_path, pkg, minros_maste
       <node pkg="launch_probe" type="names_node.py" name="names" output="screen">
         <param name="priv" value="p"/>
       </node></launch>"""
-    launch_file = tmp_path / "test.launch"
-    launch_file.write_text(xml)
-    env = ros_env(free_port(), tmp_path / "home", {"ROS_PACKAGE_PATH": str(pkg.parent)})
-    proc = Proc([str(BIN / "roslaunch"), str(launch_file),
-                 f"__master:=http://localhost:{minros_master}"], env)
+    argv, env, _port = _launch_args(tmp_path, pkg, xml, f"__master:=http://localhost:{minros_master}",
+                                    port_option=False)  # ROS_MASTER_URI names a port nobody serves
+    proc = Proc(argv, env)
     head = ""
     try:
         head = proc.read_until("NAMES /names", timeout=30)
@@ -285,11 +290,9 @@ def test_master_remap_argument_beats_the_environment(tmp_path, pkg, minros_maste
 
 
 def test_master_remap_argument_without_a_value_is_an_error(tmp_path, pkg):
-    launch_file = tmp_path / "test.launch"
-    launch_file.write_text('<launch><param name="x" value="1"/></launch>')
-    env = ros_env(free_port(), tmp_path / "home", {"ROS_PACKAGE_PATH": str(pkg.parent)})
-    done = subprocess.run([str(BIN / "roslaunch"), str(launch_file), "__master:="], env=env,
-                          capture_output=True, text=True, timeout=30)
+    argv, env, _port = _launch_args(tmp_path, pkg, '<launch><param name="x" value="1"/></launch>',
+                                    "__master:=", port_option=False)
+    done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=30)
     assert done.returncode == 1
     assert done.stderr.strip() == ("roslaunch: error: __master remapping argument '__master:=' "
                                    "improperly specified")
