@@ -35,6 +35,7 @@ def test_video_pub_sub_with_fake_camera(minros_core, ros_home, tmp_path):
     env = ros_env(minros_core, ros_home, {"PYTHONPATH": str(FAKECAM), "FAKECAM_DIR": str(out)})
     sub = Proc([PYTHON, str(VIDEO / "video_sub.py")], env)
     pub = Proc([PYTHON, str(VIDEO / "video_pub.py")], env)
+    sub_out = ""  # a read_until that fails must not be hidden by the finally below
     try:
         sub_out = sub.read_until("receiving video frame", timeout=20)
         wait_until(lambda: shown_count(out) >= 3, timeout=10, what="three frames shown")

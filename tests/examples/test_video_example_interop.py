@@ -32,6 +32,7 @@ def test_video_between_debian_and_minros(publisher_side, minros_core, ros_home, 
     sub_side = "minros" if publisher_side == "debian" else "debian"
     sub = Proc([sides[sub_side][0], str(VIDEO / "video_sub.py")], sides[sub_side][1])
     pub = Proc([sides[publisher_side][0], str(VIDEO / "video_pub.py")], sides[publisher_side][1])
+    sub_out = ""  # a read_until that fails must not be hidden by the finally below
     try:
         sub_out = sub.read_until("receiving video frame", timeout=30)
         wait_until(lambda: shown_count(out) >= 3, timeout=15, what="three frames shown")
