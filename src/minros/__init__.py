@@ -5,7 +5,7 @@ so unmodified rospy scripts run on minros. The behaviour lives in the submodules
 ``node`` (init_node, names, lifecycle), ``topics``, ``services``, ``params``, ``rostime``,
 ``log``; this file only maps the public names to them.
 
-Names are imported on first use (PEP 562), so ``import minros.tcpros`` or a command-line tool
+Names are imported on first use (PEP 562), so ``import minros.wire.tcpros`` or a command-line tool
 does not pay for the whole client library, and one layer can be used without the others.
 """
 
@@ -41,13 +41,13 @@ _TOPICS = ("Publisher", "Subscriber", "SubscribeListener", "AnyMsg", "wait_for_m
 
 #: public name -> module that defines it
 _WHERE: Dict[str, str] = {}
-for _module, _names in (("minros.exceptions", _EXCEPTIONS), ("minros.log", _LOG),
-                        ("minros.node", _NODE), ("minros.params", _PARAMS),
-                        ("minros.rostime", _ROSTIME), ("minros.services", _SERVICES),
-                        ("minros.topics", _TOPICS)):
+for _module, _names in (("minros.exceptions", _EXCEPTIONS), ("minros.client.log", _LOG),
+                        ("minros.node", _NODE), ("minros.client.params", _PARAMS),
+                        ("minros.client.rostime", _ROSTIME), ("minros.client.services", _SERVICES),
+                        ("minros.client.topics", _TOPICS)):
     for _name in _names:
         _WHERE[_name] = _module
-_WHERE["logerror"] = "minros.log"
+_WHERE["logerror"] = "minros.client.log"
 
 __all__ = ["Header", "Message", "get_ros_root", *_WHERE]
 

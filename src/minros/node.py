@@ -1,7 +1,7 @@
 """Node runtime: name and arguments, the slave XML-RPC API, master registration, the one
 TCPROS server per process, and the lifecycle (init, shutdown hooks, signals).
 
-Topics (``minros.topics``) and services (``minros.services``) register their endpoints here,
+Topics (``minros.client.topics``) and services (``minros.client.services``) register their endpoints here,
 so that everything a node offers is (re-)registered in one place: on ``init_node``, after a
 master restart, and undone with one ``system.multicall`` on shutdown.
 """
@@ -21,10 +21,11 @@ import traceback
 import urllib.parse
 from typing import Any, Callable, Dict, List, Tuple
 
-from minros import names, rosenv, tcpros
-from minros import xmlrpc as minros_xmlrpc
+from minros import names, rosenv
 from minros.exceptions import ROSException, ROSInitException, ServiceException
-from minros.xmlrpc import ServerProxy, XmlRpcServer
+from minros.wire import tcpros
+from minros.wire import xmlrpc as minros_xmlrpc
+from minros.wire.xmlrpc import ServerProxy, XmlRpcServer
 
 __all__ = [
     "DEFAULT_MASTER_URI",
@@ -86,7 +87,7 @@ _signal_chain: Dict[int, Any] = {}
 _init_argv: List[str] | None = None
 _initialized = False
 
-# registries filled by minros.topics / minros.services, registered with the master on init
+# registries filled by minros.client.topics / minros.client.services, registered with the master on init
 _publications: Dict[str, Any] = {}  # resolved topic -> publisher impl (.type, .md5sum, ...)
 _subscriptions: Dict[str, Any] = {}  # resolved topic -> subscriber impl
 _services: Dict[str, Callable] = {}  # resolved service -> handler(sock, header)
@@ -383,7 +384,7 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
         except Exception:
             use_sim_time = False
     try:
-        from minros import rostime
+        from minros.client import rostime
 
         starter = getattr(rostime, "_start_node_time", None)
         if starter is not None:
@@ -391,7 +392,7 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
     except ImportError:
         pass
     try:
-        from minros import log
+        from minros.client import log
 
         starter = getattr(log, "_start_node_logging", None)
         if starter is not None:
@@ -511,7 +512,7 @@ class MasterProxy:
         raise ROSException(f"cannot search for parameter: {msg}")
 
     def get_param_cached(self, key: str) -> Any:
-        from minros import params
+        from minros.client import params
 
         return params.get_param_cached(key)
 
@@ -839,7 +840,7 @@ def read_inbound_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_
 def _user_warn(text: str) -> None:
     """A WARN line on the node's console and /rosout, as rospy's logwarn."""
     try:
-        from minros import log
+        from minros.client import log
 
         log.logwarn(text)
     except Exception:
@@ -849,7 +850,7 @@ def _user_warn(text: str) -> None:
 def _user_error(text: str) -> None:
     """An ERROR line on the node's console (rospy's logerr)."""
     try:
-        from minros import log
+        from minros.client import log
 
         log.logerr(text)
     except Exception:

@@ -1,5 +1,6 @@
-"""rospy.client: node life-cycle functions (minros.node and minros.topics)."""
+"""rospy.client: node life-cycle functions (minros.node and minros.client.topics)."""
 
+from minros.client.topics import get_published_topics, wait_for_message  # noqa: F401
 from minros.node import (  # noqa: F401
     get_master,
     init_node,
@@ -7,4 +8,3 @@ from minros.node import (  # noqa: F401
     on_shutdown,
     spin,
 )
-from minros.topics import get_published_topics, wait_for_message  # noqa: F401

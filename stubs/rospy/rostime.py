@@ -1,6 +1,6 @@
-"""rospy.rostime: Time, Duration and the ROS clock (minros.rostime)."""
+"""rospy.rostime: Time, Duration and the ROS clock (minros.client.rostime)."""
 
-from minros.rostime import (  # noqa: F401
+from minros.client.rostime import (  # noqa: F401
     Duration,
     Time,
     get_rostime,

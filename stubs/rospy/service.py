@@ -1,3 +1,3 @@
-"""rospy.service: ServiceException (minros.services)."""
+"""rospy.service: ServiceException (minros.client.services)."""
 
 from minros.exceptions import ServiceException  # noqa: F401

@@ -1,3 +1,3 @@
-"""rospy.timer: Rate, Timer, TimerEvent and sleep (minros.rostime)."""
+"""rospy.timer: Rate, Timer, TimerEvent and sleep (minros.client.rostime)."""
 
-from minros.rostime import Rate, Timer, TimerEvent, sleep  # noqa: F401
+from minros.client.rostime import Rate, Timer, TimerEvent, sleep  # noqa: F401

@@ -1,6 +1,6 @@
-"""rospy.topics: Publisher, Subscriber, SubscribeListener (minros.topics)."""
+"""rospy.topics: Publisher, Subscriber, SubscribeListener (minros.client.topics)."""
 
-from minros.topics import (  # noqa: F401
+from minros.client.topics import (  # noqa: F401
     Publisher,
     SubscribeListener,
     Subscriber,

@@ -10,7 +10,7 @@ import pytest
 
 from support import Proc, free_port, ros_env, wait_until
 
-pytest.importorskip("minros.turtlesim.turtlesim_node")
+pytest.importorskip("minros.nodes.turtlesim.turtlesim_node")
 
 BIN = Path(sys.executable).parent
 LAUNCH_FILES = Path(__file__).resolve().parent.parent / "unit" / "launch_files"

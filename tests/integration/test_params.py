@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import minros
-from minros import params
+from minros.client import params
 from support import PYTHON, Proc, ros_env
 
 
@@ -67,7 +67,7 @@ def test_search_param(master_env):
 NODE = r'''
 import json, time, sys
 import rospy
-import minros.params as P
+import minros.client.params as P
 
 rospy.init_node("pnode")
 out = {

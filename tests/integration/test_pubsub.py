@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from integration.pubsub_scripts import LISTENER, TALKER
-from minros import tcpros
+from minros.wire import tcpros
 from support import PYTHON, Proc, ros_env, wait_until
 
 STRING_MD5 = "992ce8a1687cec8c8bd883ec73ca41d1"
@@ -293,7 +293,7 @@ def test_subscriber_that_never_reads_does_not_block_or_bloat(tmp_path, minros_ma
 
 def test_garbage_from_a_publisher_drops_only_that_connection(tmp_path, minros_master, ros_home, scripts):
     """A fake publisher sends an oversize frame; the subscriber logs one line and keeps working."""
-    from minros.xmlrpc import XmlRpcServer
+    from minros.wire.xmlrpc import XmlRpcServer
 
     server = socket.socket()
     server.bind(("127.0.0.1", 0))
@@ -385,9 +385,9 @@ def test_master_restart_reregisters_and_reconnects(scripts, ros_home):
 SYNC_FLOODER = r'''
 import time
 import rospy
-import minros.topics
+import minros.client.topics
 from std_msgs.msg import UInt8MultiArray
-minros.topics.SYNC_SEND_TIMEOUT = 1.0  # rospy's socket timeout is 60 s; shortened for the test
+minros.client.topics.SYNC_SEND_TIMEOUT = 1.0  # rospy's socket timeout is 60 s; shortened for the test
 rospy.init_node("sync_flooder")
 pub = rospy.Publisher("/sync_flood", UInt8MultiArray, queue_size=None)
 print("ready", flush=True)

@@ -17,9 +17,9 @@ from pathlib import Path
 import pytest
 
 import minros
-from minros import tcpros
+from minros.client.services import parse_rosrpc_uri
 from minros.exceptions import ROSException, ServiceException
-from minros.services import parse_rosrpc_uri
+from minros.wire import tcpros
 from services_support import ADD_TWO_INTS_MD5, SERVER
 from support import PYTHON, Proc, ros_env
 
@@ -391,7 +391,7 @@ def test_big_request_and_response(master_env, tmp_path):
 
 def test_silent_server_times_out_the_handshake(master_env, monkeypatch):
     """A peer that accepts but never sends its header cannot hang the caller."""
-    from minros import services
+    from minros.client import services
 
     with socket.socket() as listener:
         listener.bind(("127.0.0.1", 0))
@@ -413,7 +413,7 @@ def test_silent_server_times_out_the_handshake(master_env, monkeypatch):
 def test_parse_rosrpc_uri():
     assert parse_rosrpc_uri("rosrpc://host:1234") == ("host", 1234)
     assert parse_rosrpc_uri("rosrpc://10.0.0.1:99/extra") == ("10.0.0.1", 99)
-    from minros.services import ParameterInvalid
+    from minros.client.services import ParameterInvalid
 
     for bad in ("http://host:1", "rosrpc://host", "rosrpc://host:x", "rosrpc://a:1:2"):
         with pytest.raises(ParameterInvalid):

@@ -23,8 +23,9 @@ from pathlib import Path
 import pytest
 
 import minros
-from minros import services, tcpros
+from minros.client import services
 from minros.exceptions import ServiceException
+from minros.wire import tcpros
 from support import PYTHON, Proc, ros_env
 
 #: bytes a slow peer takes per recv (and its receive buffer), so the sender really waits

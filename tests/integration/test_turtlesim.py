@@ -237,7 +237,7 @@ def test_window_on_a_virtual_display(minros_core, ros_home, tmp_path):
             display = numbers.readline().strip()
         assert display.isdigit(), "Xvfb did not report its display"
         env = ros_env(minros_core, ros_home, {"DISPLAY": f":{display}"})
-        sim = Proc([PYTHON, "-m", "minros.turtlesim.turtlesim_node"], env)
+        sim = Proc([PYTHON, "-m", "minros.nodes.turtlesim.turtlesim_node"], env)
         try:
             sim.read_until("Spawning turtle [turtle1]", timeout=15)
 
@@ -312,7 +312,7 @@ def test_teleop_ctrl_c_restores_the_terminal(minros_core, ros_home):
     import signal
 
     master_fd, slave_fd = pty.openpty()
-    teleop = Proc([PYTHON, "-m", "minros.turtlesim.turtle_teleop_key"],
+    teleop = Proc([PYTHON, "-m", "minros.nodes.turtlesim.turtle_teleop_key"],
                   ros_env(minros_core, ros_home), stdin=slave_fd)
     try:
         teleop.read_until("Reading from keyboard", timeout=15)

@@ -113,7 +113,7 @@ def test_debian_rosservice_spawn_kill_and_errors(sim_under_core, ros_home, turtl
 
 def test_minros_turtlesim_under_debian_rosmaster(debian_rosmaster, ros_home, turtlesim_pythonpath):
     port = debian_rosmaster
-    proc = Proc([PYTHON, "-m", "minros.turtlesim.turtlesim_node", "--headless"],
+    proc = Proc([PYTHON, "-m", "minros.nodes.turtlesim.turtlesim_node", "--headless"],
                 ros_env(port, ros_home))
     try:
         proc.read_until("Spawning turtle [turtle1]", timeout=15)

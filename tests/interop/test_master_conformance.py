@@ -15,7 +15,7 @@ from typing import Any, Callable, Dict, List
 
 import pytest
 
-from minros.xmlrpc import XmlRpcServer
+from minros.wire.xmlrpc import XmlRpcServer
 from support import free_port, require_reference
 
 pytestmark = pytest.mark.interop

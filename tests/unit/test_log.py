@@ -1,4 +1,4 @@
-"""minros.log: console format, stdout/stderr split, levels, throttle/once/identical, /rosout records."""
+"""minros.client.log: console format, stdout/stderr split, levels, throttle/once/identical, /rosout records."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import re
 
 import pytest
 
-from minros import log, rostime
+from minros.client import log, rostime
 
 
 @pytest.fixture
@@ -248,7 +248,7 @@ def test_node_log_filename_rules(tmp_path):
 
 
 def test_failed_param_lookup_is_not_retried_on_every_record(monkeypatch):
-    from minros import params
+    from minros.client import params
 
     calls = []
 

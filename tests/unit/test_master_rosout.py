@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from minros.rosout import RotatingLog, format_line, log_dir
+from minros.nodes.rosout import RotatingLog, format_line, log_dir
 
 
 def _msg(level=2, topics=("/rosout", "/chatter")):

@@ -1,4 +1,4 @@
-"""Pure parts of minros.node and minros.topics: slave-API argument checks, frames, names."""
+"""Pure parts of minros.node and minros.client.topics: slave-API argument checks, frames, names."""
 
 from __future__ import annotations
 
@@ -6,7 +6,8 @@ import struct
 
 import pytest
 
-from minros import node, topics
+from minros import node
+from minros.client import topics
 
 
 class _FakeNode:
@@ -126,7 +127,7 @@ def test_connection_stream_is_byte_exact_under_backpressure(queue_size):
     import socket
     import threading
 
-    from minros import tcpros
+    from minros.wire import tcpros
 
     a, b = socket.socketpair()
     a.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)

@@ -1,4 +1,4 @@
-"""minros.rostime: rospy's Time/Duration, the node clock, sleep, Rate, Timer and TimerEvent.
+"""minros.client.rostime: rospy's Time/Duration, the node clock, sleep, Rate, Timer and TimerEvent.
 
 Most tests drive the *simulated* clock (``_set_rostime``, what a /clock message does) as a fake
 clock: waits then end exactly when the test moves time, so nothing here depends on how fast
@@ -13,13 +13,13 @@ import time
 
 import pytest
 
-from minros import rostime
+from minros.client import rostime
+from minros.client.rostime import Duration, Rate, Time, Timer, TimerEvent
 from minros.exceptions import (
     ROSInitException,
     ROSInterruptException,
     ROSTimeMovedBackwardsException,
 )
-from minros.rostime import Duration, Rate, Time, Timer, TimerEvent
 
 
 @pytest.fixture

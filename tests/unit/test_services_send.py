@@ -11,8 +11,9 @@ import time
 import numpy as np
 import pytest
 
-from minros import services, tcpros
+from minros.client import services
 from minros.exceptions import TransportTerminated
+from minros.wire import tcpros
 
 
 def drain(sock: socket.socket, size: int, out: bytearray, pause_every: int = 0, pause: float = 0.0) -> None:

@@ -1,4 +1,4 @@
-"""minros.tcpros without sockets: header codec, framing, service responses, handshake checks."""
+"""minros.wire.tcpros without sockets: header codec, framing, service responses, handshake checks."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from minros import tcpros
-from minros.tcpros import FrameError, FrameReader, HeaderError
+from minros.wire import tcpros
+from minros.wire.tcpros import FrameError, FrameReader, HeaderError
 
 # -------------------------------------------------------------------- connection header
 
@@ -316,8 +316,8 @@ def test_big_frames_get_their_own_buffer_by_default_and_when_not_handed_out():
 
 
 def test_only_messages_that_copy_their_fields_let_a_subscriber_reuse_buffers():
+    from minros.client.topics import AnyMsg
     from minros.msgs import numpy_msg
-    from minros.topics import AnyMsg
     from sensor_msgs.msg import Image
 
     assert Image._keeps_buffer is False

@@ -1,4 +1,4 @@
-"""turtlesim simulation numerics (minros.turtlesim.sim), checked against closed forms of noetic's
+"""turtlesim simulation numerics (minros.nodes.turtlesim.sim), checked against closed forms of noetic's
 Turtle::update, without ROS."""
 
 from __future__ import annotations
@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from minros.turtlesim import sim
-from minros.turtlesim.draw_square import FORWARD, STOP_FORWARD, STOP_TURN, TURN, SquareDriver
-from minros.turtlesim.mimic import twist_for_pose
-from minros.turtlesim.turtle_teleop_key import BANNER, key_loop, key_to_motion
+from minros.nodes.turtlesim import sim
+from minros.nodes.turtlesim.draw_square import FORWARD, STOP_FORWARD, STOP_TURN, TURN, SquareDriver
+from minros.nodes.turtlesim.mimic import twist_for_pose
+from minros.nodes.turtlesim.turtle_teleop_key import BANNER, key_loop, key_to_motion
 
 
 class Clock:

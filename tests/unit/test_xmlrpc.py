@@ -1,4 +1,4 @@
-"""minros.xmlrpc: dispatch, faults, keep-alive, limits and hostile clients (loopback sockets)."""
+"""minros.wire.xmlrpc: dispatch, faults, keep-alive, limits and hostile clients (loopback sockets)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import xmlrpc.client
 
 import pytest
 
-from minros import xmlrpc as mx
+from minros.wire import xmlrpc as mx
 
 
 class Handler:

@@ -57,7 +57,7 @@ def _master_running(port: int) -> bool:
             pass
     except OSError:
         return False
-    from minros.xmlrpc import ServerProxy
+    from minros.wire.xmlrpc import ServerProxy
 
     try:
         with ServerProxy(f"http://127.0.0.1:{port}/", timeout=1.0) as proxy:
@@ -130,7 +130,7 @@ class RosoutProcess:
         except OSError:
             out = subprocess.DEVNULL
         self.popen = subprocess.Popen(
-            [sys.executable, "-m", "minros.rosout", "__name:=rosout",
+            [sys.executable, "-m", "minros.nodes.rosout", "__name:=rosout",
              f"__log:={os.path.join(self.log_dir, 'rosout-1.log')}"],
             env=self.env, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT)
         if out is not subprocess.DEVNULL:
@@ -219,7 +219,7 @@ def main(argv: List[str], prog: str = "minros core") -> int:
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
 
-    from minros.rosout import log_dir
+    from minros.nodes.rosout import log_dir
 
     base_log = str(log_dir(env))
     run_log = os.path.join(base_log, run_id)

@@ -14,9 +14,10 @@ from typing import Any, List
 
 import yaml
 
-from minros import names, tcpros
+from minros import names
 from minros.tools.common import ToolError, dispatch, option_parser, resolve, run_tool
 from minros.tools.master import Master, MasterError
+from minros.wire import tcpros
 
 NAME = "rosservice"
 PROBE_TIMEOUT = 5.0
@@ -43,7 +44,7 @@ def _error(text: str) -> ToolError:
 
 def get_service_headers(service: str, uri: str) -> dict:
     """Probe the server (``probe=1``) and return its connection header."""
-    from minros.services import parse_rosrpc_uri
+    from minros.client.services import parse_rosrpc_uri
 
     try:
         host, port = parse_rosrpc_uri(uri)
@@ -242,8 +243,8 @@ def _summary(args: Any) -> str:
 
 
 def call_service(master: Master, service: str, service_args: list, service_class: Any) -> tuple:
+    from minros.client.services import ServiceProxy
     from minros.exceptions import MessageException, ServiceException
-    from minros.services import ServiceProxy
     from minros.tools.fill import fill_message_args, printable_message_args, substitution_keys
 
     request = service_class._request_class()
@@ -309,7 +310,7 @@ def _cmd_call(argv: List[str], prog: str) -> int:
     master = _master()
     if args.wait:
         master.getPid()
-        from minros.services import wait_for_service
+        from minros.client.services import wait_for_service
 
         wait_for_service(service)
     service_class = get_service_class_by_name(master, service)

@@ -416,7 +416,7 @@ def _now() -> Any:
     from minros.msgs import Time
 
     try:
-        from minros import rostime
+        from minros.client import rostime
 
         return rostime.get_rostime()
     except Exception:
@@ -489,7 +489,7 @@ def _cmd_echo(argv: List[str], prog: str) -> int:
         echo = _Echo(topic.rstrip("/"), field_path, args, filter_fn, real_topic)
     except FieldError as exc:
         raise ToolError(str(exc)) from None
-    from minros.topics import AnyMsg, Subscriber
+    from minros.client.topics import AnyMsg, Subscriber
 
     Subscriber(real_topic, AnyMsg, echo, queue_size=None)
     _spin_until(lambda: echo.done)
@@ -577,8 +577,8 @@ def _cmd_hz(argv: List[str], prog: str) -> int:
     filter_fn = _compile_filter(args.filter_expr)
     master = _check_master()
     _init_node()
+    from minros.client.topics import AnyMsg, Subscriber
     from minros.tools.decode import Decoder
-    from minros.topics import AnyMsg, Subscriber
 
     sim = _use_sim_time(master) and not args.use_wtime
     stats = {t: HzStats(window) for t in topics}
@@ -664,7 +664,7 @@ def _cmd_bw(argv: List[str], prog: str) -> int:
     master = _check_master()
     _type, real_topic, _field = wait_topic_type(master, topic)
     _init_node()
-    from minros.topics import AnyMsg, Subscriber
+    from minros.client.topics import AnyMsg, Subscriber
 
     lock = threading.Lock()
     sizes: List[int] = []
@@ -706,8 +706,8 @@ def _cmd_delay(argv: List[str], prog: str) -> int:
     master = _check_master()
     _type, real_topic, _field = wait_topic_type(master, topic)
     _init_node()
+    from minros.client.topics import AnyMsg, Subscriber
     from minros.tools.decode import Decoder
-    from minros.topics import AnyMsg, Subscriber
 
     decoder = Decoder()
     window = args.window_size if args.window_size >= 0 else 50000
@@ -915,7 +915,7 @@ def _cmd_pub(argv: List[str], prog: str) -> int:
     elif not args.file and sys.stdin.isatty():
         p.error("Please specify message values")
     from minros import node
-    from minros.topics import Publisher
+    from minros.client.topics import Publisher
 
     _init_node(disable_rosout=True)
     pub = Publisher(topic, msg_class, latch=latch, queue_size=100)

@@ -37,7 +37,7 @@ POLL_INTERVAL = 0.05
 
 
 def _xmlrpc_proxy(uri: str, timeout: float = 5.0) -> Any:
-    from minros.xmlrpc import ServerProxy
+    from minros.wire.xmlrpc import ServerProxy
 
     return ServerProxy(uri, timeout=timeout)
 

@@ -12,7 +12,7 @@ import xmlrpc.client
 from typing import Any, Dict, List, Tuple
 
 from minros import rosenv
-from minros.xmlrpc import ServerProxy
+from minros.wire.xmlrpc import ServerProxy
 
 DEFAULT_MASTER_URI = rosenv.DEFAULT_MASTER_URI
 #: seconds to wait for any single XML-RPC answer; a tool never hangs on a dead peer

@@ -20,21 +20,21 @@ from typing import Dict, List
 from minros import packages
 
 #: package -> executable name -> module run with ``python -m``. Turtlesim's modules are written
-#: separately (minros.turtlesim); a missing module is reported as "not available".
+#: separately (minros.nodes.turtlesim); a missing module is reported as "not available".
 BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rospy_tutorials": {
-        "talker.py": "minros.workspace.rospy_tutorials.talker",
-        "talker": "minros.workspace.rospy_tutorials.talker",
-        "listener.py": "minros.workspace.rospy_tutorials.listener",
-        "listener": "minros.workspace.rospy_tutorials.listener",
-        "add_two_ints_server": "minros.workspace.rospy_tutorials.add_two_ints_server",
-        "add_two_ints_client": "minros.workspace.rospy_tutorials.add_two_ints_client",
+        "talker.py": "minros.nodes.rospy_tutorials.talker",
+        "talker": "minros.nodes.rospy_tutorials.talker",
+        "listener.py": "minros.nodes.rospy_tutorials.listener",
+        "listener": "minros.nodes.rospy_tutorials.listener",
+        "add_two_ints_server": "minros.nodes.rospy_tutorials.add_two_ints_server",
+        "add_two_ints_client": "minros.nodes.rospy_tutorials.add_two_ints_client",
     },
     "turtlesim": {
-        "turtlesim_node": "minros.turtlesim.turtlesim_node",
-        "turtle_teleop_key": "minros.turtlesim.turtle_teleop_key",
-        "mimic": "minros.turtlesim.mimic",
-        "draw_square": "minros.turtlesim.draw_square",
+        "turtlesim_node": "minros.nodes.turtlesim.turtlesim_node",
+        "turtle_teleop_key": "minros.nodes.turtlesim.turtle_teleop_key",
+        "mimic": "minros.nodes.turtlesim.mimic",
+        "draw_square": "minros.nodes.turtlesim.draw_square",
     },
 }
 

@@ -1,4 +1,4 @@
-"""``rosrun turtlesim turtlesim_node``: the ROS face of :class:`minros.turtlesim.sim.TurtleFrame`.
+"""``rosrun turtlesim turtlesim_node``: the ROS face of :class:`minros.nodes.turtlesim.sim.TurtleFrame`.
 
 Interfaces as in noetic's turtlesim: node ``turtlesim``; services ``clear``, ``reset``, ``spawn``,
 ``kill`` in the node's namespace; per turtle ``<name>/cmd_vel`` (in), ``<name>/pose`` and
@@ -20,7 +20,7 @@ import threading
 import time
 from typing import Any, Callable, Dict, List, Tuple
 
-from minros.turtlesim import sim
+from minros.nodes.turtlesim import sim
 
 _BACKGROUND_PARAMS = (("background_r", sim.DEFAULT_BACKGROUND[0]),
                       ("background_g", sim.DEFAULT_BACKGROUND[1]),
@@ -36,7 +36,7 @@ def _cpp_service_class():
     returning false: ``ok=0`` with an empty error text (what clients of the real turtlesim see
     for an existing spawn name or an unknown kill name)."""
     import rospy
-    from minros import tcpros
+    from minros.wire import tcpros
 
     class CppStyleService(rospy.Service):
         def __init__(self, name: str, service_class: type, handler: Callable[[Any], Any]) -> None:
@@ -412,6 +412,6 @@ def _wait(delay: float) -> None:
 
 
 if __name__ == "__main__":
-    from minros.turtlesim import run_tool
+    from minros.nodes.turtlesim import run_tool
 
     sys.exit(run_tool("turtlesim_node", main))

@@ -1,7 +1,7 @@
 """The rosout node: aggregates ``/rosout`` onto ``/rosout_agg`` and into ``rosout.log``.
 
 Built on the public minros (rospy) API like any other node. ``minros core`` starts it as a
-separate process (as roscore starts ``rosout/rosout``) with ``python -m minros.rosout``.
+separate process (as roscore starts ``rosout/rosout``) with ``python -m minros.nodes.rosout``.
 
 The log file is ``$ROS_LOG_DIR/<run_id>/rosout.log`` (``$ROS_HOME/log`` or ``~/.ros/log`` when
 ``ROS_LOG_DIR`` is unset), one line per message in the C++ rosout format::

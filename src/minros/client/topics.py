@@ -6,7 +6,7 @@ writer thread; when the queue is empty the publishing thread first tries a non-b
 itself, which keeps latency at raw-socket level without ever blocking on a slow subscriber.
 
 Receiving runs one thread per publisher connection: ``recv_into`` a preallocated buffer,
-frames cut by ``minros.tcpros.FrameReader`` (large frames land in their own buffer, zero-copy),
+frames cut by ``minros.wire.tcpros.FrameReader`` (large frames land in their own buffer, zero-copy),
 deserialize, run the callbacks.
 """
 
@@ -25,14 +25,14 @@ import warnings
 from typing import Any, Callable, Dict, List, Tuple
 
 from minros import node as _node_mod
-from minros import tcpros
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
     ROSSerializationException,
     SerializationError,
 )
-from minros.xmlrpc import ServerProxy
+from minros.wire import tcpros
+from minros.wire.xmlrpc import ServerProxy
 
 __all__ = [
     "AnyMsg",
@@ -44,7 +44,7 @@ __all__ = [
     "wait_for_message",
 ]
 
-_logger = logging.getLogger("minros.topics")
+_logger = logging.getLogger("minros.client.topics")
 
 DEFAULT_BUFF_SIZE = 65536
 #: frames up to this size are joined into one bytes object; larger keep their parts (no copy)
@@ -70,7 +70,7 @@ def _next_conn_id() -> int:
 def _log_error(text: str) -> None:
     """User-visible error line (rospy's logerr), falling back to the module logger."""
     try:
-        from minros import log
+        from minros.client import log
 
         log.logerr(text)
     except Exception:

@@ -115,7 +115,7 @@ def format_console_line(fmt: str, *, severity: str, message: str, wall_time: flo
 
 def _ros_time_or_none() -> float | None:
     """The simulated time for the console's ``${time}``, or None on wall-clock time."""
-    from minros import rostime
+    from minros.client import rostime
 
     if rostime.is_wallclock() or not rostime.is_rostime_initialized():
         return None
@@ -225,7 +225,7 @@ class RosoutHandler(logging.Handler):
             return
         _rosout.local.busy = True
         try:
-            from minros import rostime
+            from minros.client import rostime
             from rosgraph_msgs.msg import Log
 
             try:
@@ -260,7 +260,7 @@ _param_failed_at: Dict[str, float] = {}
 
 
 def _get_param_cached(key: str, default: Any) -> Any:
-    from minros import params
+    from minros.client import params
 
     failed = _param_failed_at.get(key)
     if failed is not None and time.monotonic() - failed < _PARAM_RETRY:
@@ -350,14 +350,14 @@ def _start_node_logging(caller_id: str, log_level: int | None, disable_rosout: b
     if log_level is not None:
         logger.setLevel(ROS_TO_LOGGING.get(log_level, logging.INFO))
     if not disable_rosout and _rosout.publisher is None:
-        from minros.topics import Publisher
+        from minros.client.topics import Publisher
         from rosgraph_msgs.msg import Log
 
         _rosout.publisher = Publisher("/rosout", Log, latch=True, queue_size=100)
         _rosout.handler = RosoutHandler()
         logger.addHandler(_rosout.handler)
     if not _rosout.services:
-        from minros.services import Service
+        from minros.client.services import Service
         from roscpp.srv import GetLoggers, SetLoggerLevel
 
         _rosout.services = [
@@ -387,7 +387,7 @@ def _frame_key(frame) -> _Key:
 
 
 def _now_for_throttle() -> float:
-    from minros import rostime
+    from minros.client import rostime
 
     if rostime.is_rostime_initialized():
         return rostime.get_time()

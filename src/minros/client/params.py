@@ -6,7 +6,7 @@ on the master (``subscribeParam``) and keeps a local tree fresh from the master'
 ``paramUpdate`` calls; plain ``get_param`` answers from that tree too once a key is cached, and
 ``set_param`` updates it, as rospy does.
 
-The first section names the node context shared with ``minros.services`` (the node runtime's
+The first section names the node context shared with ``minros.client.services`` (the node runtime's
 own functions): both work before ``init_node``.
 """
 
@@ -31,7 +31,7 @@ __all__ = [
 
 # --------------------------------------------------------------------------- node context
 # The node runtime answers these before init_node too (caller id ``/unnamed`` in the namespace,
-# master from ``__master:=`` or ROS_MASTER_URI), so this module and minros.services use it as is.
+# master from ``__master:=`` or ROS_MASTER_URI), so this module and minros.client.services use it as is.
 
 _caller_id = node.get_caller_id
 _node_uri = node.get_node_uri

@@ -1,7 +1,7 @@
 """TCPROS as pure functions: connection headers, length-prefixed framing, service responses.
 
-No sockets here (sans-IO, like h11): the socket layer in ``minros.node`` / ``minros.topics`` /
-``minros.services`` only moves bytes in and out of these objects.
+No sockets here (sans-IO, like h11): the socket layer in ``minros.node`` / ``minros.client.topics`` /
+``minros.client.services`` only moves bytes in and out of these objects.
 
 Wire format (all integers little-endian ``uint32``):
 

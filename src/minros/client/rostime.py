@@ -159,7 +159,7 @@ def _start_node_time(use_sim_time: bool) -> None:
     """Called by ``init_node``: start the node clock, following /clock if ``use_sim_time``."""
     node.add_shutdown_hook(_on_node_shutdown)
     if use_sim_time and _clock.clock_sub is None:
-        from minros.topics import Subscriber
+        from minros.client.topics import Subscriber
         from rosgraph_msgs.msg import Clock
 
         # rospy starts a simulated clock at 0 until the first /clock message arrives

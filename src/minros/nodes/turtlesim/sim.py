@@ -6,7 +6,7 @@ a fixed dt of 0.016 s per tick, a 1 s wall-clock timeout on velocity commands, o
 wrapped to [-pi, pi) with the C++ constant ``PI = 3.14159265``, positions kept in Qt
 coordinates (y pointing down) and clamped to the canvas with the original warning text.
 
-The ROS node (:mod:`minros.turtlesim.turtlesim_node`) is a thin layer around
+The ROS node (:mod:`minros.nodes.turtlesim.turtlesim_node`) is a thin layer around
 :class:`TurtleFrame`; everything here can be driven tick by tick from a unit test.
 """
 

@@ -143,6 +143,6 @@ def main(argv: List[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from minros.turtlesim import run_tool
+    from minros.nodes.turtlesim import run_tool
 
     sys.exit(run_tool("turtle_teleop_key", main))

@@ -15,7 +15,7 @@ Client side: ``ServiceProxy`` looks the service up on the master for every call 
 persistent), connects, exchanges headers, sends one request and reads one response. It works
 without ``init_node`` (caller id ``/unnamed``). All error texts are rospy's.
 
-The header codec, framing and response encoding are the pure functions of ``minros.tcpros``;
+The header codec, framing and response encoding are the pure functions of ``minros.wire.tcpros``;
 this module only moves their bytes through sockets.
 """
 
@@ -32,7 +32,7 @@ import warnings
 import xmlrpc.client
 from typing import Any, Callable, Dict, Tuple
 
-from minros import names, node, tcpros
+from minros import names, node
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -41,6 +41,7 @@ from minros.exceptions import (
     TransportInitError,
     TransportTerminated,
 )
+from minros.wire import tcpros
 
 # the node context (answers before init_node too)
 _caller_id = node.get_caller_id
@@ -212,7 +213,7 @@ def _convert_return_to_response(response: Any, response_class: type) -> Any:
 
 
 def _default_error_handler(exc: BaseException, exc_type, exc_value, tb) -> None:
-    from minros.log import logerr
+    from minros.client.log import logerr
 
     logerr(f"Error processing request: {exc}\n{traceback.format_exception(exc_type, exc_value, tb)}")
 
@@ -295,7 +296,7 @@ class Service:
             error = f"[{_caller_id()}] is not a provider of  [{self.resolved_name}]"
         if error is not None:
             _send_all(sock, tcpros.encode_error_header(error))
-            from minros.log import logwarn
+            from minros.client.log import logwarn
 
             logwarn(f"Could not process inbound connection: {error}{header}")
             return
@@ -308,7 +309,7 @@ class Service:
             frame = source.next()
             if frame is None:
                 if not persistent:
-                    from minros.log import logerr
+                    from minros.client.log import logerr
 
                     logerr(f"incoming connection failed: {_PEER_GONE}")
                 return
@@ -316,7 +317,7 @@ class Service:
             try:
                 request.deserialize(frame)
             except Exception as exc:
-                from minros.log import logerr
+                from minros.client.log import logerr
 
                 logerr(f"[{self.resolved_name}] error deserializing incoming request: {exc}")
                 return
@@ -327,7 +328,7 @@ class Service:
                 if not _is_shutdown():
                     # the client left (or stalled) mid-response: one line, then the next one
                     # (rospy sends the error through the error handler and logs twice)
-                    from minros.log import logerr
+                    from minros.client.log import logerr
 
                     logerr(f"incoming connection failed: [{self.resolved_name}] response to "
                            f"[{header.get('callerid', '')}] not delivered: {exc}")
@@ -609,7 +610,7 @@ def wait_for_service(service: str, timeout: float | None = None) -> None:
     ROSException("timeout exceeded while waiting for service ...") on timeout and
     ROSInterruptException when the node shuts down meanwhile.
     """
-    from minros.log import loginfo, logwarn_throttle
+    from minros.client.log import loginfo, logwarn_throttle
 
     if timeout is not None and hasattr(timeout, "to_sec"):
         timeout = timeout.to_sec()
