@@ -14,7 +14,7 @@ Layout, from pure to I/O:
   in order, each call bounded by a timeout; a slow or dead node never delays an API reply;
 * :class:`MasterHandler` — the XML-RPC methods with rosmaster's argument validation and exact
   ``[code, statusMessage, value]`` results;
-* :class:`Master` — handler + :class:`minros.xmlrpc.XmlRpcServer`.
+* :class:`Master` — handler + :class:`minros.wire.xmlrpc.XmlRpcServer`.
 """
 
 from __future__ import annotations
@@ -28,10 +28,20 @@ import os
 import signal
 import sys
 import threading
-from typing import Any, Callable, Dict, Iterable, List, Sequence, Tuple
+from typing import Any, Callable, Dict, Iterable, List, Tuple
 
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
 from minros.names import resolve_name as _resolve_name
+from minros.wire.rosapi import (
+    api,
+    empty_or_valid_name,
+    is_api,
+    is_topic,
+    non_empty_str,
+    not_none,
+    valid_name,
+    valid_type_name,
+)
 
 DEFAULT_MASTER_PORT = 11311
 #: Timeout of one callback (publisherUpdate, paramUpdate, shutdown) to a node, in seconds.
@@ -41,7 +51,6 @@ CALLBACK_WORKERS = 16  # started on demand; many slow nodes do not stall the oth
 MAX_QUEUED_PER_NODE = 10000
 #: Queued calls to one node beyond which a newer update replaces a queued one for the same key.
 COALESCE_BACKLOG = 32
-ROSRPC = "rosrpc://"
 
 #: What the master did (+PUB, -SUB, +PARAM ... as in rosmaster's master.log); no handler is
 #: attached unless :func:`configure_log_file` is called, so library use stays silent.
@@ -482,7 +491,7 @@ class CallbackPool:
                     self._queues.pop(api, None)
 
     def _xmlrpc_call(self, api: str, method: str, args: Tuple[Any, ...]) -> Any:
-        from minros.xmlrpc import ServerProxy
+        from minros.wire.xmlrpc import ServerProxy
 
         with self._proxies_lock:
             proxy = self._proxies.pop(api, None)
@@ -514,130 +523,6 @@ class CallbackPool:
             for proxy in self._proxies.values():
                 proxy.close()
             self._proxies.clear()
-
-
-# ====================================================================== argument validation
-
-
-class ParameterInvalid(Exception):
-    """An API argument failed validation (-> code -1 with this message)."""
-
-
-Validator = Callable[[Any, str], Any]
-
-
-def non_empty_str(name: str) -> Validator:
-    def check(value: Any, caller_id: str) -> Any:
-        if not value:
-            raise ParameterInvalid(f"ERROR: parameter [{name}] must be specified and non-empty")
-        if not isinstance(value, str):
-            raise ParameterInvalid(f"ERROR: parameter [{name}] must be a string")
-        return value
-    return check
-
-
-def not_none(name: str) -> Validator:
-    def check(value: Any, caller_id: str) -> Any:
-        if value is None:
-            raise ParameterInvalid(f"ERROR: parameter [{name}] must be specified")
-        return value
-    return check
-
-
-def is_api(name: str) -> Validator:
-    def check(value: Any, caller_id: str) -> Any:
-        if not value or not isinstance(value, str):
-            raise ParameterInvalid(f"ERROR: parameter [{name}] is not an XMLRPC URI")
-        if not value.startswith("http://") and not value.startswith(ROSRPC):
-            raise ParameterInvalid(f"ERROR: parameter [{name}] is not an RPC URI")
-        return value
-    return check
-
-
-def _resolved_name(name: str, value: Any, caller_id: str) -> str:
-    if not value or not isinstance(value, str):
-        raise ParameterInvalid(f"ERROR: parameter [{name}] must be a non-empty string")
-    # ':' and ' ' catch the common mistake of passing a URI where a name belongs
-    if ":" in value or " " in value:
-        raise ParameterInvalid(f"ERROR: parameter [{name}] contains illegal chars")
-    return _resolve_name(value, caller_id)
-
-
-def valid_name(name: str) -> Validator:
-    def check(value: Any, caller_id: str) -> Any:
-        return _resolved_name(name, value, caller_id)
-    return check
-
-
-def is_topic(name: str) -> Validator:
-    """Also used for services: a resolved name that is not the root namespace."""
-    def check(value: Any, caller_id: str) -> Any:
-        resolved = _resolved_name(name, value, caller_id)
-        if value == SEP:
-            raise ParameterInvalid(f"ERROR: parameter [{name}] cannot be the global namespace")
-        return resolved
-    return check
-
-
-def empty_or_valid_name(name: str) -> Validator:
-    def check(value: Any, caller_id: str) -> Any:
-        if not isinstance(value, str):
-            raise ParameterInvalid(f"ERROR: parameter [{name}] must be a string")
-        if not value:
-            return ""
-        return _resolve_name(value, caller_id)
-    return check
-
-
-def valid_type_name(name: str) -> Validator:
-    def check(value: Any, caller_id: str) -> Any:
-        if value == ANYTYPE:
-            return value
-        if not value or not isinstance(value, str):
-            raise ParameterInvalid(f"ERROR: parameter [{name}] must be a non-empty string")
-        if len(value.split("/")) != 2:
-            raise ParameterInvalid(f"ERROR: parameter [{name}] is not a valid package resource name")
-        return value
-    return check
-
-
-def api(error_value: Any, validators: Sequence[Validator | None] = ()) -> Callable:
-    """Decorate a Master API method: arity and caller_id checks, validators, exact error triplets.
-
-    The decorated method takes ``(self, caller_id, *validated_args)`` and returns a triplet.
-    """
-    arity = 1 + len(validators)
-
-    def decorate(impl: Callable[..., Any]) -> Callable[..., Any]:
-        @functools.wraps(impl)
-        def method(self: Any, *args: Any) -> Any:
-            if not args:
-                return [-1, "missing required caller_id parameter", error_value]
-            if len(args) != arity:
-                return [-1, "Error: bad call arity", error_value]
-            caller_id = args[0]
-            if not isinstance(caller_id, str):
-                return [-1, "caller_id must be a string", error_value]
-            checked = [caller_id]
-            try:
-                for validator, value in zip(validators, args[1:]):
-                    if validator is None:
-                        checked.append(value)
-                        continue
-                    try:
-                        checked.append(validator(value, caller_id))
-                    except ParameterInvalid as exc:
-                        return [-1, str(exc) or "error", error_value]
-                code, msg, value = impl(self, *checked)
-                if value is None:
-                    return [-1, "Internal error (None value returned)", error_value]
-                return [code, msg, value]
-            except TypeError as exc:
-                return [-1, f"Error: invalid arguments: {exc}", error_value]
-            except Exception as exc:  # noqa: BLE001 - rosmaster reports internal failures as code 0
-                return [0, f"Internal failure: {exc}", error_value]
-        return method
-    return decorate
 
 
 # ====================================================================== the API
@@ -898,7 +783,7 @@ class Master:
                  hostname: str | None = None) -> None:
         """``host``: address to bind (default: ROS's rule from ROS_IP/ROS_HOSTNAME);
         ``hostname``: name advertised in the master URI (default: ROS_HOSTNAME/ROS_IP/host name)."""
-        from minros import xmlrpc
+        from minros.wire import xmlrpc
 
         self.hostname = hostname
         if host is None and hostname is not None:
@@ -914,7 +799,7 @@ class Master:
         self.uri = ""
 
     def start(self) -> Master:
-        from minros import xmlrpc
+        from minros.wire import xmlrpc
 
         self.server.start()
         if self.hostname:
@@ -990,7 +875,7 @@ def main(argv: List[str] | None = None, prog: str = "minros master") -> int:
     except OSError as exc:
         print(f"{prog}: cannot listen on port {args.port}: {exc.strerror or exc}", file=sys.stderr)
         return 1
-    from minros.rosout import log_dir
+    from minros.nodes.rosout import log_dir
 
     configure_log_file(log_path or str(log_dir() / "master.log"))
     _log.info("Master initialized: port[%s], uri[%s]", master.port, master.uri)
