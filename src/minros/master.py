@@ -30,8 +30,10 @@ import sys
 import threading
 from typing import Any, Callable, Dict, Iterable, List, Tuple
 
+from minros import rosenv
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
 from minros.names import resolve_name as _resolve_name
+from minros.wire import xmlrpc
 from minros.wire.rosapi import (
     api,
     empty_or_valid_name,
@@ -491,12 +493,10 @@ class CallbackPool:
                     self._queues.pop(api, None)
 
     def _xmlrpc_call(self, api: str, method: str, args: Tuple[Any, ...]) -> Any:
-        from minros.wire.xmlrpc import ServerProxy
-
         with self._proxies_lock:
             proxy = self._proxies.pop(api, None)
             if proxy is None:
-                proxy = ServerProxy(api, timeout=self.timeout)
+                proxy = xmlrpc.ServerProxy(api, timeout=self.timeout)
             self._proxies[api] = proxy
             while len(self._proxies) > 256:
                 _old_api, old = self._proxies.popitem(last=False)
@@ -783,29 +783,25 @@ class Master:
                  hostname: str | None = None) -> None:
         """``host``: address to bind (default: ROS's rule from ROS_IP/ROS_HOSTNAME);
         ``hostname``: name advertised in the master URI (default: ROS_HOSTNAME/ROS_IP/host name)."""
-        from minros.wire import xmlrpc
-
         self.hostname = hostname
         if host is None and hostname is not None:
-            host = xmlrpc.get_bind_address(hostname)
+            host = rosenv.get_bind_address(hostname)
         self.pool = CallbackPool(workers, callback_timeout)
         self.handler = MasterHandler(self.pool)
-        # Stop a moment after the shutdown call so its reply still reaches the caller.
-        self.handler._on_shutdown = lambda reason: threading.Timer(0.2, self._stopped.set).start()
-        bind = xmlrpc.get_bind_address() if host is None else host
+        # Stop once the reply to the shutdown call has reached the caller.
+        self.handler._on_shutdown = lambda reason: xmlrpc.after_reply(self._stopped.set)
+        bind = rosenv.get_bind_address() if host is None else host
         self.server = xmlrpc.XmlRpcServer(self.handler, bind, port,
-                                          ipv6=":" in bind or xmlrpc.use_ipv6())
+                                          ipv6=":" in bind or rosenv.use_ipv6())
         self._stopped = threading.Event()
         self.uri = ""
 
     def start(self) -> Master:
-        from minros.wire import xmlrpc
-
         self.server.start()
         if self.hostname:
             self.uri = f"http://{self.hostname}:{self.server.port}/"
         else:
-            self.uri = xmlrpc.create_local_xmlrpc_uri(self.server.port)
+            self.uri = rosenv.create_local_xmlrpc_uri(self.server.port)
         self.handler._set_uri(self.uri)
         return self
 
@@ -875,9 +871,7 @@ def main(argv: List[str] | None = None, prog: str = "minros master") -> int:
     except OSError as exc:
         print(f"{prog}: cannot listen on port {args.port}: {exc.strerror or exc}", file=sys.stderr)
         return 1
-    from minros.nodes.rosout import log_dir
-
-    configure_log_file(log_path or str(log_dir() / "master.log"))
+    configure_log_file(log_path or str(rosenv.ros_log_dir() / "master.log"))
     _log.info("Master initialized: port[%s], uri[%s]", master.port, master.uri)
     install_stop_signals(master._stopped.set)
     try:

@@ -1,4 +1,5 @@
-"""The ROS environment rules in one place: master URI, ROS_HOME and the log directory.
+"""The ROS environment rules in one place: master URI, ROS_HOME, the log directory, and the
+addresses a node binds to and advertises (ROS_IP, ROS_HOSTNAME, ROS_IPV6).
 
 Every tool and node reads these the same way, as rosgraph.rosenv does: ``__master:=`` beats
 ``ROS_MASTER_URI`` (default ``http://localhost:11311/``); ``ROS_HOME`` defaults to ``~/.ros``;
@@ -9,9 +10,10 @@ directory named by its run_id and ``latest`` links to the newest one.
 from __future__ import annotations
 
 import os
+import socket
 import sys
 from pathlib import Path
-from typing import Iterable, Mapping, Optional
+from typing import Iterable, Mapping, Optional, Sequence
 
 DEFAULT_MASTER_PORT = 11311
 DEFAULT_MASTER_URI = f"http://localhost:{DEFAULT_MASTER_PORT}/"
@@ -64,3 +66,57 @@ def renew_latest_log_dir(run_dir: Path) -> None:
         latest.symlink_to(run_dir)
     except OSError as exc:
         sys.stderr.write(f"INFO: cannot create a symlink to latest log directory: {exc}\n")
+
+
+# ---------------------------------------------------------------------------------------------
+# addresses nodes bind to and advertise (ROS_IP / ROS_HOSTNAME, as rosgraph.network)
+
+
+def get_address_override(env: Mapping[str, str] | None = None,
+                         argv: Sequence[str] | None = None) -> str | None:
+    """``__hostname:=``/``__ip:=`` argument, else ROS_HOSTNAME, else ROS_IP, else None."""
+    argv = sys.argv if argv is None else argv
+    env = os.environ if env is None else env
+    for arg in argv:
+        if arg.startswith("__hostname:=") or arg.startswith("__ip:="):
+            return arg.split(":=", 1)[1]
+    if "ROS_HOSTNAME" in env:
+        return env["ROS_HOSTNAME"]
+    if "ROS_IP" in env:
+        return env["ROS_IP"]
+    return None
+
+
+def use_ipv6(env: Mapping[str, str] | None = None) -> bool:
+    env = os.environ if env is None else env
+    return env.get("ROS_IPV6") == "on"
+
+
+def get_bind_address(address: str | None = None, env: Mapping[str, str] | None = None) -> str:
+    """Loopback when the advertised address is local-only, else the wildcard address."""
+    if address is None:
+        address = get_address_override(env)
+    ipv6 = use_ipv6(env)
+    if address and (address == "localhost" or address.startswith("127.") or address == "::1"):
+        if ipv6:
+            return "::1"
+        return address if address.startswith("127.") else "127.0.0.1"
+    return "::" if ipv6 else "0.0.0.0"
+
+
+def get_host_name(env: Mapping[str, str] | None = None) -> str:
+    """Host name for advertised URIs: the override, else the host name, else a local address."""
+    host = get_address_override(env)
+    if host:
+        return host
+    try:
+        host = socket.gethostname()
+    except OSError:
+        host = ""
+    if not host or host == "localhost" or host.startswith("127."):
+        host = "::1" if use_ipv6(env) else "127.0.0.1"
+    return host
+
+
+def create_local_xmlrpc_uri(port: int, env: Mapping[str, str] | None = None) -> str:
+    return f"http://{get_host_name(env)}:{port}/"

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from minros.nodes.rosout import RotatingLog, format_line, log_dir
+from minros.nodes.rosout import RotatingLog, format_line
+from minros.rosenv import ros_log_dir as log_dir
 
 
 def _msg(level=2, topics=("/rosout", "/chatter")):

@@ -254,29 +254,6 @@ def test_concurrent_clients(server):
     assert not errors
 
 
-def test_triplets_and_unwrap():
-    assert mx.triplet(mx.SUCCESS, "", 3) == [1, "", 3]
-    assert mx.unwrap([1, "ok", 5]) == 5
-    with pytest.raises(mx.RemoteError) as info:
-        mx.unwrap([-1, "no such node", ""])
-    assert info.value.code == mx.ERROR and info.value.msg == "no such node"
-    with pytest.raises(mx.RemoteError):
-        mx.unwrap("nonsense")
-
-
-def test_address_rules():
-    assert mx.get_bind_address(env={"ROS_HOSTNAME": "localhost"}) == "127.0.0.1"
-    assert mx.get_bind_address(env={"ROS_IP": "127.0.0.5"}) == "127.0.0.5"
-    assert mx.get_bind_address(env={"ROS_IP": "10.1.2.3"}) == "0.0.0.0"
-    assert mx.get_bind_address(env={"ROS_HOSTNAME": "localhost", "ROS_IPV6": "on"}) == "::1"
-    assert mx.get_address_override({"ROS_IP": "1.2.3.4", "ROS_HOSTNAME": "h"}, []) == "h"
-    assert mx.get_address_override({"ROS_IP": "1.2.3.4"}, ["__ip:=5.6.7.8"]) == "5.6.7.8"
-    assert mx.create_local_xmlrpc_uri(1234, {"ROS_HOSTNAME": "h"}) == "http://h:1234/"
-    assert mx.parse_http_host_and_port("http://h:99/") == ("h", 99)
-    with pytest.raises(ValueError):
-        mx.parse_http_host_and_port("rosrpc://h:99")
-
-
 def test_bodies_in_memory_are_bounded_in_total():
     srv = mx.XmlRpcServer(Handler(), "127.0.0.1", max_body=1000, body_budget=1000, idle_timeout=0.1)
     assert srv._reserve(900)

@@ -219,9 +219,9 @@ def main(argv: List[str], prog: str = "minros core") -> int:
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
 
-    from minros.nodes.rosout import log_dir
+    from minros.rosenv import ros_log_dir
 
-    base_log = str(log_dir(env))
+    base_log = str(ros_log_dir(env))
     run_log = os.path.join(base_log, run_id)
     try:
         os.makedirs(run_log, exist_ok=True)

@@ -27,11 +27,6 @@ MAX_BACKUPS = 10
 _LEVELS = {1: "DEBUG", 2: "INFO", 4: "WARN", 8: "ERROR", 16: "FATAL"}
 
 
-def log_dir(env: dict | None = None) -> Path:
-    """The ROS log directory (ROS_LOG_DIR, else ROS_HOME/log, else ~/.ros/log)."""
-    return ros_log_dir(env)
-
-
 def format_line(msg: Any) -> str:
     """One rosout.log line for a rosgraph_msgs/Log message."""
     stamp = msg.header.stamp
@@ -109,7 +104,7 @@ def main(argv: List[str] | None = None) -> int:
     _exit_with_core(minros)  # before init_node, which waits for a master that may be gone
     minros.init_node("rosout", argv=argv, disable_rosout=True, disable_rostime=True)
     run_id = minros.get_param("/run_id", "")
-    directory = log_dir() / run_id if run_id else log_dir()
+    directory = ros_log_dir() / run_id if run_id else ros_log_dir()
     try:
         log: RotatingLog | None = RotatingLog(directory / "rosout.log")
     except OSError as exc:

@@ -1,5 +1,6 @@
-"""XML-RPC for the master and slave APIs: a threaded HTTP/1.1 server, a client with timeouts,
-the ``[code, statusMessage, value]`` convention and the ROS network-address rules.
+"""XML-RPC for the master and slave APIs: a threaded HTTP/1.1 server and a client with timeouts;
+HTTP for the XML-RPC bodies and nothing ROS-specific (the ``[code, statusMessage, value]``
+convention is :mod:`minros.wire.rosapi`, the ROS_IP/ROS_HOSTNAME rules :mod:`minros.rosenv`).
 
 Server behaviour matches what ROS nodes expect from rosgraph's ``ThreadingXMLRPCServer``:
 HTTP/1.1 keep-alive, one thread per connection (so one kept-alive client never blocks another),
@@ -12,51 +13,14 @@ is bounded. Nothing is logged per request (and no reverse DNS lookups are ever m
 
 from __future__ import annotations
 
-import _thread
-import os
+import logging
 import socket
-import sys
 import threading
 import time
 import xmlrpc.client
-from typing import Any, Callable, Dict, List, Mapping, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Sequence, Tuple
 from urllib.parse import urlparse
 from xmlrpc.client import Binary, DateTime, Fault, ProtocolError  # noqa: F401 - re-exported
-
-# ------------------------------------------------------------------ the result triplet convention
-
-#: ``[code, statusMessage, value]``: the call did what was asked.
-SUCCESS = 1
-#: The call was valid but failed (an internal error on the callee's side).
-FAILURE = 0
-#: The caller made an error (invalid argument, unknown name, ...).
-ERROR = -1
-
-
-def triplet(code: int, msg: str, value: Any) -> List[Any]:
-    """A ROS API result; ``value`` is mandatory even on error (XML-RPC cannot carry None)."""
-    return [code, msg, value]
-
-
-class RemoteError(Exception):
-    """A ROS API call answered with a code other than SUCCESS."""
-
-    def __init__(self, code: int, msg: str, value: Any = None) -> None:
-        super().__init__(msg)
-        self.code = code
-        self.msg = msg
-        self.value = value
-
-
-def unwrap(result: Any) -> Any:
-    """Value of a SUCCESS triplet; raises :class:`RemoteError` otherwise (or on a malformed result)."""
-    if not isinstance(result, (list, tuple)) or len(result) != 3:
-        raise RemoteError(FAILURE, f"malformed ROS API result: {result!r}")
-    code, msg, value = result
-    if code != SUCCESS:
-        raise RemoteError(code, str(msg), value)
-    return value
-
 
 # ------------------------------------------------------------------ limits
 
@@ -180,6 +144,22 @@ def _status_response(status: int, detail: str) -> bytes:
     head = (f"HTTP/1.1 {status} {_REASONS.get(status, 'Error')}\r\nServer: minros\r\n"
             f"Content-Type: text/plain\r\nContent-Length: {len(body)}\r\nConnection: close\r\n\r\n")
     return head.encode("latin-1") + body
+
+
+_logger = logging.getLogger("minros.xmlrpc")
+#: per connection thread: the hooks of the request being handled (None outside a request)
+_request = threading.local()
+
+
+def after_reply(hook: Callable[[], Any]) -> None:
+    """Run ``hook()`` once the reply to the request being handled has been sent, in the same
+    thread. An API method that ends the server (``shutdown``) uses it, so that its own reply
+    still reaches the caller without a grace sleep. Outside a request, ``hook`` runs now."""
+    hooks = getattr(_request, "after_reply", None)
+    if hooks is None:
+        hook()
+    else:
+        hooks.append(hook)
 
 
 class XmlRpcServer:
@@ -311,9 +291,8 @@ class XmlRpcServer:
                 conn.settimeout(self.idle_timeout)
                 with self._conns_lock:
                     self._conns[id(conn)] = conn
-                # _thread rather than threading.Thread: Thread.start() waits until the new thread
-                # runs, which costs a GIL hand-off (up to 5 ms) per accepted client.
-                _thread.start_new_thread(self._serve_connection, (conn,))
+                threading.Thread(target=self._serve_connection, args=(conn,), daemon=True,
+                                 name=f"xmlrpc-conn:{self.port}").start()
             except BaseException:  # noqa: BLE001 - e.g. cannot start a thread: drop this client
                 with self._conns_lock:
                     self._conns.pop(id(conn), None)
@@ -337,15 +316,25 @@ class XmlRpcServer:
                 if request is None:
                     return
                 body, keep_alive = request
+                hooks: List[Callable[[], Any]] = []
+                _request.after_reply = hooks
                 try:
                     payload = self.dispatcher.handle_request_body(body)
                 finally:
+                    _request.after_reply = None
                     self._release(len(body))
                     del body
                 head = ("HTTP/1.1 200 OK\r\nServer: minros\r\nContent-type: text/xml\r\n"
                         f"Content-length: {len(payload)}\r\n"
                         + ("" if keep_alive else "Connection: close\r\n") + "\r\n")
-                conn.sendall(head.encode("latin-1") + payload)
+                try:
+                    conn.sendall(head.encode("latin-1") + payload)
+                finally:
+                    for hook in hooks:
+                        try:
+                            hook()
+                        except Exception:  # noqa: BLE001 - a hook must not end the connection thread
+                            _logger.exception("after-reply hook failed")
                 if not keep_alive:
                     return
         except (OSError, ValueError):
@@ -586,64 +575,3 @@ class ServerProxy:
 
 class _PeerClosed(ConnectionError):
     """The server closed a kept-alive connection before answering."""
-
-
-# ------------------------------------------------------------------ addresses (ROS_IP / ROS_HOSTNAME)
-
-
-def get_address_override(env: Mapping[str, str] | None = None,
-                         argv: Sequence[str] | None = None) -> str | None:
-    """``__hostname:=``/``__ip:=`` argument, else ROS_HOSTNAME, else ROS_IP, else None."""
-    argv = sys.argv if argv is None else argv
-    env = os.environ if env is None else env
-    for arg in argv:
-        if arg.startswith("__hostname:=") or arg.startswith("__ip:="):
-            return arg.split(":=", 1)[1]
-    if "ROS_HOSTNAME" in env:
-        return env["ROS_HOSTNAME"]
-    if "ROS_IP" in env:
-        return env["ROS_IP"]
-    return None
-
-
-def use_ipv6(env: Mapping[str, str] | None = None) -> bool:
-    env = os.environ if env is None else env
-    return env.get("ROS_IPV6") == "on"
-
-
-def get_bind_address(address: str | None = None, env: Mapping[str, str] | None = None) -> str:
-    """Loopback when the advertised address is local-only, else the wildcard address."""
-    if address is None:
-        address = get_address_override(env)
-    ipv6 = use_ipv6(env)
-    if address and (address == "localhost" or address.startswith("127.") or address == "::1"):
-        if ipv6:
-            return "::1"
-        return address if address.startswith("127.") else "127.0.0.1"
-    return "::" if ipv6 else "0.0.0.0"
-
-
-def get_host_name(env: Mapping[str, str] | None = None) -> str:
-    """Host name for advertised URIs: the override, else the host name, else a local address."""
-    host = get_address_override(env)
-    if host:
-        return host
-    try:
-        host = socket.gethostname()
-    except OSError:
-        host = ""
-    if not host or host == "localhost" or host.startswith("127."):
-        host = "::1" if use_ipv6(env) else "127.0.0.1"
-    return host
-
-
-def create_local_xmlrpc_uri(port: int, env: Mapping[str, str] | None = None) -> str:
-    return f"http://{get_host_name(env)}:{port}/"
-
-
-def parse_http_host_and_port(uri: str) -> Tuple[str, int]:
-    """``http://host:port/`` -> ``(host, port)``; ValueError when it is not such a URI."""
-    parsed = urlparse(uri)
-    if parsed.scheme != "http" or not parsed.hostname:
-        raise ValueError(f"not an http URI: {uri!r}")
-    return parsed.hostname, parsed.port or 80
