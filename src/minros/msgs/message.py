@@ -45,6 +45,9 @@ class Message:
     #: views do); False lets a subscriber reuse one receive buffer for its big frames
     _keeps_buffer = True
     _slot_types: List[str] = []
+    #: the message context (registry) the class came from; the registry sets the default for
+    #: every class and its own for those it builds (numpy_msg finds the numpy variant there)
+    _context: Any = None
 
     def __init__(self, *args: Any, **kwds: Any) -> None:
         # Generated classes override this; kept for hand-written subclasses.
@@ -121,13 +124,11 @@ class Message:
 
     def deserialize_numpy(self, data: Any, numpy: Any = None) -> Message:
         """As :meth:`deserialize`, but numeric arrays become numpy views of ``data``."""
-        from .registry import numpy_msg
-
         view = data if data.__class__ is memoryview else memoryview(data)
         if view.format != "B" or view.ndim != 1:
             view = view.cast("B")
         # the numpy variant's reader fills any instance of the type (it sets fields by name)
-        reader = numpy_msg(type(self))._deserialize_from
+        reader = type(self)._context.get_numpy_class(type(self))._deserialize_from
         try:
             try:
                 end = reader(self, view, 0)

@@ -15,7 +15,6 @@ import threading
 from pathlib import Path
 from typing import Any, Dict, List, Tuple
 
-from . import runtime
 from .codegen import generate_source, numpy_class_name
 from .message import Message
 from .spec import (
@@ -33,8 +32,6 @@ from .spec import (
     parse_srv,
     split_full_text,
 )
-
-_RUNTIME_NAMES = dict(runtime.EXPORTS)
 
 
 class UnknownTypeError(LookupError):
@@ -277,8 +274,7 @@ class MsgContext:
     def _compile(self, type_name: str, source: str, base_class: type | None) -> type:
         filename = f"<minros msg {type_name}{' numpy' if base_class else ''}>"
         linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
-        namespace: Dict[str, Any] = dict(_RUNTIME_NAMES)
-        namespace["_load"] = self.get_class
+        namespace: Dict[str, Any] = {"_load": self.get_class}  # embedded types from this context
         namespace["__name__"] = self._module_for(type_name) or "minros.msgs.generated"
         if base_class is not None:
             namespace["_base_class"] = base_class
@@ -323,6 +319,7 @@ def _read_text(path: Path) -> str:
 
 #: The process-wide registry of message and service types.
 REGISTRY = MsgContext()
+Message._context = REGISTRY  # hand-written subclasses of Message load from the global registry
 
 
 def get_message_class(type_name: str) -> type:
@@ -337,8 +334,7 @@ def get_service_class(type_name: str) -> type:
 
 def numpy_msg(cls: type) -> type:
     """The variant of message class ``cls`` whose numeric arrays deserialize as numpy views."""
-    context = getattr(cls, "_context", None) or REGISTRY
-    return context.get_numpy_class(cls)
+    return (getattr(cls, "_context", None) or REGISTRY).get_numpy_class(cls)
 
 
 _dynamic_cache: Dict[Tuple[str, str], Dict[str, type]] = {}

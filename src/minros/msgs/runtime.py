@@ -1,8 +1,9 @@
 """Names the generated message code uses (imported by every generated module).
 
 Kept small and explicit so the printed source of a message class (``minros msg gen``) reads
-like ordinary Python: ``from minros.msgs.runtime import *`` brings exactly :data:`EXPORTS`,
-all prefixed with ``_`` so they never clash with a message named ``Time`` or ``Struct``.
+like ordinary Python and runs on its own: it imports by name the few of :data:`EXPORTS` it
+uses, each under an alias prefixed with ``_`` so it never clashes with a message named ``Time``
+or ``Struct`` (``from minros.msgs.runtime import Message as _Message, ...``).
 """
 
 from __future__ import annotations
@@ -140,13 +141,15 @@ def string_bytes(value: Any) -> bytes:
     raise TypeError(f"a string field must be str or bytes, not {type(value).__name__}")
 
 
-#: what ``from minros.msgs.runtime import *`` gives generated code
+#: the names generated code imports from this module: the alias it uses -> the name here
 EXPORTS = {
-    "_Struct": Struct, "_Message": Message, "_Time": Time, "_Duration": Duration, "_new": new,
-    "_S_I": S_I, "_overrun": overrun, "_too_many": too_many, "_bad_length": bad_length,
-    "_put_array": put_array, "_unpack_array": unpack_array, "_numpy_view": numpy_view,
-    "_as_bytes": as_bytes, "_as_list": as_list, "_string_bytes": string_bytes,
-    "_init_fields": init_fields, "_MAX_EMPTY_ELEMENTS": MAX_EMPTY_ELEMENTS,
+    "_Struct": "Struct", "_Message": "Message", "_Time": "Time", "_Duration": "Duration",
+    "_new": "new", "_S_I": "S_I", "_overrun": "overrun", "_too_many": "too_many",
+    "_bad_length": "bad_length", "_put_array": "put_array", "_unpack_array": "unpack_array",
+    "_numpy_view": "numpy_view", "_as_bytes": "as_bytes", "_as_list": "as_list",
+    "_string_bytes": "string_bytes", "_init_fields": "init_fields",
+    "_MAX_EMPTY_ELEMENTS": "MAX_EMPTY_ELEMENTS",
 }
-globals().update(EXPORTS)
-__all__ = list(EXPORTS)  # noqa: PLE0605
+__all__ = ["Duration", "MAX_EMPTY_ELEMENTS", "Message", "S_I", "Struct", "Time", "as_bytes", "as_list",
+           "bad_length", "init_fields", "new", "numpy_view", "overrun", "put_array", "string_bytes",
+           "too_many", "unpack_array"]
