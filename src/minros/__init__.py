@@ -1,9 +1,10 @@
 """minros: a pure-Python ROS 1 middleware. This module is the rospy-compatible public API.
 
 ``import rospy`` gives exactly these names (the ``rospy`` stand-in package re-exports them),
-so unmodified rospy scripts run on minros. The behaviour lives in the submodules:
-``node`` (init_node, names, lifecycle), ``topics``, ``services``, ``params``, ``rostime``,
-``log``; this file only maps the public names to them.
+so unmodified rospy scripts run on minros. The behaviour lives in the layers below: the node
+runtime ``minros.node`` (names, lifecycle) and the client library ``minros.client`` (``init``,
+``topics``, ``services``, ``params``, ``rostime``, ``log``, ``msproxy``); this file only maps the
+public names to them.
 
 Names are imported on first use (PEP 562), so ``import minros.wire.tcpros`` or a command-line tool
 does not pay for the whole client library, and one layer can be used without the others.
@@ -29,9 +30,10 @@ _EXCEPTIONS = ("ROSException", "ROSSerializationException", "ROSInitException",
 _LOG = ("DEBUG", "INFO", "WARN", "ERROR", "FATAL", "logout",
         *(f"log{level}{suffix}" for level in ("debug", "info", "warn", "err", "fatal")
           for suffix in ("", "_throttle", "_throttle_identical", "_once")))
-_NODE = ("init_node", "spin", "myargv", "on_shutdown", "is_shutdown", "signal_shutdown",
-         "get_node_uri", "get_master", "MasterProxy", "get_name", "get_caller_id",
-         "get_namespace", "resolve_name", "remap_name")
+_NODE = ("spin", "myargv", "on_shutdown", "is_shutdown", "signal_shutdown", "get_node_uri",
+         "get_name", "get_caller_id", "get_namespace", "resolve_name", "remap_name")
+_INIT = ("init_node",)
+_MSPROXY = ("get_master", "MasterProxy")
 _PARAMS = ("get_param", "get_param_cached", "get_param_names", "set_param", "delete_param",
            "has_param", "search_param")
 _ROSTIME = ("Time", "Duration", "get_rostime", "get_time", "sleep", "Rate", "Timer", "TimerEvent")
@@ -42,7 +44,8 @@ _TOPICS = ("Publisher", "Subscriber", "SubscribeListener", "AnyMsg", "wait_for_m
 #: public name -> module that defines it
 _WHERE: Dict[str, str] = {}
 for _module, _names in (("minros.exceptions", _EXCEPTIONS), ("minros.client.log", _LOG),
-                        ("minros.node", _NODE), ("minros.client.params", _PARAMS),
+                        ("minros.node", _NODE), ("minros.client.init", _INIT),
+                        ("minros.client.msproxy", _MSPROXY), ("minros.client.params", _PARAMS),
                         ("minros.client.rostime", _ROSTIME), ("minros.client.services", _SERVICES),
                         ("minros.client.topics", _TOPICS)):
     for _name in _names:

@@ -1,3 +1,3 @@
-"""rospy.msproxy: MasterProxy (minros.node)."""
+"""rospy.msproxy: MasterProxy (minros.client.msproxy)."""
 
-from minros.node import MasterProxy  # noqa: F401
+from minros.client.msproxy import MasterProxy  # noqa: F401

@@ -27,7 +27,7 @@ if len(sys.argv) > 2:  # wait for the /rosout subscriber, so no record predates 
     try:
         from rospy.impl.rosout import _rosout_pub as rosout
     except ImportError:
-        from minros.client.log import _rosout
+        from minros.client.rosout_log import _rosout
         rosout = _rosout.publisher
     deadline = time.monotonic() + 20
     while rosout.get_num_connections() < 1 and time.monotonic() < deadline:

@@ -1,4 +1,5 @@
-"""minros.client.log: console format, stdout/stderr split, levels, throttle/once/identical, /rosout records."""
+"""minros.client.log (console format, stdout/stderr split, levels, throttle/once/identical) and
+minros.client.rosout_log (/rosout records, logger services)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,8 @@ import re
 
 import pytest
 
-from minros.client import log, rostime
+from minros import node
+from minros.client import log, rosout_log, rostime
 
 
 @pytest.fixture
@@ -196,10 +198,10 @@ def test_rosout_handler_publishes_log_messages(streams, monkeypatch):
     from rosgraph_msgs.msg import Log
 
     pub = FakePublisher()
-    monkeypatch.setattr(log._rosout, "publisher", pub)
-    monkeypatch.setattr(log, "_get_param_cached", lambda key, default: default)
-    monkeypatch.setattr(log, "_node_topics", lambda: ["/chatter", "/rosout"])
-    handler = log.RosoutHandler()
+    monkeypatch.setattr(rosout_log._rosout, "publisher", pub)
+    monkeypatch.setattr(rosout_log, "_get_param_cached", lambda key, default: default)
+    monkeypatch.setattr(rosout_log, "_node_topics", lambda: ["/chatter", "/rosout"])
+    handler = rosout_log.RosoutHandler()
     logger = logging.getLogger("rosout")
     logger.addHandler(handler)
     try:
@@ -221,7 +223,7 @@ def test_rosout_handler_publishes_log_messages(streams, monkeypatch):
     assert first.function == "Talker.talk"
     assert first.line == expected_line
     assert first.topics == ["/chatter", "/rosout"]
-    assert first.name == log._caller_id()
+    assert first.name == node.get_caller_id()
     assert not first.header.stamp.is_zero()
     assert pub.sent[1].level == Log.ERROR and pub.sent[1].msg == "from python logging"
 
@@ -230,12 +232,12 @@ def test_logger_services_handlers():
     from roscpp.srv import GetLoggersRequest, SetLoggerLevelRequest
 
     logging.getLogger("minros.test.svc").setLevel(logging.ERROR)
-    response = log._get_loggers(GetLoggersRequest())
+    response = rosout_log._get_loggers(GetLoggersRequest())
     levels = {lg.name: lg.level for lg in response.loggers}
     assert levels["minros.test.svc"] == "error"
-    log._set_logger_level(SetLoggerLevelRequest(logger="minros.test.svc", level="debug"))
+    rosout_log._set_logger_level(SetLoggerLevelRequest(logger="minros.test.svc", level="debug"))
     assert logging.getLogger("minros.test.svc").level == logging.DEBUG
-    response = log._get_loggers(GetLoggersRequest())
+    response = rosout_log._get_loggers(GetLoggersRequest())
     assert {lg.name: lg.level for lg in response.loggers}["minros.test.svc"] == "debug"
 
 
@@ -257,10 +259,10 @@ def test_failed_param_lookup_is_not_retried_on_every_record(monkeypatch):
         raise OSError("master unreachable")
 
     monkeypatch.setattr(params, "get_param_cached", failing)
-    monkeypatch.setattr(log, "_param_failed_at", {})
-    assert log._get_param_cached("/rosout_disable_topics_generation", False) is False
-    assert log._get_param_cached("/rosout_disable_topics_generation", False) is False
+    monkeypatch.setattr(rosout_log, "_param_failed_at", {})
+    assert rosout_log._get_param_cached("/rosout_disable_topics_generation", False) is False
+    assert rosout_log._get_param_cached("/rosout_disable_topics_generation", False) is False
     assert calls == ["/rosout_disable_topics_generation"]
-    log._param_failed_at["/rosout_disable_topics_generation"] -= log._PARAM_RETRY + 1
-    log._get_param_cached("/rosout_disable_topics_generation", False)
+    rosout_log._param_failed_at["/rosout_disable_topics_generation"] -= rosout_log._PARAM_RETRY + 1
+    rosout_log._get_param_cached("/rosout_disable_topics_generation", False)
     assert len(calls) == 2

@@ -10,18 +10,13 @@ from minros import node
 from minros.client import topics
 
 
-class _FakeNode:
-    uri = "http://localhost:1234/"
-    name = "/fake"
-    master_uri = "http://localhost:11311/"
-
-    def tcpros_address(self):
-        return "localhost", 4321
-
-
 @pytest.fixture
-def api():
-    return node.SlaveApi(_FakeNode())
+def api(monkeypatch):
+    monkeypatch.delenv("ROS_MASTER_URI", raising=False)
+    fake = node.Node(argv=["fake", "__name:=fake"])  # never started: no sockets
+    fake.uri = "http://localhost:1234/"
+    fake.tcpros_address = lambda: ("localhost", 4321)
+    return node.SlaveApi(fake)
 
 
 def test_slave_api_arity_and_caller_id(api):
@@ -65,12 +60,12 @@ def test_counters_saturate_for_xmlrpc():
     assert node._xmlrpc_ints([1, [2 ** 40, True], "x"]) == [1, [2 ** 31 - 1, True], "x"]
 
 
-def test_pre_init_names_use_namespace_and_remaps(monkeypatch):
-    monkeypatch.setattr(node, "_argv_mappings", {"chatter": "/remapped", "__name": "x"})
-    assert node.resolve_name_without_node_name("chatter") == "/remapped"
-    assert node.resolve_name_without_node_name("other") == "/other"
+def test_pre_init_names_use_namespace_and_remaps():
+    fresh = node.Node(argv=["prog", "chatter:=/remapped", "__name:=x"])
+    assert fresh.resolve_name_without_node_name("chatter") == "/remapped"
+    assert fresh.resolve_name_without_node_name("other") == "/other"
     with pytest.raises(ValueError, match="~name topics cannot be created before init_node"):
-        node.resolve_name_without_node_name("~private")
+        fresh.resolve_name_without_node_name("~private")
 
 
 def test_serialize_frame_small_and_large():

@@ -13,7 +13,7 @@ import pytest
 
 from minros.client import services
 from minros.exceptions import TransportTerminated
-from minros.wire import tcpros
+from minros.wire import sockets, tcpros
 
 
 def drain(sock: socket.socket, size: int, out: bytearray, pause_every: int = 0, pause: float = 0.0) -> None:
@@ -93,7 +93,7 @@ def test_send_all_delivers_everything_in_order_to_a_slow_reader():
 
 
 def test_send_all_handles_more_buffers_than_one_sendmsg_takes():
-    parts = [bytes([i % 256]) * 5000 for i in range(3 * services._MAX_IOV + 7)]
+    parts = [bytes([i % 256]) * 5000 for i in range(3 * sockets._MAX_IOV + 7)]
     assert send_and_collect(parts) == b"".join(parts)
 
 

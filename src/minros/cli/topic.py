@@ -136,10 +136,10 @@ def wait_topic_type(master: Master, topic: str) -> Tuple[str, str, str]:
 
 
 def _init_node(disable_rosout: bool = False) -> None:
-    from minros import node
+    from minros.client.init import init_node
 
-    node.init_node(NAME, argv=[sys.argv[0]] + [a for a in sys.argv[1:] if ":=" in a],
-                   anonymous=True, disable_rosout=disable_rosout)
+    init_node(NAME, argv=[sys.argv[0]] + [a for a in sys.argv[1:] if ":=" in a],
+              anonymous=True, disable_rosout=disable_rosout)
 
 
 def _spin_until(done: Callable[[], bool], step: float = 0.1) -> None:

@@ -7,8 +7,8 @@ logger:
 * the console handler (installed on import, so logging before ``init_node`` prints too) writes
   one line per record in the ``ROSCONSOLE_FORMAT`` (default ``[${severity}] [${time}]:
   ${message}``); DEBUG and INFO go to stdout, WARN and worse to stderr;
-* the /rosout handler (installed by ``init_node`` unless ``disable_rosout``) publishes a
-  ``rosgraph_msgs/Log`` per record.
+* the /rosout handler (:mod:`minros.client.rosout_log`, installed by ``init_node`` unless
+  ``disable_rosout``) publishes a ``rosgraph_msgs/Log`` per record.
 
 The console line itself is built by the pure function :func:`format_console_line`.
 """
@@ -25,6 +25,8 @@ import threading
 import time
 from typing import Any, Dict, Tuple
 
+from minros import node
+from minros.client import rostime
 from minros.rosenv import ros_log_dir
 
 __all__ = [
@@ -115,20 +117,9 @@ def format_console_line(fmt: str, *, severity: str, message: str, wall_time: flo
 
 def _ros_time_or_none() -> float | None:
     """The simulated time for the console's ``${time}``, or None on wall-clock time."""
-    from minros.client import rostime
-
     if rostime.is_wallclock() or not rostime.is_rostime_initialized():
         return None
     return rostime.get_time()
-
-
-def _caller_id() -> str:
-    try:
-        from minros import node
-
-        return node.get_caller_id()
-    except (ImportError, AttributeError):
-        return "/unnamed"
 
 
 class ConsoleHandler(logging.Handler):
@@ -155,7 +146,7 @@ class ConsoleHandler(logging.Handler):
                 message=self._plain.format(record),
                 wall_time=time.time(),
                 ros_time=_ros_time_or_none(),
-                node=_caller_id(),
+                node=node.get_caller_id(),
                 logger=record.name,
                 file=record.pathname,
                 line=record.lineno,
@@ -188,111 +179,7 @@ _install_console_handler()
 logging.getLogger("rospy").addHandler(logging.NullHandler())
 
 
-# --------------------------------------------------------------------------- /rosout
-
-class _RosoutState:
-    def __init__(self) -> None:
-        self.publisher = None
-        self.handler: RosoutHandler | None = None
-        self.services: list = []
-        self.local = threading.local()  # guards against logging from inside publish()
-
-
-_rosout = _RosoutState()
-
-
-def _node_topics() -> list:
-    """Names of the topics this node publishes or subscribes (the Log message's ``topics``)."""
-    try:
-        from minros import node
-
-        getter = getattr(node, "get_topics", None)
-        if getter is not None:
-            return sorted(getter())
-        # the node's registries: resolved topic name -> publication/subscription
-        topics = set(getattr(node, "_publications", {})) | set(getattr(node, "_subscriptions", {}))
-        return sorted(topics)
-    except ImportError:
-        return []
-
-
-class RosoutHandler(logging.Handler):
-    """Publishes every record as a rosgraph_msgs/Log on /rosout."""
-
-    def emit(self, record: logging.LogRecord) -> None:
-        publisher = _rosout.publisher
-        if publisher is None or getattr(_rosout.local, "busy", False):
-            return
-        _rosout.local.busy = True
-        try:
-            from minros.client import rostime
-            from rosgraph_msgs.msg import Log
-
-            try:
-                disable_topics = _get_param_cached("/rosout_disable_topics_generation", False)
-            except Exception:
-                disable_topics = False
-            log = Log(
-                level=LOGGING_TO_ROS.get(record.levelno, INFO),
-                name=_caller_id(),
-                msg=str(self.format(record)),
-                file=record.filename,
-                function=getattr(record, "ros_function", record.funcName),
-                line=record.lineno,
-                topics=[] if disable_topics else _node_topics(),
-            )
-            try:
-                log.header.stamp = rostime.get_rostime()
-            except Exception:  # time not initialised yet: stamp with the wall clock
-                log.header.stamp = rostime._wall_now()
-            publisher.publish(log)
-        except Exception:
-            # never let a broken /rosout break the caller; say so on the internal logger
-            logging.getLogger("rospy.rosout").debug("unable to report to /rosout", exc_info=True)
-        finally:
-            _rosout.local.busy = False
-
-
-#: after a failed parameter lookup, /rosout records use the default for this many seconds
-#: (a master that hangs must not stall every log call for an XML-RPC timeout)
-_PARAM_RETRY = 10.0
-_param_failed_at: Dict[str, float] = {}
-
-
-def _get_param_cached(key: str, default: Any) -> Any:
-    from minros.client import params
-
-    failed = _param_failed_at.get(key)
-    if failed is not None and time.monotonic() - failed < _PARAM_RETRY:
-        return default
-    try:
-        return params.get_param_cached(key, default)
-    except Exception:
-        _param_failed_at[key] = time.monotonic()
-        return default
-
-
-def _get_loggers(_request):
-    from roscpp.msg import Logger
-    from roscpp.srv import GetLoggersResponse
-
-    response = GetLoggersResponse()
-    for name in list(logging.Logger.manager.loggerDict.keys()):
-        level = logging.getLogger(name).getEffectiveLevel()
-        response.loggers.append(Logger(name, _LOGGING_TO_NAME.get(level, "debug")))
-    return response
-
-
-def _set_logger_level(request):
-    from roscpp.srv import SetLoggerLevelResponse
-
-    level = request.level.upper()
-    if level in _NAME_TO_LOGGING:
-        logging.getLogger(request.logger).setLevel(_NAME_TO_LOGGING[level])
-    else:
-        logging.getLogger("rospy").error(f"Bad logging level: {level}")
-    return SetLoggerLevelResponse()
-
+# --------------------------------------------------------------------------- the node's log file
 
 #: rospy's log file line format (python_logging.conf's defaultFormatter)
 FILE_FORMAT = "[%(name)s][%(levelname)s] %(asctime)s: %(message)s"
@@ -316,15 +203,9 @@ def node_log_filename(caller_id: str, mappings: Dict[str, str] | None = None,
     return os.path.join(log_dir, name + ".log")
 
 
-def _start_file_logging(caller_id: str) -> None:
+def start_file_logging(caller_id: str) -> None:
     """rospy's logging config: every logger at INFO and above also goes to the node's file."""
-    try:
-        from minros import node
-
-        mappings = node.get_mappings()
-    except (ImportError, AttributeError):
-        mappings = {}
-    filename = node_log_filename(caller_id, mappings)
+    filename = node_log_filename(caller_id, node.get_mappings())
     root = logging.getLogger()
     if any(getattr(h, "_minros_node_log", False) for h in root.handlers):
         return
@@ -343,39 +224,6 @@ def _start_file_logging(caller_id: str) -> None:
         root.setLevel(logging.INFO)
 
 
-def _start_node_logging(caller_id: str, log_level: int | None, disable_rosout: bool) -> None:
-    """Called by ``init_node``: level filter, log file, /rosout publisher, logger services."""
-    logger = _install_console_handler()
-    _start_file_logging(caller_id)
-    if log_level is not None:
-        logger.setLevel(ROS_TO_LOGGING.get(log_level, logging.INFO))
-    if not disable_rosout and _rosout.publisher is None:
-        from minros.client.topics import Publisher
-        from rosgraph_msgs.msg import Log
-
-        _rosout.publisher = Publisher("/rosout", Log, latch=True, queue_size=100)
-        _rosout.handler = RosoutHandler()
-        logger.addHandler(_rosout.handler)
-    if not _rosout.services:
-        from minros.client.services import Service
-        from roscpp.srv import GetLoggers, SetLoggerLevel
-
-        _rosout.services = [
-            Service("~get_loggers", GetLoggers, _get_loggers),
-            Service("~set_logger_level", SetLoggerLevel, _set_logger_level),
-        ]
-
-
-def _stop_node_logging() -> None:
-    """Undo ``_start_node_logging`` (node shutdown)."""
-    logger = logging.getLogger(ROSOUT_LOGGER)
-    if _rosout.handler is not None:
-        logger.removeHandler(_rosout.handler)
-        _rosout.handler = None
-    _rosout.publisher = None
-    _rosout.services = []
-
-
 # --------------------------------------------------------------------------- log functions
 
 _Key = Tuple[str, int, int]
@@ -387,8 +235,6 @@ def _frame_key(frame) -> _Key:
 
 
 def _now_for_throttle() -> float:
-    from minros.client import rostime
-
     if rostime.is_rostime_initialized():
         return rostime.get_time()
     return time.time()  # before init_node: wall clock rather than an error

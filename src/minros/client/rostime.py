@@ -83,7 +83,6 @@ class _Clock:
         self.initialized = False
         #: None = wall clock; otherwise the last simulated time received on /clock.
         self.sim_time: Time | None = None
-        self.clock_sub = None
 
     def notify(self) -> None:
         with self.cond:
@@ -147,7 +146,8 @@ def get_time() -> float:
     return get_rostime().to_sec()
 
 
-def _on_clock(msg) -> None:
+def on_clock(msg) -> None:
+    """A ``rosgraph_msgs/Clock`` from /clock (``init_node`` subscribes it on simulated time)."""
     _set_rostime(msg.clock)
 
 
@@ -155,28 +155,13 @@ def _on_node_shutdown(*_args) -> None:
     _clock.notify()
 
 
-def _start_node_time(use_sim_time: bool) -> None:
-    """Called by ``init_node``: start the node clock, following /clock if ``use_sim_time``."""
+def start_node_time(use_sim_time: bool) -> None:
+    """Called by ``init_node``: start the node clock, at 0 on simulated time until the first
+    /clock message arrives (as rospy does)."""
     node.add_shutdown_hook(_on_node_shutdown)
-    if use_sim_time and _clock.clock_sub is None:
-        from minros.client.topics import Subscriber
-        from rosgraph_msgs.msg import Clock
-
-        # rospy starts a simulated clock at 0 until the first /clock message arrives
+    if use_sim_time:
         _set_rostime(Time(0, 0))
-        _clock.clock_sub = Subscriber("/clock", Clock, _on_clock, queue_size=1)
     _clock.initialized = True
-
-
-def _stop_node_time() -> None:
-    """Undo ``_start_node_time`` (node shutdown in tests that init several nodes)."""
-    sub, _clock.clock_sub = _clock.clock_sub, None
-    if sub is not None:
-        try:
-            sub.unregister()
-        except Exception:  # the node is going away anyway
-            pass
-    _switch_to_wallclock()
 
 
 # rospy.rostime's internal names, which some tests and tools call directly

@@ -21,7 +21,6 @@ this module only moves their bytes through sockets.
 
 from __future__ import annotations
 
-import collections
 import logging
 import socket
 import sys
@@ -33,6 +32,7 @@ import xmlrpc.client
 from typing import Any, Callable, Dict, Tuple
 
 from minros import names, node
+from minros.client.log import logerr, loginfo, logwarn, logwarn_throttle
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -41,7 +41,8 @@ from minros.exceptions import (
     TransportInitError,
     TransportTerminated,
 )
-from minros.wire import tcpros
+from minros.wire import sockets, tcpros
+from minros.wire.rosapi import ROSRPC
 
 # the node context (answers before init_node too)
 _caller_id = node.get_caller_id
@@ -58,7 +59,6 @@ __all__ = [
     "wait_for_service",
 ]
 
-ROSRPC = "rosrpc://"
 DEFAULT_BUFF_SIZE = 65536
 #: how often wait_for_service retries (rospy's interval)
 WAIT_FOR_SERVICE_INTERVAL = 0.3
@@ -72,14 +72,11 @@ _POLL = 1.0
 #: puts on synchronous publishing). rospy's sendall waits forever; as long as the peer keeps
 #: taking bytes, however slowly, a send goes on.
 SEND_STALL_TIMEOUT = 60.0
-#: buffers handed to one sendmsg call (Linux takes up to IOV_MAX = 1024)
-_MAX_IOV = 512
 #: frames up to this size are joined into one bytes object (one send call); larger ones keep
 #: their big pieces and go out as scatter-gather, never copied into one buffer
 _JOIN_LIMIT = 65536
 #: serialized pieces smaller than this are joined with their neighbours (fewer buffers)
 _SMALL_PART = 4096
-_HAS_SENDMSG = hasattr(socket.socket, "sendmsg")
 #: the ok byte that starts a successful service response
 _OK = b"\x01"
 
@@ -104,88 +101,12 @@ def parse_rosrpc_uri(uri: str) -> Tuple[str, int]:
     return host, port
 
 
-# --------------------------------------------------------------------------- socket helpers
+# --------------------------------------------------------------------------- sending
 
 def _send_all(sock: socket.socket, data: Any) -> None:
-    """Send ``data`` (bytes, or a list of buffers sent in order) completely.
-
-    The socket's timeout (``_POLL`` on an exchange) only paces the waiting, so that node
-    shutdown is noticed: ``sendall`` would apply it to the whole transfer and fail a big
-    message to a slow reader. The send goes on while the peer takes bytes and raises
-    TransportTerminated when the node shuts down, the peer is gone, or the peer took nothing
-    for SEND_STALL_TIMEOUT seconds.
-    """
-    if not isinstance(data, list):
-        data = [data]
-    parts = [memoryview(part) for part in data if len(part)]  # an empty one would never go
-    first = 0  # parts[first:] are unsent; parts[first] may have been sliced
-    deadline = time.monotonic() + SEND_STALL_TIMEOUT
-    while first < len(parts):
-        if _is_shutdown():
-            raise TransportTerminated("node shutdown")
-        try:
-            if _HAS_SENDMSG and first + 1 < len(parts):
-                sent = sock.sendmsg(parts[first:first + _MAX_IOV])
-            else:
-                sent = sock.send(parts[first])
-        except socket.timeout:  # not writable for _POLL seconds
-            if time.monotonic() >= deadline:
-                raise TransportTerminated(f"peer took no data for {SEND_STALL_TIMEOUT:g} s") from None
-            continue
-        except OSError as exc:
-            raise TransportTerminated(f"unable to send data: {exc}") from None
-        if sent:
-            deadline = time.monotonic() + SEND_STALL_TIMEOUT
-        while sent:
-            size = parts[first].nbytes
-            if sent < size:
-                parts[first] = parts[first][sent:]
-                break
-            sent -= size
-            first += 1
-
-
-class _FrameSource:
-    """Frames from one socket, one at a time (FrameReader may parse several per recv)."""
-
-    def __init__(self, sock: socket.socket, reader: tcpros.FrameReader) -> None:
-        self.sock = sock
-        self.reader = reader
-        self.pending: collections.deque = collections.deque()
-
-    def next(self) -> Any:
-        """The next frame; None if the peer closed cleanly between frames."""
-        reader = self.reader
-        while not self.pending:
-            target = reader.recv_buffer()
-            while True:
-                try:
-                    n = self.sock.recv_into(target)
-                    break
-                except socket.timeout:
-                    if _is_shutdown():
-                        raise TransportTerminated("node shutdown") from None
-                except OSError as exc:
-                    raise TransportTerminated(f"unable to receive data from sender: {exc}") from None
-            # release the view now: the reader grows a big frame's buffer in the next
-            # recv_buffer(), which a live export of it would make fail (BufferError)
-            del target
-            if not n:
-                reader.eof()  # FrameError (a TransportException) when cut mid-frame
-                return None
-            reader.received(n)
-            self.pending.extend(reader.frames())
-        return self.pending.popleft()
-
-
-def _close(sock: socket.socket | None) -> None:
-    if sock is None:
-        return
-    try:
-        sock.shutdown(socket.SHUT_RDWR)
-    except OSError:
-        pass
-    sock.close()
+    """Send ``data`` completely; give up at node shutdown or on a peer stalled for
+    SEND_STALL_TIMEOUT seconds (TransportTerminated)."""
+    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=_is_shutdown)
 
 
 # --------------------------------------------------------------------------- server
@@ -213,8 +134,6 @@ def _convert_return_to_response(response: Any, response_class: type) -> Any:
 
 
 def _default_error_handler(exc: BaseException, exc_type, exc_value, tb) -> None:
-    from minros.client.log import logerr
-
     logerr(f"Error processing request: {exc}\n{traceback.format_exception(exc_type, exc_value, tb)}")
 
 
@@ -287,7 +206,7 @@ class Service:
         except TransportException as exc:
             _logger.debug("service [%s]: connection ended: %s", self.resolved_name, exc)
         finally:
-            _close(sock)
+            sockets.close(sock)
 
     def _serve(self, sock: socket.socket, header: Dict[str, str]) -> None:
         sock.settimeout(_POLL)  # every wait, sending or receiving, wakes up to check for shutdown
@@ -296,29 +215,24 @@ class Service:
             error = f"[{_caller_id()}] is not a provider of  [{self.resolved_name}]"
         if error is not None:
             _send_all(sock, tcpros.encode_error_header(error))
-            from minros.client.log import logwarn
-
             logwarn(f"Could not process inbound connection: {error}{header}")
             return
         _send_all(sock, tcpros.encode_header(self._header_fields()))
         if header.get("probe") == "1":  # wait_for_service checking we are alive
             return
         persistent = header.get("persistent", "").lower() in ("1", "true")
-        source = _FrameSource(sock, tcpros.FrameReader(buff_size=max(self.buff_size, 16)))
+        source = sockets.FrameSource(sock, tcpros.FrameReader(buff_size=max(self.buff_size, 16)),
+                                     stop=_is_shutdown)
         while not self.done:
             frame = source.next()
             if frame is None:
                 if not persistent:
-                    from minros.client.log import logerr
-
                     logerr(f"incoming connection failed: {_PEER_GONE}")
                 return
             request = self.request_class()
             try:
                 request.deserialize(frame)
             except Exception as exc:
-                from minros.client.log import logerr
-
                 logerr(f"[{self.resolved_name}] error deserializing incoming request: {exc}")
                 return
             request._connection_header = header
@@ -328,8 +242,6 @@ class Service:
                 if not _is_shutdown():
                     # the client left (or stalled) mid-response: one line, then the next one
                     # (rospy sends the error through the error handler and logs twice)
-                    from minros.client.log import logerr
-
                     logerr(f"incoming connection failed: [{self.resolved_name}] response to "
                            f"[{header.get('callerid', '')}] not delivered: {exc}")
                 return
@@ -479,7 +391,7 @@ class ServiceProxy:
         self.seq = 0
         self.buff_size = DEFAULT_BUFF_SIZE
         self._sock: socket.socket | None = None
-        self._source: _FrameSource | None = None
+        self._source: sockets.FrameSource | None = None
         self._server_header: Dict[str, str] = {}
         self._lock = threading.Lock()  # one call at a time on a persistent connection
 
@@ -506,24 +418,25 @@ class ServiceProxy:
             raise ServiceException(f"unable to connect to service: {exc}") from None
         try:
             _send_all(sock, tcpros.encode_header(self._header_fields()))
-            header = node.read_inbound_header(sock)
+            header = sockets.read_header(sock)
             if "error" in header:
                 raise TransportInitError("remote error reported: {}".format(header["error"]))
             for required in ("md5sum", "type"):
                 if required not in header:
                     raise TransportInitError(f"header missing required field [{required}]")
         except (TransportException, OSError) as exc:
-            _close(sock)
+            sockets.close(sock)
             raise ServiceException(f"unable to connect to service: {exc}") from None
         sock.settimeout(_POLL)
         self._sock = sock
         self._server_header = header
-        self._source = _FrameSource(sock, tcpros.FrameReader(buff_size=self.buff_size, ok_byte=True))
+        self._source = sockets.FrameSource(sock, tcpros.FrameReader(buff_size=self.buff_size, ok_byte=True),
+                                           stop=_is_shutdown)
 
     def _drop(self) -> None:
         sock, self._sock = self._sock, None
         self._source = None
-        _close(sock)
+        sockets.close(sock)
 
     def call(self, *args: Any, **kwds: Any) -> Any:
         """Call the service; returns the response message.
@@ -599,7 +512,7 @@ def _probe_service(resolved_name: str, timeout: float) -> str | None:
         _send_all(sock, tcpros.encode_header({"probe": "1", "md5sum": "*", "callerid": _caller_id(),
                                               "service": resolved_name}))
     finally:
-        _close(sock)
+        sockets.close(sock)
     return uri
 
 
@@ -610,8 +523,6 @@ def wait_for_service(service: str, timeout: float | None = None) -> None:
     ROSException("timeout exceeded while waiting for service ...") on timeout and
     ROSInterruptException when the node shuts down meanwhile.
     """
-    from minros.client.log import loginfo, logwarn_throttle
-
     if timeout is not None and hasattr(timeout, "to_sec"):
         timeout = timeout.to_sec()
     if timeout == 0.0:

@@ -25,13 +25,14 @@ import warnings
 from typing import Any, Callable, Dict, List, Tuple
 
 from minros import node as _node_mod
+from minros.client import log
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
     ROSSerializationException,
     SerializationError,
 )
-from minros.wire import tcpros
+from minros.wire import sockets, tcpros
 from minros.wire.xmlrpc import ServerProxy
 
 __all__ = [
@@ -65,20 +66,6 @@ def _yield_gil() -> None:
 def _next_conn_id() -> int:
     with _conn_id_lock:
         return next(_conn_ids)
-
-
-def _log_error(text: str) -> None:
-    """User-visible error line (rospy's logerr), falling back to the module logger."""
-    try:
-        from minros.client import log
-
-        log.logerr(text)
-    except Exception:
-        _logger.error(text)
-
-
-#: user-visible warning line (rospy's logwarn), the node runtime's
-_log_warn = _node_mod._user_warn
 
 
 # ---------------------------------------------------------------------------------------------
@@ -448,7 +435,7 @@ class _PubConnection:
         if exc is not None and not isinstance(exc, (BrokenPipeError, ConnectionResetError)):
             _logger.info("publisher connection to [%s] on [%s] closed: %s",
                          self.callerid, self.impl.resolved_name, exc)
-        _close_socket(self.sock)
+        sockets.close(self.sock)
         threading.Thread(target=self.impl._remove_connection, args=(self,), daemon=True).start()
 
     def close(self) -> None:
@@ -466,7 +453,7 @@ class _PubConnection:
             self.done = True
             self.queue.clear()
             self.cond.notify_all()
-        _close_socket(self.sock)
+        sockets.close(self.sock)
 
 
 class _Partial:
@@ -493,7 +480,8 @@ def _advance(parts: list, sent: int) -> _Partial | None:
 class _PublisherImpl:
     """Shared state of all Publisher handles for one topic in this process."""
 
-    def __init__(self, name: str, resolved_name: str, data_class: Any) -> None:
+    def __init__(self, node: _node_mod.Node, name: str, resolved_name: str, data_class: Any) -> None:
+        self.node = node
         self.name = name
         self.resolved_name = resolved_name
         self.data_class = data_class
@@ -506,7 +494,6 @@ class _PublisherImpl:
         self.is_latch = False
         self.latch: Any = None
         self.queue_size: int | None = None
-        self.queue_size_set = False
         self.tcp_nodelay = False
         self.seq = 0
         self.message_data_sent = 0
@@ -518,7 +505,7 @@ class _PublisherImpl:
     def accept_subscriber(self, sock: socket.socket, addr, header: Dict[str, str]) -> str | None:
         """Inbound connection from a subscriber (called by the node's TCPROS server)."""
         error = tcpros.publisher_header_error(
-            header, _node_mod.get_caller_id(), {self.resolved_name: (self.type, self.md5sum)})
+            header, self.node.caller_id, {self.resolved_name: (self.type, self.md5sum)})
         if error is not None:
             return error
         if self.closed:
@@ -532,7 +519,7 @@ class _PublisherImpl:
             "latching": "1" if self.is_latch else "0",
             "message_definition": self.data_class._full_text,
             "md5sum": self.md5sum,
-            "callerid": _node_mod.get_caller_id(),
+            "callerid": self.node.caller_id,
         }
         fields.update(self.headers)
         sock.sendall(tcpros.encode_header(fields))
@@ -581,7 +568,7 @@ class _PublisherImpl:
     def publish(self, msg: Any) -> None:
         with self.lock:
             if self.closed:
-                if _node_mod.is_shutdown():
+                if self.node.is_shutdown():
                     return
                 raise ROSException("publish() to a closed topic")
             if self.is_latch:
@@ -652,14 +639,15 @@ class _SubConnection:
         self.done = True
         sock = self.sock
         if sock is not None:
-            _close_socket(sock)
+            sockets.close(sock)
 
     # -- connection life ---------------------------------------------------------------------
 
     def _run(self) -> None:
         interval = 0.5
+        node = self.impl.node
         try:
-            while not self.done and not _node_mod.is_shutdown():
+            while not self.done and not node.is_shutdown():
                 try:
                     address = self._request_topic()
                 except OSError as exc:
@@ -682,22 +670,22 @@ class _SubConnection:
                                             BrokenPipeError)):
                             # the publisher went away (killed): not worth a console line
                             _logger.debug("publisher %s went away: %s", self.pub_uri, text)
-                        elif (not self.done and not _node_mod.is_shutdown_requested()
+                        elif (not self.done and not node.is_shutdown_requested()
                                 and text not in self.reported):
                             # one line per distinct failure, not one per retry
                             self.reported.add(text)
-                            _log_warn(f"[{self.impl.resolved_name}] connection to publisher "
+                            log.logwarn(f"[{self.impl.resolved_name}] connection to publisher "
                                       f"[{self.pub_uri}] failed: {text}")
                     finally:
                         self.connected = False
                         if self.sock is not None:
-                            _close_socket(self.sock)
+                            sockets.close(self.sock)
                             self.sock = None
-                if self.done or _node_mod.is_shutdown_requested():
+                if self.done or node.is_shutdown_requested():
                     return
                 if self.pub_uri not in self.impl.publisher_uris:
                     return
-                if _node_mod.wait_for_shutdown(interval):
+                if node.wait_for_shutdown(interval):
                     return
                 interval = min(interval * 2, 8.0)
         finally:
@@ -706,7 +694,7 @@ class _SubConnection:
     def _request_topic(self) -> Tuple[str, int] | None:
         proxy = ServerProxy(self.pub_uri, timeout=5.0)
         try:
-            code, msg, params = proxy.requestTopic(_node_mod.get_caller_id(), self.impl.resolved_name,
+            code, msg, params = proxy.requestTopic(self.impl.node.caller_id, self.impl.resolved_name,
                                                    [[tcpros.TCPROS]])
         finally:
             proxy.close()
@@ -732,22 +720,9 @@ class _SubConnection:
             "tcp_nodelay": "1" if impl.tcp_nodelay else "0",
             "md5sum": data_class._md5sum,
             "type": data_class._type,
-            "callerid": _node_mod.get_caller_id(),
+            "callerid": impl.node.caller_id,
         }))
-        # one reader for the header and the messages behind it (they may share a segment)
-        reader = tcpros.FrameReader(buff_size=max(impl.buff_size, 4096),
-                                    reuse_big=not getattr(data_class, "_keeps_buffer", True))
-        frames: list = []
-        while not frames:
-            n = sock.recv_into(reader.recv_buffer())
-            if not n:
-                reader.eof()
-                raise tcpros.HeaderError("publisher closed the connection during the handshake")
-            frames = reader.received_frames(n)
-        if len(frames[0]) > tcpros.DEFAULT_MAX_HEADER:
-            raise tcpros.HeaderError(f"connection header of {len(frames[0])} bytes exceeds the "
-                                     f"limit of {tcpros.DEFAULT_MAX_HEADER}")
-        header = tcpros.decode_header(frames[0])
+        header = sockets.read_header(sock)  # exactly the header: the messages follow
         error = tcpros.subscriber_header_error(header, impl.resolved_name, data_class._md5sum,
                                                data_class._type)
         if error is not None:
@@ -757,8 +732,9 @@ class _SubConnection:
         self.local = sock.getsockname()
         self.remote = sock.getpeername()
         self.fileno = sock.fileno()
-        self.reader = reader
-        self.pending = frames[1:]
+        self.reader = tcpros.FrameReader(buff_size=max(impl.buff_size, 4096),
+                                         reuse_big=not getattr(data_class, "_keeps_buffer", True))
+        self.pending = []
         self.connected = True
         return True
 
@@ -784,7 +760,7 @@ class _SubConnection:
                         msg = data_class()
                         msg.deserialize(frame)
                     except Exception as exc:
-                        _log_error(f"[{impl.resolved_name}] error deserializing incoming message "
+                        log.logerr(f"[{impl.resolved_name}] error deserializing incoming message "
                                    f"from [{self.pub_uri}]: {exc}")
                         continue
                     try:
@@ -821,7 +797,8 @@ def _is_refused(exc: BaseException) -> bool:
 class _SubscriberImpl:
     """Shared state of all Subscriber handles for one topic: one connection per publisher."""
 
-    def __init__(self, name: str, resolved_name: str, data_class: Any) -> None:
+    def __init__(self, node: _node_mod.Node, name: str, resolved_name: str, data_class: Any) -> None:
+        self.node = node
         self.name = name
         self.resolved_name = resolved_name
         self.data_class = data_class
@@ -860,7 +837,7 @@ class _SubscriberImpl:
             if self.connections.get(conn.pub_uri) is conn:
                 del self.connections[conn.pub_uri]
             again = (not self.closed and not conn.done and conn.pub_uri in self.publisher_uris
-                     and self.update_gen != conn.gen and not _node_mod.is_shutdown_requested())
+                     and self.update_gen != conn.gen and not self.node.is_shutdown_requested())
         if again:  # the publisher was announced again while this connection was ending
             self.publisher_update(self.publisher_uris)
 
@@ -888,8 +865,8 @@ class _SubscriberImpl:
                 else:
                     cb(msg, cb_args)
             except Exception:
-                if not _node_mod.is_shutdown():
-                    _log_error(f"bad callback: {cb}\n{traceback.format_exc()}")
+                if not self.node.is_shutdown():
+                    log.logerr(f"bad callback: {cb}\n{traceback.format_exc()}")
 
     @staticmethod
     def _invoke(msg: Any, cb: Callable, cb_args: Any) -> None:
@@ -899,7 +876,7 @@ class _SubscriberImpl:
             else:
                 cb(msg)
         except Exception:
-            _log_error(f"bad callback: {cb}\n{traceback.format_exc()}")
+            log.logerr(f"bad callback: {cb}\n{traceback.format_exc()}")
 
     def get_stats(self) -> list:
         return [self.resolved_name,
@@ -926,7 +903,9 @@ class _SubscriberImpl:
 # ---------------------------------------------------------------------------------------------
 # process-wide topic bookkeeping
 
-_impl_lock = threading.RLock()
+#: guards the reference counts of the publication/subscription objects (a leaf: the master
+#: is called outside it, so a slow master does not block other threads' Publisher() calls)
+_impl_lock = threading.Lock()
 
 
 def _acquire(kind: str, name: str, data_class: Any) -> Any:
@@ -934,31 +913,28 @@ def _acquire(kind: str, name: str, data_class: Any) -> Any:
         raise ValueError("topic name must be a non-empty string")
     if data_class is None or not hasattr(data_class, "_md5sum"):
         raise ValueError(f"data_class [{data_class}] is not a message data class")
-    if _node_mod.get_node() is not None:  # init_node has named the node
-        resolved = _node_mod.resolve_name(name)
-    else:
-        resolved = _node_mod.resolve_name_without_node_name(name)
+    me = _node_mod.default_node()
+    resolved = me.resolve_topic_name(name)
+    registry = me.publications if kind == "pub" else me.subscriptions
     with _impl_lock:
-        if kind == "pub":
-            impl = _node_mod._get_publication(resolved)
-            if impl is None or impl.closed:
-                impl = _PublisherImpl(name, resolved, data_class)
-                impl.ref_count = 1
-                _node_mod._add_publication(impl)
-                return impl
-        else:
-            impl = _node_mod._get_subscription(resolved)
-            if impl is None or impl.closed:
-                impl = _SubscriberImpl(name, resolved, data_class)
-                impl.ref_count = 1
-                _node_mod._add_subscription(impl)
-                return impl
-        if impl.md5sum != data_class._md5sum and tcpros.ANYTYPE not in (impl.md5sum, data_class._md5sum):
+        impl = registry.get(resolved)
+        fresh = impl is None or impl.closed
+        if fresh:
+            cls = _PublisherImpl if kind == "pub" else _SubscriberImpl
+            impl = cls(me, name, resolved, data_class)
+        elif impl.md5sum != data_class._md5sum and tcpros.ANYTYPE not in (impl.md5sum, data_class._md5sum):
             raise ROSException(
                 f"{'publisher' if kind == 'pub' else 'subscriber'} for [{resolved}] already exists "
                 f"with a different type [{impl.type}]")
         impl.ref_count += 1
-        return impl
+        if fresh:  # in the registry at once, so that a second Publisher() finds this one
+            if kind == "pub":
+                me.add_publication(impl, announce=False)
+            else:
+                me.add_subscription(impl, announce=False)
+    if fresh:  # the master round trip happens outside the lock
+        me.announce(kind, impl)
+    return impl
 
 
 def _release(kind: str, impl: Any) -> None:
@@ -967,10 +943,10 @@ def _release(kind: str, impl: Any) -> None:
         if impl.ref_count > 0:
             return
         impl.close()
-        if kind == "pub":
-            _node_mod._remove_publication(impl)
-        else:
-            _node_mod._remove_subscription(impl)
+    if kind == "pub":
+        impl.node.remove_publication(impl)
+    else:
+        impl.node.remove_subscription(impl)
 
 
 class Topic:
@@ -1033,7 +1009,6 @@ class Publisher(Topic):
             if not isinstance(queue_size, int) or queue_size < 0:
                 raise ROSException("queue_size must be a non-negative integer or None")
             impl.queue_size = queue_size
-            impl.queue_size_set = True
         else:
             warnings.warn(
                 "The publisher should be created with an explicit keyword argument 'queue_size'. "
@@ -1045,7 +1020,7 @@ class Publisher(Topic):
         impl = self.impl
         if impl is None:
             raise ROSException("publish() to an unregistered() handle")
-        if not _node_mod._initialized:
+        if not impl.node.initialized:
             raise ROSException("ROS node has not been initialized yet. Please call init_node() first")
         if len(args) == 1 and not kwds and args[0].__class__ is self.data_class:
             impl.publish(args[0])  # the common case, without the argument juggling
@@ -1131,5 +1106,3 @@ def get_published_topics(namespace: str = "/") -> List[List[str]]:
         raise ROSException(f"unable to get published topics: {msg}")
     return value
 
-
-_close_socket = _node_mod._close
