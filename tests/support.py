@@ -20,6 +20,8 @@ from typing import Dict, List, Optional, Sequence
 import pytest
 
 REPO = Path(__file__).resolve().parent.parent
+#: the runnable scripts of examples/, which the example tests run as a user would
+EXAMPLES = REPO / "examples"
 #: The interpreter that runs minros (the venv's).
 PYTHON = sys.executable
 #: The system interpreter that sees Debian's ROS 1.

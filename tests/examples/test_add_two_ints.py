@@ -1,5 +1,5 @@
 """ROS tutorial "Writing a Simple Service and Client (Python)": rospy_tutorials' add_two_ints
-server and client, unmodified (tests/examples/scripts/), on minros's master."""
+server and client, unmodified (examples/add_two_ints/), on minros's master."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from support import PYTHON, REPO, Proc, ros_env
+from support import EXAMPLES, PYTHON, Proc, ros_env
 
-SCRIPTS = REPO / "tests" / "examples" / "scripts"
+SCRIPTS = EXAMPLES / "add_two_ints"
 SERVER = SCRIPTS / "add_two_ints_server.py"
 CLIENT = SCRIPTS / "add_two_ints_client.py"
 

@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import pytest
 
-from support import PYTHON, Proc, ros_env
+from support import EXAMPLES, PYTHON, Proc, ros_env
 
-SEED_DIR = Path(__file__).resolve().parent / "pubsub_seed"
+SEED_DIR = EXAMPLES / "pubsub"
 LOG_LINE = r"\[INFO\] \[\d+\.\d+\]: "
 
 

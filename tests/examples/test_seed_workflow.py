@@ -7,7 +7,7 @@ their order, with the scanning damage read past (``catkin create pkg my package`
 ("Navigate to the src directory" is ``cd ~/catkin_ws/src``). Two deliberate substitutions keep
 the test hermetic: the master runs on a free port (``roscore -p PORT`` and ROS_MASTER_URI set as
 a user with another port would), and seed 002's ``/any_name_ws`` lives in a temporary folder.
-The seed publisher/subscriber scripts are the repaired copies in ``pubsub_seed/``.
+The seed publisher/subscriber scripts are the repaired copies in ``examples/pubsub/``.
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ from pathlib import Path
 
 import pytest
 
-from support import Proc, free_port, wait_for_master
+from support import EXAMPLES, Proc, free_port, wait_for_master
 
-SEED_SCRIPTS = Path(__file__).resolve().parent / "pubsub_seed"
+SEED_SCRIPTS = EXAMPLES / "pubsub"
 VENV_BIN = str(Path(sys.executable).parent)
 
 

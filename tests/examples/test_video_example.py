@@ -14,10 +14,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from support import PYTHON, Proc, ros_env, wait_until
+from support import EXAMPLES, PYTHON, Proc, ros_env, wait_until
 
-VIDEO = Path(__file__).resolve().parent / "video"
-FAKECAM = VIDEO / "fakecam"
+VIDEO = EXAMPLES / "video"
+#: a test-only shim: a synthetic webcam and an imshow that writes PNGs
+FAKECAM = Path(__file__).resolve().parent / "fakecam"
 sys.path.insert(0, str(FAKECAM))
 from fakecam_synthetic import HEIGHT, WIDTH, frame_index, synthetic_frame  # noqa: E402
 

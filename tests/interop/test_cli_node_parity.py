@@ -4,7 +4,7 @@ unregistering.
 
 Both tools run with the same arguments on the same master (Debian's rosmaster and minros's, one
 module run each); stdout, stderr and the exit status must agree once ports, pids and times are
-masked (minros.tools.compare), as in test_cli_oracle.
+masked (tests/compare.py), as in test_cli_oracle.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from minros.tools.compare import Outcome, assert_same, normalize
+from compare import Outcome, assert_same, normalize
 from support import (
     PYTHON,
     REFERENCE_PYTHON,

@@ -3,7 +3,7 @@
 One Debian rosmaster, one rospy demo node (Debian's rospy) and one minros demo node are
 shared by the module; every case runs the minros tool and the Debian tool with the same
 arguments and requires the same exit status and the same stdout, masking only ports, pids,
-anonymous-name suffixes, times and sequence numbers (minros.tools.compare).
+anonymous-name suffixes, times and sequence numbers (tests/compare.py).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from minros.tools.compare import Outcome, assert_same  # noqa: E402
+from compare import Outcome, assert_same  # noqa: E402
 from support import (  # noqa: E402
     PYTHON,
     REFERENCE_PYTHON,

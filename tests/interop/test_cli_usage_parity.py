@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from minros.tools.compare import Outcome, assert_same
+from compare import Outcome, assert_same
 from support import (
     PYTHON,
     Proc,

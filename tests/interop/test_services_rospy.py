@@ -12,11 +12,19 @@ from pathlib import Path
 import pytest
 
 from services_support import CLIENT, SERVER, make_reference_modules
-from support import PYTHON, REFERENCE_PYTHON, REPO, Proc, reference_env, require_reference, ros_env
+from support import (
+    EXAMPLES,
+    PYTHON,
+    REFERENCE_PYTHON,
+    Proc,
+    reference_env,
+    require_reference,
+    ros_env,
+)
 
 pytestmark = pytest.mark.interop
 
-SCRIPTS = REPO / "tests" / "examples" / "scripts"
+SCRIPTS = EXAMPLES / "add_two_ints"
 
 
 @pytest.fixture

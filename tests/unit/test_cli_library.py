@@ -8,10 +8,10 @@ import xmlrpc.client
 
 import pytest
 
+from compare import Outcome, differences, normalize
 from minros.exceptions import MessageException
 from minros.msgs import Duration, Time, get_message_class
 from minros.tools import echo, fill
-from minros.tools.compare import Outcome, differences, normalize
 from minros.tools.decode import DecodeError, load_class
 
 PoseStamped = get_message_class("geometry_msgs/PoseStamped")

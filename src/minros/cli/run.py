@@ -35,7 +35,7 @@ def _pick(candidates: List[Path]) -> Path | None:
 
 
 def main(argv: List[str], prog: str | None = None) -> int:
-    from minros.workspace.nodes import (
+    from minros.workspace.executables import (
         ExecutableError,
         child_environment,
         command_for,

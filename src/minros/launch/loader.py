@@ -231,7 +231,7 @@ def _float_attr(value: str | None, default: float, label: str) -> float:
 
 def _run_command(command: str, name: str, env: Mapping[str, str]) -> str:
     """Output of ``<param command=...>``; Python scripts run under minros's interpreter."""
-    from minros.workspace.nodes import child_environment, command_for
+    from minros.workspace.executables import child_environment, command_for
 
     try:
         argv = shlex.split(command)

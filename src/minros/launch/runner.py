@@ -338,7 +338,7 @@ class LaunchRunner:
 
     def node_command(self, spec: NodeSpec, proc_name: str) -> Tuple[List[str], str]:
         """argv and working directory of a node, as roslaunch builds them."""
-        from minros.workspace.nodes import ExecutableError, resolve_executable
+        from minros.workspace.executables import ExecutableError, resolve_executable
 
         try:
             command = resolve_executable(spec.package, spec.type)
@@ -368,7 +368,7 @@ class LaunchRunner:
         return argv, cwd
 
     def node_env(self, spec: NodeSpec) -> Dict[str, str]:
-        from minros.workspace.nodes import child_environment
+        from minros.workspace.executables import child_environment
 
         env = child_environment(self.env)
         env["ROS_MASTER_URI"] = self.master_uri
