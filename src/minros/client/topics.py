@@ -436,7 +436,8 @@ class _PubConnection:
             _logger.info("publisher connection to [%s] on [%s] closed: %s",
                          self.callerid, self.impl.resolved_name, exc)
         sockets.close(self.sock)
-        threading.Thread(target=self.impl._remove_connection, args=(self,), daemon=True).start()
+        threading.Thread(target=self.impl._remove_connection, args=(self,), daemon=True,
+                         name=f"minros-pub-close:{self.impl.resolved_name}").start()
 
     def close(self) -> None:
         if self.done:
