@@ -226,9 +226,10 @@ class WebServer:
         from websockets.http11 import Response
 
         all_headers = Headers()
-        for key, value in (headers or [("Server", "minros web")]):
+        for key, value in headers or []:
             all_headers[key] = value
-        all_headers["Content-Type"] = content_type
+        if "Content-Type" not in all_headers:
+            all_headers["Content-Type"] = content_type
         all_headers["Content-Length"] = str(len(body))
         all_headers["Connection"] = "close"
         return Response(status, HTTPStatus(status).phrase, all_headers, body)

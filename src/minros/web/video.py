@@ -254,9 +254,9 @@ def stream_part(jpeg: bytes, stamp: float) -> List[bytes]:
 
 
 def snapshot_headers(stamp: float) -> List[Tuple[str, str]]:
-    return [("Server", "minros web"), ("Cache-Control", "no-cache, no-store, must-revalidate, "
+    return [("Cache-Control", "no-cache, no-store, must-revalidate, "
             "pre-check=0, post-check=0, max-age=0"), ("X-Timestamp", f"{stamp:.6f}"),
-            ("Pragma", "no-cache"), ("Content-type", "image/jpeg"),
+            ("Pragma", "no-cache"), ("Content-Type", "image/jpeg"),
             ("Access-Control-Allow-Origin", "*")]
 
 
