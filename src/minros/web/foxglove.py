@@ -318,7 +318,8 @@ class FoxgloveSession:
         topic, cls = entry
         payload = bytes(frame.payload)
         try:  # a malformed payload stops here instead of breaking every subscriber
-            cls().deserialize(payload)
+            msg = cls()
+            msg.deserialize(payload)
         except Exception as exc:
             self.error(f"Dropping a message on {topic}: the payload is not a valid "
                        f"{cls._type}: {exc}")
@@ -327,7 +328,8 @@ class FoxgloveSession:
         if pub is None:
             self.error(f"Dropping client message: {topic} is no longer advertised")
             return
-        pub.publish(pub.data_class(payload))
+        # bytes as they came, unless a rosbridge client set the publisher up with the real class
+        pub.publish(pub.data_class(payload) if issubclass(pub.data_class, minros.AnyMsg) else msg)
 
     # -- services --------------------------------------------------------------------------
 

@@ -56,6 +56,7 @@ class _Subscription:
 
     def __init__(self) -> None:
         self.ids: Dict[Any, Dict[str, Any]] = {}
+        self.name = ""  # the topic as the client named it (rosbridge echoes that name)
 
     def params(self) -> Dict[str, Any]:
         values = list(self.ids.values())
@@ -193,7 +194,7 @@ class RosbridgeSession:
 
     def advertise(self, msg: Dict[str, Any]) -> None:
         _check(msg, [(True, "topic", (str,)), (True, "type", (str,))])
-        topic = msg["topic"]
+        topic = minros.resolve_name(msg["topic"])
         self._allowed(topic)
         cls = self._established_class(topic, msg["type"])
         self.state.acquire_publisher(self, topic, cls, latch=bool(msg.get("latch", False)),
@@ -202,7 +203,7 @@ class RosbridgeSession:
 
     def unadvertise(self, msg: Dict[str, Any]) -> None:
         _check(msg, [(True, "topic", (str,))])
-        topic = msg["topic"]
+        topic = minros.resolve_name(msg["topic"])
         ids = self.advertised.get(topic)
         if ids is None:
             return
@@ -217,7 +218,7 @@ class RosbridgeSession:
 
     def publish(self, msg: Dict[str, Any]) -> None:
         _check(msg, [(True, "topic", (str,))])
-        topic = msg["topic"]
+        topic = minros.resolve_name(msg["topic"])
         self._allowed(topic)
         pub = self.state.publishers.get(topic)
         if pub is None or self not in pub.clients:
@@ -225,7 +226,10 @@ class RosbridgeSession:
             pub = self.state.acquire_publisher(self, topic, cls, latch=bool(msg.get("latch", False)),
                                                queue_size=int(msg.get("queue_size", 100)))
             self.published.add(topic)
-        instance = pub.data_class()
+        cls = pub.data_class
+        if issubclass(cls, minros.AnyMsg):  # set up by a Foxglove client: bytes publisher
+            cls = self._class(cls._type)
+        instance = cls()
         populate_message(msg.get("msg", {}), instance, self.state.now)
         pub.publish(instance)
 
@@ -233,7 +237,7 @@ class RosbridgeSession:
         _check(msg, [(True, "topic", (str,)), (False, "type", (str,)),
                      (False, "throttle_rate", (int,)), (False, "fragment_size", (int,)),
                      (False, "queue_length", (int,)), (False, "compression", (str,))])
-        topic = msg["topic"]
+        topic = minros.resolve_name(msg["topic"])
         self._allowed(topic)
         compression = msg.get("compression", "none")
         if compression not in ("none", "png", "cbor", "cbor-raw"):
@@ -252,6 +256,7 @@ class RosbridgeSession:
             "throttle_rate": max(0, msg.get("throttle_rate", 0)),
             "queue_length": max(0, msg.get("queue_length", 0)),
             "fragment_size": msg.get("fragment_size"), "compression": compression}
+        sub.name = msg["topic"]
         self._configure(topic, sub)
         if first:
             self.state.tap(topic, type_name, self, self._listener(topic))
@@ -260,7 +265,7 @@ class RosbridgeSession:
     def _configure(self, topic: str, sub: _Subscription) -> None:
         params = sub.params()
         queue = params["queue_length"] or DEFAULT_QUEUE_LENGTH
-        self.outbox.open_slot(("sub", topic), self._renderer(topic, params), maxlen=queue,
+        self.outbox.open_slot(("sub", topic), self._renderer(sub.name, params), maxlen=queue,
                               max_bytes=MAX_QUEUE_BYTES,
                               min_interval=params["throttle_rate"] / 1000.0)
 
@@ -299,7 +304,7 @@ class RosbridgeSession:
 
     def unsubscribe(self, msg: Dict[str, Any]) -> None:
         _check(msg, [(True, "topic", (str,))])
-        topic = msg["topic"]
+        topic = minros.resolve_name(msg["topic"])
         sub = self.subscriptions.get(topic)
         if sub is None:
             return
@@ -324,7 +329,7 @@ class RosbridgeSession:
         op_id = msg.get("id")
         if op_id is None and "#" in service:  # the deprecated "/name#id" form
             op_id = service[service.find("#") + 1:]
-        name = service.split("#", 1)[0]
+        name = minros.resolve_name(service.split("#", 1)[0])
         if not self.state.service_allowed(name):
             raise OpError(f"service {name} is not in the server's services_glob")
         args = msg.get("args", [])
