@@ -22,5 +22,9 @@ if [ ! -x .venv/bin/python ]; then
 fi
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e '.[test]'
+# Foxglove's and roslib's own client libraries for tests/integration/test_web.py
+if command -v npm >/dev/null; then
+  (cd tests/web/js && npm ci --no-audit --no-fund --loglevel=error)
+fi
 .venv/bin/ruff check src stubs tests benchmarks
 .venv/bin/python -m pytest "$@"
