@@ -9,7 +9,8 @@
 * ``time``/``duration`` are ``{"secs": s, "nsecs": n}``; a time may be given as ``"now"``;
 * float NaN and +-Inf become ``null`` (JSON has neither);
 * a ``Header`` is stamped with the current time before the client's fields are applied, so a
-  client may leave out the header or just its stamp;
+  client may leave out the header or just its stamp (the protocol's rule; rosbridge 0.11's
+  code stamps only a header the client sends, even ``{}``);
 * type checks: a JSON int fills any numeric field, a float only float fields, a bool only bool
   fields, a string only string fields; an unknown field is an error.
 
@@ -206,6 +207,9 @@ def _populate(values: Any, msg: Any, root: str, stack: List[str],
         msg.stamp.secs = stamp.secs
         msg.stamp.nsecs = stamp.nsecs
     slots = dict(zip(msg.__slots__, msg._slot_types))
+    for name, slot_type in slots.items():  # a header the client left out is stamped now
+        if slot_type in HEADER_TYPES and name not in values:
+            _populate({}, getattr(msg, name), root, stack + [name], now)
     for name, value in values.items():
         field_stack = stack + [name]
         slot_type = slots.get(name)
