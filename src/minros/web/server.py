@@ -172,7 +172,7 @@ class WebServer:
             select_subprotocol=self._select_subprotocol, server_header="minros web",
             compression="deflate" if self.compression else None,
             max_size=self.max_message_size, logger=_ws_logger(), ping_interval=20,
-            ping_timeout=None, open_timeout=10)
+            ping_timeout=None, open_timeout=10, close_timeout=2)
         self.port = self._server.socket.getsockname()[1]
         for target, name in ((self._server.serve_forever, "minros-web-server"),
                              (self._watchdog, "minros-web-watchdog")):
@@ -393,12 +393,13 @@ class WebServer:
                     client.session.receive(data)
                 except Exception:
                     minros.logerr(f"[web] client {client_id}: internal error\n{traceback.format_exc()}")
-        except ConnectionClosed as exc:
-            code = exc.rcvd.code if exc.rcvd is not None else (exc.sent.code if exc.sent else None)
-            if code == 1009 or (exc.sent is not None and exc.sent.code == 1009):
+        except ConnectionClosed:
+            pass
+        finally:
+            sent = getattr(connection.protocol, "close_sent", None)
+            if sent is not None and sent.code == 1009:  # websockets refused a frame over max_size
                 minros.logwarn(f"[web] closed client {client_id}: it sent a message larger than "
                                f"{self.max_message_size} bytes (raise --max-message-size)")
-        finally:
             with self._lock:
                 self.clients.pop(client_id, None)
             client.outbox.close()
