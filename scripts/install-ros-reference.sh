@@ -20,14 +20,18 @@ PKGS="ros-core python3-rosmaster python3-roslaunch rosout
 # devel/setup.zsh; python3-venv and python3-tk so that minros's own venv can be built on the
 # same interpreter as the reference (scripts/test.sh), turtlesim's Tk window included.
 TEST_TOOLS="xvfb zsh python3-venv python3-tk"
+# minros web's tests: Debian's Chromium for roslib in a real browser (Playwright drives it),
+# node and npm for Foxglove's and roslib's own client libraries (tests/web/js, npm ci).
+WEB_TEST_TOOLS="chromium nodejs npm"
 if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msgs.msg, tf2_msgs.msg' 2>/dev/null \
    && command -v rostopic >/dev/null && command -v catkin_create_pkg >/dev/null \
    && pkg-config --exists roscpp std_msgs && command -v Xvfb >/dev/null && command -v zsh >/dev/null \
-   && /usr/bin/python3 -c 'import ensurepip, tkinter' 2>/dev/null; then
+   && /usr/bin/python3 -c 'import ensurepip, tkinter' 2>/dev/null \
+   && [ -x /usr/bin/chromium ] && command -v node >/dev/null && command -v npm >/dev/null; then
   echo "ROS 1 reference already installed"
   exit 0
 fi
 $SUDO apt-get update -q
 # shellcheck disable=SC2086
-DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $PKGS $TEST_TOOLS
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $PKGS $TEST_TOOLS $WEB_TEST_TOOLS
 /usr/bin/python3 -c 'import rospy, rosmaster, genpy' && echo "ROS 1 reference installed"

@@ -22,6 +22,10 @@ if [ ! -x .venv/bin/python ]; then
 fi
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e '.[test]'
+# Foxglove's and roslib's own client libraries for tests/integration/test_web.py
+if command -v npm >/dev/null; then
+  (cd tests/web/js && npm ci --no-audit --no-fund --loglevel=error)
+fi
 .venv/bin/ruff check src stubs tests benchmarks examples
 .venv/bin/lint-imports  # the layers of docs/architecture.md (contracts in pyproject.toml)
 .venv/bin/python -m pytest "$@"

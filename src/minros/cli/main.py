@@ -25,6 +25,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "graph": ("minros.cli.graph", "draw the node/topic graph as DOT, SVG or PNG (rqt_graph)"),
     "pkg": ("minros.cli.pkg", "find and list packages (rospack)"),
     "ws": ("minros.cli.ws", "catkin workspaces: init, create_pkg, make"),
+    "web": ("minros.cli.web", "rosbridge, rosapi, Foxglove and video for browsers, on one port"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)

@@ -36,6 +36,13 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
         "mimic": "minros.nodes.turtlesim.mimic",
         "draw_square": "minros.nodes.turtlesim.draw_square",
     },
+    # `minros web` under the names of the servers it stands in for
+    "rosbridge_server": {
+        "rosbridge_websocket": "minros.web.rosbridge_websocket",
+        "rosbridge_websocket.py": "minros.web.rosbridge_websocket",
+    },
+    "foxglove_bridge": {"foxglove_bridge": "minros.web.foxglove_bridge"},
+    "rosapi": {"rosapi_node": "minros.web.rosapi_node"},
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...

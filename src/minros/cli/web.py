@@ -1,0 +1,65 @@
+"""``minros web``: rosbridge v2 with rosapi, Foxglove WebSocket and video endpoints on one port.
+
+``minros web [--port 9090] [--host 127.0.0.1] [--token TOKEN] ...`` runs until Ctrl-C as the
+node ``/minros_web`` (``__name:=`` renames it). roslaunch users start the same server with
+``roslaunch rosbridge_server rosbridge_websocket.launch`` or
+``roslaunch foxglove_bridge foxglove_bridge.launch``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import List
+
+
+def _parser(prog: str) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description="Serve the ROS graph to browsers and GUIs on one port: rosbridge v2 with "
+                    "rosapi (roslibjs, roslibpy, webviz), the Foxglove WebSocket protocol "
+                    "(Foxglove, Lichtblick) and web_video_server's /stream, /snapshot and "
+                    "/stream_viewer endpoints.")
+    parser.add_argument("--port", type=int, default=9090, help="TCP port (default 9090)")
+    parser.add_argument("--host", default="127.0.0.1",
+                        help="address to listen on (default 127.0.0.1: this machine only; "
+                             "0.0.0.0 for every interface)")
+    parser.add_argument("--token", help="a secret every client must present, as ?token=... in "
+                                        "the URL or an 'Authorization: Bearer' header")
+    parser.add_argument("--name", default="minros_web", help="node name (default minros_web)")
+    parser.add_argument("--topics-glob", default="", metavar="GLOBS",
+                        help="only these topics, e.g. '[/turtle1/*, /rosout]' (default: all)")
+    parser.add_argument("--services-glob", default="", metavar="GLOBS",
+                        help="only these services (default: all)")
+    parser.add_argument("--params-glob", default="", metavar="GLOBS",
+                        help="only these parameters (default: all)")
+    parser.add_argument("--max-message-size", type=int, default=64 << 20, metavar="BYTES",
+                        help="largest message a client may send (default 64 MiB); larger ones "
+                             "close that client's connection")
+    parser.add_argument("--send-timeout", type=float, default=10.0, metavar="SECONDS",
+                        help="close a client that reads nothing for this long while data waits "
+                             "(default 10)")
+    parser.add_argument("--graph-interval", type=float, default=1.0, metavar="SECONDS",
+                        help="how often the master's graph is read (default 1)")
+    parser.add_argument("--compression", action="store_true",
+                        help="offer permessage-deflate (costs CPU on images)")
+    return parser
+
+
+def main(argv: List[str], prog: str | None = None) -> int:
+    from minros.tools.common import strip_ros_args
+    from minros.web.node import Settings, parse_globs, run
+
+    args = _parser(prog or "minros web").parse_args(strip_ros_args(list(argv)))
+    if not 0 <= args.port <= 65535:
+        print(f"{prog or 'minros web'}: error: --port {args.port} is not a TCP port (0-65535)",
+              file=sys.stderr)
+        return 2
+    settings = Settings(host=args.host, port=args.port, token=args.token, name=args.name,
+                        topics_glob=parse_globs(args.topics_glob),
+                        services_glob=parse_globs(args.services_glob),
+                        params_glob=parse_globs(args.params_glob),
+                        graph_interval=max(0.05, args.graph_interval),
+                        send_timeout=max(0.5, args.send_timeout),
+                        max_message_size=args.max_message_size, compression=args.compression)
+    return run(settings, announce=lambda text: print(text, flush=True))

@@ -1,0 +1,173 @@
+"""Running ``minros web``: the node, rosapi's services, the server, until shutdown.
+
+Used by ``minros web`` (minros.cli.web) and by the executables that roslaunch and rosrun find as
+``rosbridge_server/rosbridge_websocket``, ``foxglove_bridge/foxglove_bridge`` and
+``rosapi/rosapi_node`` (the launch files minros ships start those). Launched as a node, the
+server reads its settings from private parameters, with rosbridge's and foxglove_bridge's
+names: ``~port``, ``~address``, ``~topics_glob``, ``~services_glob``, ``~params_glob``,
+``~max_message_size``, ``~unregister_timeout``, ``~use_compression``, plus ``~token``.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from dataclasses import dataclass, field
+from typing import Any, List, Optional
+
+import minros
+
+
+@dataclass
+class Settings:
+    host: str = "127.0.0.1"
+    port: int = 9090
+    token: Optional[str] = None
+    name: str = "minros_web"
+    topics_glob: List[str] = field(default_factory=list)
+    services_glob: List[str] = field(default_factory=list)
+    params_glob: List[str] = field(default_factory=list)
+    graph_interval: float = 1.0
+    send_timeout: float = 10.0
+    max_message_size: int = 64 << 20
+    unregister_timeout: float = 10.0
+    compression: bool = False
+    server_name: str = "minros web"
+    rosapi: bool = True
+    server: bool = True
+
+
+def parse_globs(value: Any) -> List[str]:
+    """rosapi's glob parameter: ``"[*]"``, ``"['/a/*', '/b']"`` or a YAML list."""
+    if isinstance(value, list):
+        items = [str(v) for v in value]
+    else:
+        text = str(value or "").strip().strip("[").strip("]")
+        items = [part.strip().strip("'\"") for part in text.split(",")]
+    items = [i for i in items if i]
+    return [] if items == ["*"] else items
+
+
+def register_rosapi(rosapi: Any) -> List[Any]:
+    """Serve every rosapi service as a real ROS service of this node."""
+    from minros.web.rosapi import SERVICES
+
+    services = []
+    for name in SERVICES:
+        def handler(request: Any, _name: str = name) -> Any:
+            return rosapi.handle(_name, request)
+        services.append(minros.Service(name, rosapi.service_class(name), handler))
+    return services
+
+
+def master_error() -> Optional[str]:
+    """Why the master cannot be used, or None."""
+    from minros.tools.master import Master, MasterIOError
+
+    master = Master("/minros_web")
+    try:
+        master.getPid()
+        return None
+    except MasterIOError:
+        return (f"cannot reach the ROS master at {master.uri}: start one with `minros core` "
+                "(or roscore), or set ROS_MASTER_URI")
+    except Exception as exc:
+        return f"the ROS master at {master.uri} does not answer: {exc}"
+    finally:
+        master.close()
+
+
+def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = None) -> int:
+    """Start the node and the server; serve until Ctrl-C or a ROS shutdown. Exit status."""
+    from minros.web.rosapi import Rosapi
+    from minros.web.state import Options, WebState
+
+    error = master_error()
+    if error:
+        print(f"minros web: error: {error}", file=sys.stderr)
+        return 1
+    minros.init_node(settings.name, argv=argv, disable_signals=True)
+    stop = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_args: stop.set())
+    minros.on_shutdown(stop.set)
+    state = WebState(Options(topics_glob=settings.topics_glob, services_glob=settings.services_glob,
+                             params_glob=settings.params_glob, graph_interval=settings.graph_interval,
+                             unregister_timeout=settings.unregister_timeout))
+    rosapi = Rosapi(state, settings.topics_glob, settings.services_glob, settings.params_glob)
+    if settings.rosapi:
+        register_rosapi(rosapi)
+    server = None
+    if settings.server:
+        from minros.web.server import WebServer
+
+        server = WebServer(state, settings.host, settings.port, token=settings.token,
+                           name=settings.server_name, rosapi=rosapi,
+                           send_timeout=settings.send_timeout,
+                           max_message_size=settings.max_message_size,
+                           compression=settings.compression)
+        try:
+            server.start()
+        except OSError as exc:
+            print(f"minros web: error: cannot listen on {settings.host}:{settings.port}: "
+                  f"{exc.strerror or exc}. Is another server using that port? Pick another "
+                  "with --port.", file=sys.stderr)
+            minros.signal_shutdown("port unavailable")
+            return 1
+    state.start()
+    if server is not None:
+        announce(_banner(server, settings))
+    else:
+        announce(f"rosapi: {len(rosapi_names())} services served by {minros.get_name()}")
+    try:
+        while not stop.wait(0.5):
+            if minros.is_shutdown():
+                break
+    finally:
+        if server is not None:
+            server.shutdown()
+        state.stop()
+        minros.signal_shutdown("minros web stopped")
+    return 0
+
+
+def rosapi_names() -> List[str]:
+    from minros.web.rosapi import SERVICES
+
+    return list(SERVICES)
+
+
+def _banner(server: Any, settings: Settings) -> str:
+    url = server.url
+    ws = url.replace("http://", "ws://")
+    token = f"?token={settings.token}" if settings.token else ""
+    return "\n".join([
+        f"minros web: listening on {url}/{token} (node {minros.get_name()})",
+        f"  rosbridge v2 + rosapi  {ws}{token}   (roslibjs, roslibpy, webviz)",
+        f"  Foxglove WebSocket     {ws}{token}   (Foxglove, Lichtblick: 'Foxglove WebSocket')",
+        f"  video                  {url}/streams{token}   (/stream?topic=..., /snapshot?topic=...)",
+    ])
+
+
+def run_node(default_name: str, default_port: int, server_name: str, serve: bool = True) -> int:
+    """Entry of the launch-file executables: settings from private parameters."""
+    from minros.web.state import DEFAULT_UNREGISTER_TIMEOUT
+
+    minros.init_node(default_name, disable_signals=True)
+
+    def param(key: str, default: Any) -> Any:
+        return minros.get_param("~" + key, default)
+
+    max_size = param("max_message_size", None)
+    settings = Settings(
+        host=str(param("address", "127.0.0.1") or "0.0.0.0"), port=int(param("port", default_port)),
+        token=param("token", None) or None, name=default_name,
+        topics_glob=parse_globs(param("topics_glob", "")),
+        services_glob=parse_globs(param("services_glob", "")),
+        params_glob=parse_globs(param("params_glob", "")),
+        max_message_size=int(max_size) if str(max_size).isdigit() else 64 << 20,
+        unregister_timeout=float(param("unregister_timeout", DEFAULT_UNREGISTER_TIMEOUT)),
+        compression=bool(param("use_compression", False)), server_name=server_name,
+        server=serve)
+    return run(settings, announce=minros.loginfo)

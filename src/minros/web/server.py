@@ -1,0 +1,411 @@
+"""The ``minros web`` server: one port for rosbridge, Foxglove, the video endpoints and the page.
+
+Built on the threading server of ``websockets`` (one thread per connection, like the rest of
+minros). A connection is told apart by:
+
+* the WebSocket subprotocol: ``foxglove.websocket.v1`` -> :class:`FoxgloveSession`; no (or any
+  other) subprotocol -> :class:`RosbridgeSession` (roslibjs and roslibpy ask for none);
+* for plain HTTP (no ``Upgrade``), the path: ``/stream``, ``/snapshot``, ``/stream_viewer``,
+  ``/streams`` (web_video_server's endpoints), else the static files of ``minros/web/static``.
+
+Each WebSocket client has an :class:`~minros.web.outbox.Outbox` and a writer thread: ROS
+callbacks only queue, the writer encodes and sends. A watchdog closes a client whose send has
+been blocked for ``send_timeout`` seconds (a client that stopped reading); MJPEG viewers write
+with the same bound. With a token, every request (WebSocket or HTTP) must carry it, as
+``?token=`` in the URL or an ``Authorization: Bearer`` header.
+"""
+
+from __future__ import annotations
+
+import hmac
+import itertools
+import logging
+import mimetypes
+import select
+import socket
+import threading
+import time
+import traceback
+import urllib.parse
+from pathlib import Path
+from typing import Any, Dict, List, Optional
+
+import minros
+from minros.web import foxglove_protocol as fp
+from minros.web import video
+from minros.web.foxglove import FoxgloveSession
+from minros.web.outbox import Outbox
+from minros.web.rosbridge import RosbridgeSession
+from minros.web.state import WebState
+
+STATIC_DIR = Path(__file__).resolve().parent / "static"
+DEFAULT_PORT = 9090
+DEFAULT_MAX_MESSAGE_SIZE = 64 << 20
+DEFAULT_SEND_TIMEOUT = 10.0
+
+
+class _OneLine(logging.Filter):
+    """websockets' own log lines, without tracebacks (expected network errors are not bugs)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.exc_info and record.exc_info[1] is not None:
+            record.msg = f"{record.getMessage()}: {record.exc_info[1]}"
+            record.args = None
+        record.exc_info = None
+        return True
+
+
+def _ws_logger() -> logging.Logger:
+    logger = logging.getLogger("minros.web.websockets")
+    if not logger.filters:
+        logger.addFilter(_OneLine())
+        logger.setLevel(logging.CRITICAL)  # connection-level failures are reported by us
+    return logger
+
+
+def send_with_timeout(sock: socket.socket, parts: List[bytes], timeout: float) -> None:
+    """Write ``parts`` to a blocking socket without blocking longer than ``timeout`` seconds
+    at a time (another thread reads the same socket, so its timeout cannot be changed)."""
+    for part in parts:
+        view = memoryview(part)
+        while len(view):
+            try:
+                sent = sock.send(view, socket.MSG_DONTWAIT)
+            except BlockingIOError:
+                sent = 0
+            if sent:
+                view = view[sent:]
+                continue
+            _, writable, _ = select.select([], [sock], [], timeout)
+            if not writable:
+                raise TimeoutError(f"the viewer read nothing for {timeout:.0f} s")
+
+
+class _Client:
+    """One WebSocket client: its outbox, its writer thread, its session."""
+
+    def __init__(self, server: WebServer, connection: Any, client_id: str) -> None:
+        self.server = server
+        self.connection = connection
+        self.id = client_id
+        self.outbox = Outbox()
+        self.send_started: Optional[float] = None
+        self.closing: Optional[str] = None
+        self.session: Any = None
+        self.writer = threading.Thread(target=self._write_loop, name=f"minros-web-writer:{client_id}",
+                                       daemon=True)
+
+    def close(self, reason: str) -> None:
+        """Drop the client (from any thread): one log line, the socket shut down."""
+        if self.closing is not None:
+            return
+        self.closing = reason
+        minros.logwarn(f"[web] closing client {self.id}: {reason}")
+        self.outbox.close()
+        try:
+            self.connection.socket.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+
+    def _write_loop(self) -> None:
+        from websockets.exceptions import ConnectionClosed
+
+        send = self.connection.send
+        get = self.outbox.get
+        while True:
+            got = get()
+            if got is None:
+                return
+            slot, item = got
+            try:
+                frames = item if slot is None else slot.render(item)
+                if not isinstance(frames, list):
+                    frames = [frames]
+            except Exception as exc:
+                minros.logerr(f"[web] client {self.id}: cannot encode a message for "
+                              f"{slot.key if slot else 'reply'}: {exc}")
+                continue
+            try:
+                for frame in frames:
+                    self.send_started = time.monotonic()
+                    send(frame)
+                    self.send_started = None
+            except (ConnectionClosed, OSError):
+                self.send_started = None
+                return
+
+
+class WebServer:
+    """Serves rosbridge, Foxglove, video and static files on one port (see the module doc)."""
+
+    def __init__(self, state: WebState, host: str = "127.0.0.1", port: int = DEFAULT_PORT,
+                 token: Optional[str] = None, name: str = "minros web", rosapi: Any = None,
+                 send_timeout: float = DEFAULT_SEND_TIMEOUT,
+                 max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE, compression: bool = False,
+                 static_dir: Path = STATIC_DIR) -> None:
+        self.state = state
+        self.host = host
+        self.port = port
+        self.token = token or None
+        self.name = name
+        self.rosapi = rosapi
+        self.send_timeout = send_timeout
+        self.max_message_size = max_message_size
+        self.compression = compression
+        self.static_dir = static_dir
+        self.clients: Dict[str, _Client] = {}
+        self.viewers = 0
+        self._ids = itertools.count(1)
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._server: Any = None
+        self._threads: List[threading.Thread] = []
+
+    # -- lifecycle -------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Bind the port (OSError if taken) and serve in background threads."""
+        from websockets.sync.server import serve
+
+        self._server = serve(
+            self._handle, self.host, self.port, process_request=self._process_request,
+            select_subprotocol=self._select_subprotocol, server_header="minros web",
+            compression="deflate" if self.compression else None,
+            max_size=self.max_message_size, logger=_ws_logger(), ping_interval=20,
+            ping_timeout=None, open_timeout=10, close_timeout=2)
+        self.port = self._server.socket.getsockname()[1]
+        for target, name in ((self._server.serve_forever, "minros-web-server"),
+                             (self._watchdog, "minros-web-watchdog")):
+            thread = threading.Thread(target=target, name=name, daemon=True)
+            thread.start()
+            self._threads.append(thread)
+
+    def shutdown(self) -> None:
+        self._stop.set()
+        if self._server is not None:
+            for client in list(self.clients.values()):
+                client.outbox.close()
+            threading.Thread(target=self._server.shutdown, name="minros-web-shutdown",
+                             daemon=True).start()
+
+    @property
+    def url(self) -> str:
+        host = "localhost" if self.host in ("127.0.0.1", "::1", "localhost") else self.host
+        if host in ("0.0.0.0", "", "::"):
+            host = socket.gethostname()
+        return f"http://{host}:{self.port}"
+
+    def _watchdog(self) -> None:
+        while not self._stop.wait(0.5):
+            now = time.monotonic()
+            for client in list(self.clients.values()):
+                started = client.send_started
+                if started is not None and now - started > self.send_timeout:
+                    client.close(f"it has not read anything for {self.send_timeout:.0f} s")
+
+    # -- the handshake ---------------------------------------------------------------------
+
+    @staticmethod
+    def _select_subprotocol(connection: Any, offered: Any) -> Optional[str]:
+        return fp.SUBPROTOCOL if fp.SUBPROTOCOL in offered else None
+
+    def _token_ok(self, request: Any, query: str) -> bool:
+        if self.token is None:
+            return True
+        given = urllib.parse.parse_qs(query).get("token", [""])[0]
+        auth = request.headers.get("Authorization", "")
+        if not given and auth.lower().startswith("bearer "):
+            given = auth[7:].strip()
+        return hmac.compare_digest(given.encode(), self.token.encode())
+
+    def _response(self, status: int, body: bytes, content_type: str = "text/plain; charset=utf-8",
+                  headers: Optional[List[Any]] = None) -> Any:
+        from http import HTTPStatus
+
+        from websockets.datastructures import Headers
+        from websockets.http11 import Response
+
+        all_headers = Headers()
+        for key, value in headers or []:
+            all_headers[key] = value
+        if "Content-Type" not in all_headers:
+            all_headers["Content-Type"] = content_type
+        all_headers["Content-Length"] = str(len(body))
+        all_headers["Connection"] = "close"
+        return Response(status, HTTPStatus(status).phrase, all_headers, body)
+
+    def _text(self, status: int, text: str) -> Any:
+        return self._response(status, (text + "\n").encode("utf-8"))
+
+    def _process_request(self, connection: Any, request: Any) -> Any:
+        path, _, query = request.path.partition("?")
+        if not self._token_ok(request, query):
+            peer = connection.remote_address
+            minros.logwarn(f"[web] refused {peer[0] if peer else '?'}: wrong or missing token")
+            return self._text(401, "minros web: wrong or missing token. Add ?token=TOKEN to the "
+                                   "URL (the token `minros web --token` was started with).")
+        if request.headers.get("Upgrade", "").lower() == "websocket":
+            return None
+        try:
+            return self._http(connection, path, query)
+        except video.VideoError as exc:
+            return self._text(exc.status, f"minros web: {exc}")
+
+    # -- plain HTTP ------------------------------------------------------------------------
+
+    def _token_query(self, query: str) -> str:
+        token = urllib.parse.parse_qs(query).get("token", [""])[0]
+        return "&token=" + urllib.parse.quote(token) if token else ""
+
+    def _http(self, connection: Any, path: str, query: str) -> Any:
+        if path == "/stream":
+            return self._stream(connection, self._video_params(query))
+        if path == "/snapshot":
+            params = self._video_params(query)
+            feed = self._feed(params.topic)
+            try:
+                seq = feed.wait(0, 5.0)
+                if not seq:
+                    raise video.VideoError(f"no image arrived on {params.topic} within 5 s: is "
+                                           "anything publishing it?", 503)
+                _seq, jpeg, stamp = feed.jpeg(params)
+            finally:
+                self._release_feed(params.topic)
+            return self._response(200, jpeg, "image/jpeg", video.snapshot_headers(stamp))
+        if path == "/stream_viewer":
+            params = self._video_params(query)
+            return self._response(200, video.viewer_page(params, query).encode(),
+                                  "text/html; charset=utf-8")
+        if path == "/streams":
+            graph = self.state.refresh_graph()
+            topics = [t for t, ty in graph.topic_types.items() if video.is_image_type(ty)]
+            return self._response(200, video.list_page(topics, self._token_query(query)).encode(),
+                                  "text/html; charset=utf-8")
+        return self._static(path)
+
+    def _static(self, path: str) -> Any:
+        relative = urllib.parse.unquote(path).lstrip("/") or "index.html"
+        root = self.static_dir.resolve()
+        target = (root / relative).resolve()
+        if root not in target.parents or not target.is_file():
+            return self._text(404, f"minros web: no such page {path}")
+        content_type = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
+        if content_type.startswith("text/") or content_type.endswith("javascript"):
+            content_type += "; charset=utf-8"
+        return self._response(200, target.read_bytes(), content_type)
+
+    # -- video -----------------------------------------------------------------------------
+
+    def _video_params(self, query: str) -> video.StreamParams:
+        params = video.parse_params(query)
+        type_name = self.state.topic_type(params.topic)
+        if params.type == "ros_compressed":
+            compressed = params.topic.rstrip("/") + "/compressed"
+            if self.state.topic_type(compressed) == video.COMPRESSED:
+                params = video.StreamParams(compressed, params.width, params.height,
+                                            params.quality, params.invert, params.type)
+                type_name = video.COMPRESSED
+        if type_name is not None and not video.is_image_type(type_name):
+            raise video.VideoError(f"{params.topic} is a {type_name}, not a sensor_msgs/Image "
+                                   "or CompressedImage", 415)
+        return params
+
+    def _feed(self, topic: str) -> video.ImageFeed:
+        with self._lock:
+            feed = self.state.feeds.get(topic)
+            if feed is None:
+                feed = video.ImageFeed(topic)
+                self.state.feeds[topic] = feed
+                self.state.tap(topic, self.state.topic_type(topic), ("video", topic), feed.push)
+            feed.viewers += 1
+            return feed
+
+    def _release_feed(self, topic: str) -> None:
+        with self._lock:
+            feed = self.state.feeds.get(topic)
+            if feed is None:
+                return
+            feed.viewers -= 1
+            if feed.viewers <= 0:
+                del self.state.feeds[topic]
+                self.state.untap(topic, ("video", topic))
+
+    def _stream(self, connection: Any, params: video.StreamParams) -> Any:
+        """Write an MJPEG stream on the connection's socket until the viewer goes away (this
+        runs in the connection's own thread; the websockets handshake is never completed)."""
+        feed = self._feed(params.topic)
+        sock = connection.socket
+        reader = getattr(connection, "recv_events_thread", None)
+        with self._lock:
+            self.viewers += 1
+        try:
+            send_with_timeout(sock, [video.stream_head()], self.send_timeout)
+            seq = 0
+            while not self._stop.is_set():
+                newest = feed.wait(seq, 1.0)
+                if reader is not None and not reader.is_alive():
+                    break  # the viewer closed its end
+                if newest == seq:
+                    continue
+                seq, jpeg, stamp = feed.jpeg(params)
+                send_with_timeout(sock, video.stream_part(jpeg, stamp), self.send_timeout)
+        except TimeoutError as exc:
+            minros.logwarn(f"[web] closing the stream of {params.topic}: {exc}")
+        except video.VideoError as exc:
+            minros.logwarn(f"[web] stream of {params.topic} stopped: {exc}")
+        except OSError:
+            pass  # the viewer went away
+        finally:
+            with self._lock:
+                self.viewers -= 1
+            self._release_feed(params.topic)
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+        return self._text(200, "")  # not delivered: the socket is shut down
+
+    # -- WebSocket clients -----------------------------------------------------------------
+
+    def _handle(self, connection: Any) -> None:
+        from websockets.exceptions import ConnectionClosed
+
+        peer = connection.remote_address
+        client_id = f"{peer[0]}:{peer[1]}#{next(self._ids)}" if peer else str(next(self._ids))
+        client = _Client(self, connection, client_id)
+        foxglove = connection.subprotocol == fp.SUBPROTOCOL
+        if foxglove:
+            client.session = FoxgloveSession(client_id, self.state, client.outbox, client.close,
+                                             server_name=self.name)
+        else:
+            client.session = RosbridgeSession(client_id, self.state, client.outbox, client.close,
+                                              rosapi=self.rosapi)
+        with self._lock:
+            self.clients[client_id] = client
+        minros.loginfo(f"[web] {'Foxglove' if foxglove else 'rosbridge'} client {client_id} connected")
+        client.writer.start()
+        try:
+            if foxglove:
+                client.session.start()
+            while True:
+                data = connection.recv()
+                try:
+                    client.session.receive(data)
+                except Exception:
+                    minros.logerr(f"[web] client {client_id}: internal error\n{traceback.format_exc()}")
+        except ConnectionClosed:
+            pass
+        finally:
+            sent = getattr(connection.protocol, "close_sent", None)
+            if sent is not None and sent.code == 1009:  # websockets refused a frame over max_size
+                minros.logwarn(f"[web] closed client {client_id}: it sent a message larger than "
+                               f"{self.max_message_size} bytes (raise --max-message-size)")
+            with self._lock:
+                self.clients.pop(client_id, None)
+            client.outbox.close()
+            try:
+                client.session.close()
+            except Exception:
+                minros.logerr(f"[web] client {client_id}: cleanup failed\n{traceback.format_exc()}")
+            client.writer.join(timeout=self.send_timeout + 1)
+            minros.loginfo(f"[web] client {client_id} disconnected")

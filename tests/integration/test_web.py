@@ -1,0 +1,478 @@
+"""``minros web`` with real clients: roslibpy (PyPI), Foxglove's own client libraries (npm:
+@foxglove/ws-protocol + @foxglove/rosmsg-serialization, run by node), roslib (npm) in headless
+Chromium; web_video_server's endpoints; the seed's video subscriber under headless OpenCV; bad
+input from a raw WebSocket client; the launch files of rosbridge_server and foxglove_bridge.
+
+The node clients need ``npm ci`` in tests/web/js and Chromium needs Debian's ``chromium``
+(scripts/install-ros-reference.sh installs it): missing, they skip locally and fail in CI.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import socket
+import subprocess
+import threading
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from support import IN_CI, PYTHON, Proc, free_port, ros_env, wait_for_master
+
+WEB = Path(__file__).resolve().parent.parent / "web"
+JS = WEB / "js"
+VIDEO = Path(__file__).resolve().parent.parent / "examples" / "video"
+CHROMIUM = "/usr/bin/chromium"
+
+
+def need(condition: bool, what: str) -> None:
+    if condition:
+        return
+    if IN_CI:
+        pytest.fail(f"{what} (scripts/test.sh installs it)")
+    pytest.skip(what)
+
+
+def start_web(port: int, home: Path, *args: str, web_port: int | None = None) -> tuple:
+    web_port = web_port or free_port()
+    proc = Proc([PYTHON, "-m", "minros", "web", "--port", str(web_port), *args], ros_env(port, home))
+    proc.read_until("listening on", timeout=20)
+    return proc, web_port
+
+
+class Graph:
+    """minros core + turtlesim + a talker + minros web, shared by the tests of this module."""
+
+    def __init__(self, tmp: Path) -> None:
+        self.home = tmp / "ros_home"
+        (self.home / "log").mkdir(parents=True)
+        self.port = free_port()
+        self.procs = [Proc([PYTHON, "-m", "minros", "core", "-p", str(self.port)], self.env())]
+        wait_for_master(self.port)
+        turtle = Proc([PYTHON, "-m", "minros", "run", "turtlesim", "turtlesim_node"],
+                      self.env({"MINROS_HEADLESS": "1"}))
+        self.procs.append(turtle)
+        turtle.read_until("Spawning turtle [turtle1]", timeout=20)
+        self.procs.append(Proc([PYTHON, "-m", "minros", "topic", "pub", "-r", "10", "/chatter",
+                                "std_msgs/String", "data: hello web"], self.env()))
+        self.web, self.web_port = start_web(self.port, self.home)
+        self.procs.append(self.web)
+
+    def env(self, extra: dict | None = None) -> dict:
+        return ros_env(self.port, self.home, extra)
+
+    @property
+    def ws(self) -> str:
+        return f"ws://127.0.0.1:{self.web_port}"
+
+    @property
+    def http(self) -> str:
+        return f"http://127.0.0.1:{self.web_port}"
+
+    def stop(self) -> str:
+        out = ""
+        for proc in reversed(self.procs):
+            out += proc.stop()
+        return out
+
+
+@pytest.fixture(scope="module")
+def graph(tmp_path_factory):
+    g = Graph(tmp_path_factory.mktemp("web"))
+    try:
+        yield g
+    finally:
+        g.stop()
+
+
+def node_client(*args: str, timeout: float = 30) -> list:
+    need(shutil.which("node") is not None and (JS / "node_modules" / "@foxglove").is_dir(),
+         "node and tests/web/js/node_modules (npm ci) are needed for the Foxglove client")
+    done = subprocess.run(["node", str(JS / "foxglove_client.mjs"), *args], capture_output=True,
+                          text=True, timeout=timeout)
+    lines = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
+    assert done.returncode == 0, f"{done.stdout}\n{done.stderr}"
+    return lines
+
+
+# -- roslibpy --------------------------------------------------------------------------------
+
+def test_roslibpy_subscribes_publishes_calls_and_uses_rosapi(graph):
+    proc = Proc([PYTHON, str(WEB / "roslibpy_client.py"), graph.ws], graph.env())
+    try:
+        out = proc.read_until("RESULT ", timeout=60)
+    finally:
+        out += proc.stop()
+    lines = [line for line in out.splitlines() if line.startswith("RESULT ")]
+    assert lines, out
+    result = json.loads(lines[0][len("RESULT "):])
+    assert result["connected"] is True
+    assert "/turtle1/pose" in result["topics"] and "/chatter" in result["topics"]
+    assert result["topic_type"] == "turtlesim/Pose"
+    assert "/turtlesim" in result["nodes"] and "/minros_web" in result["nodes"]
+    assert "/spawn" in result["services"] and "/rosapi/topics" in result["services"]
+    assert result["service_type"] == "turtlesim/Spawn"
+    twist = result["message_details"]["typedefs"][0]
+    assert twist["type"] == "geometry_msgs/Twist" and twist["fieldnames"] == ["linear", "angular"]
+    assert result["message_details"]["typedefs"][1]["fieldtypes"] == ["float64"] * 3
+    assert result["request_details"]["typedefs"][0]["fieldnames"] == ["x", "y", "theta", "name"]
+    # the turtle drove along +x: roslibpy's cmd_vel reached turtlesim, its pose came back
+    first, last = result["first_pose"], result["last_pose"]
+    assert first is not None and abs(first["x"] - 5.544445) < 1e-3
+    assert last["x"] > first["x"] + 1.0 and abs(last["y"] - first["y"]) < 1e-3
+    assert result["spawn"] == {"name": "webturtle"}
+    assert "turtlesim/SpawnRequest message requires a float32 for field x" in result["bad_call"]
+    assert result["param"] == {"kp": 1.5, "names": ["a", "b"]}
+    assert "/web_test/gains/kp" in result["param_names"]
+    assert result["advertised_call"] == {"sum": 42}
+    assert result["time"]["secs"] > 1_600_000_000
+
+
+# -- Foxglove --------------------------------------------------------------------------------
+
+def test_foxglove_client_receives_and_decodes_a_topic(graph):
+    lines = node_client("echo", graph.ws, "/turtle1/pose", "3")
+    info = lines[0]["serverInfo"]
+    assert info["supportedEncodings"] == ["ros1"]
+    assert {"clientPublish", "parameters", "parametersSubscribe", "services",
+            "connectionGraph"} <= set(info["capabilities"])
+    channel = lines[1]["channel"]
+    assert channel["encoding"] == "ros1" and channel["schemaEncoding"] == "ros1msg"
+    assert channel["schemaName"] == "turtlesim/Pose"
+    assert channel["schema"].startswith("float32 x\nfloat32 y\nfloat32 theta")
+    messages = [line for line in lines if "message" in line]
+    assert len(messages) == 3
+    assert set(messages[0]["message"]) == {"x", "y", "theta", "linear_velocity", "angular_velocity"}
+    assert all(m["size"] == 20 for m in messages)  # 5 float32: the TCPROS body, forwarded as is
+
+
+def test_foxglove_client_publishes_calls_services_and_sets_parameters(graph):
+    lines = node_client("call", graph.ws, "/turtle1/teleport_absolute",
+                        '{"x": 3.0, "y": 4.0, "theta": 0.0}')
+    assert lines[-1] == {"response": {}, "callId": 7}
+    pose = node_client("echo", graph.ws, "/turtle1/pose", "1")[-1]["message"]
+    assert abs(pose["x"] - 3.0) < 1e-3 and abs(pose["y"] - 4.0) < 1e-3
+
+    lines = node_client("call", graph.ws, "/rosapi/topic_type", '{"topic": "/chatter"}')
+    assert lines[-1]["response"] == {"type": "std_msgs/String"}
+
+    node_client("publish", graph.ws, "/turtle1/cmd_vel",
+                '{"linear": {"x": 0, "y": 0, "z": 0}, "angular": {"x": 0, "y": 0, "z": 1.0}}', "5")
+    pose = node_client("echo", graph.ws, "/turtle1/pose", "1")[-1]["message"]
+    assert pose["theta"] > 0.2  # turned left
+
+    lines = node_client("params", graph.ws, "/fox/gain", "2.5")
+    got = [line["parameterValues"] for line in lines if "parameterValues" in line]
+    assert got[-1]["id"] == "get-1"
+    assert got[-1]["parameters"] == [{"name": "/fox/gain", "value": 2.5, "type": "float64"}]
+
+    lines = node_client("graph", graph.ws, "/turtlesim")
+    update = lines[-1]["graph"]
+    published = {t["name"]: t["publisherIds"] for t in update["publishedTopics"]}
+    assert published["/turtle1/pose"] == ["/turtlesim"]
+    services = {s["name"] for s in update["advertisedServices"]}
+    assert "/spawn" in services
+
+
+# -- roslib in Chromium ----------------------------------------------------------------------
+
+def test_roslib_in_headless_chromium(graph):
+    playwright = pytest.importorskip("playwright.sync_api")
+    need(Path(CHROMIUM).exists(), "Debian's chromium is needed for the browser test")
+    need((JS / "node_modules" / "roslib").is_dir(), "tests/web/js/node_modules (npm ci) is needed")
+    # The page comes from a loopback HTTP server (Chromium's local network access checks keep
+    # pages of other origins from opening ws://127.0.0.1).
+    import functools
+    import http.server
+
+    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(WEB))
+    handler.func.extensions_map = {**handler.func.extensions_map, ".js": "text/javascript",
+                                   ".mjs": "text/javascript"}
+    handler.func.log_message = lambda *args: None
+    pages = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=pages.serve_forever, name="test-pages", daemon=True).start()
+    base = f"http://127.0.0.1:{pages.server_address[1]}/"
+    with playwright.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=[
+            "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+            "--disable-component-update", "--disable-sync", "--no-first-run"])
+        try:
+            page = browser.new_page()
+            console: list = []
+            page.on("console", lambda m: console.append(m.text))
+            page.on("pageerror", lambda e: console.append(str(e)))
+            page.goto(f"{base}roslib_page.html?ws={graph.ws}")
+            try:
+                page.wait_for_function("window.results && window.results.messages.length >= 3 && "
+                                       "window.results.cbor.length >= 1 && "
+                                       "window.results.param === 42 && window.results.topics",
+                                       timeout=20_000)
+            except playwright.Error as exc:
+                state = page.evaluate("window.results")
+                raise AssertionError(f"{exc}\nresults: {state}\nconsole: {console}") from None
+            results = page.evaluate("window.results")
+        finally:
+            browser.close()
+            pages.shutdown()
+            pages.server_close()
+    assert results["connected"] is True and results["errors"] == []
+    assert results["messages"][0] == {"data": "hello web"}
+    assert results["cbor"][0] == {"data": "hello web"}
+    assert "/chatter" in results["topics"]["topics"]
+    idx = results["topics"]["topics"].index("/chatter")
+    assert results["topics"]["types"][idx] == "std_msgs/String"
+
+
+# -- video -----------------------------------------------------------------------------------
+
+def read_mjpeg_parts(url: str, count: int, timeout: float = 20) -> tuple:
+    """The first ``count`` JPEG parts of an MJPEG stream, and the response headers."""
+    with urllib.request.urlopen(url, timeout=timeout) as response:
+        headers = {k.lower(): v for k, v in response.headers.items()}
+        data = b""
+        parts: list = []
+        deadline = time.monotonic() + timeout
+        while len(parts) < count and time.monotonic() < deadline:
+            data += response.read1(65536)
+            while True:
+                start = data.find(b"Content-Length: ")
+                if start < 0:
+                    break
+                end = data.find(b"\r\n\r\n", start)
+                if end < 0:
+                    break
+                length = int(data[start + 16:data.find(b"\r\n", start)])
+                if len(data) < end + 4 + length:
+                    break
+                parts.append(data[end + 4:end + 4 + length])
+                data = data[end + 4 + length:]
+    return parts, headers
+
+
+def test_seed_video_subscriber_frames_appear_at_stream(graph, tmp_path):
+    """video_sub.py, unmodified, with opencv-python-headless: its 'camera' window is streamed."""
+    fake = tmp_path / "fakecam"
+    fake.mkdir()
+    pub = Proc([PYTHON, str(VIDEO / "video_pub.py")],
+               graph.env({"PYTHONPATH": str(VIDEO / "fakecam"), "FAKECAM_DIR": str(fake)}))
+    sub = Proc([PYTHON, str(VIDEO / "video_sub.py")], graph.env())
+    try:
+        notice = sub.read_until("[imshow]", timeout=30)
+        assert "/stream_viewer?topic=/imshow/camera" in notice
+        parts, headers = read_mjpeg_parts(f"{graph.http}/stream?topic=/imshow/camera", 3)
+        assert headers["content-type"].startswith("multipart/x-mixed-replace;boundary=")
+        assert len(parts) == 3
+        frame = cv2.imdecode(np.frombuffer(parts[-1], np.uint8), cv2.IMREAD_COLOR)
+        assert frame.shape == (480, 640, 3)
+        # the publisher's blue 'A' at (150, 150) survived the trip (JPEG: roughly blue)
+        glyph = frame[125:155, 148:178].reshape(-1, 3).astype(int)
+        assert ((glyph[:, 0] > 180) & (glyph[:, 1] < 80) & (glyph[:, 2] < 80)).sum() > 15
+        with urllib.request.urlopen(f"{graph.http}/snapshot?topic=/imshow/camera", timeout=20) as r:
+            assert r.headers["Content-Type"] == "image/jpeg"
+            assert cv2.imdecode(np.frombuffer(r.read(), np.uint8), cv2.IMREAD_COLOR).shape == (480, 640, 3)
+        small, _ = read_mjpeg_parts(f"{graph.http}/stream?topic=/video_frames&width=320&height=240&quality=50", 1)
+        assert cv2.imdecode(np.frombuffer(small[0], np.uint8), cv2.IMREAD_COLOR).shape == (240, 320, 3)
+        with urllib.request.urlopen(f"{graph.http}/stream_viewer?topic=/imshow/camera", timeout=10) as r:
+            assert b'<img src="/stream?topic=/imshow/camera">' in r.read()
+        with urllib.request.urlopen(f"{graph.http}/streams", timeout=10) as r:
+            listing = r.read().decode()
+        assert "/imshow/camera" in listing and "/video_frames" in listing
+    finally:
+        pub_out = pub.stop()
+        sub_out = sub.stop()
+    assert "Traceback" not in pub_out + sub_out
+    assert "not implemented" not in sub_out
+
+
+def test_video_endpoints_report_bad_requests(graph):
+    def status(path: str) -> tuple:
+        try:
+            with urllib.request.urlopen(graph.http + path, timeout=10) as r:
+                return r.status, r.read().decode()
+        except urllib.error.HTTPError as exc:
+            return exc.code, exc.read().decode()
+
+    code, text = status("/stream")
+    assert code == 400 and "missing ?topic=" in text
+    code, text = status("/snapshot?topic=/chatter")
+    assert code == 415 and "std_msgs/String, not a sensor_msgs/Image" in text
+    code, text = status("/stream?topic=/x&width=abc")
+    assert code == 400 and "width='abc' is not an integer" in text
+    code, text = status("/no/such/page")
+    assert code == 404
+    code, text = status("/")
+    assert code == 200 and "minros web" in text
+
+
+# -- bad input ------------------------------------------------------------------------------
+
+def raw_client(url: str, **kwargs):
+    from websockets.sync.client import connect
+
+    return connect(url, open_timeout=10, **kwargs)
+
+
+def next_status(ws) -> dict:
+    while True:
+        msg = json.loads(ws.recv(timeout=10))
+        if msg.get("op") == "status":
+            return msg
+
+
+def test_bad_input_gets_status_and_leaves_others_alone(graph):
+    with raw_client(graph.ws) as bystander, raw_client(graph.ws) as ws:
+        bystander.send(json.dumps({"op": "subscribe", "topic": "/chatter", "id": "keep"}))
+        assert json.loads(bystander.recv(timeout=10))["msg"] == {"data": "hello web"}
+
+        ws.send("{not json")
+        assert "not valid JSON" in next_status(ws)["msg"]
+        ws.send(json.dumps({"op": "dance", "id": "d1"}))
+        status = next_status(ws)
+        assert status["level"] == "error" and status["id"] == "d1"
+        assert status["msg"].startswith("Unknown operation: dance.  Allowed operations: [")
+        ws.send(json.dumps({"op": "subscribe", "topic": "/nothing_here", "type": "no_pkg/Nope"}))
+        assert "Unable to load the message type no_pkg/Nope" in next_status(ws)["msg"]
+        ws.send(json.dumps({"op": "subscribe", "topic": "/never_advertised"}))
+        assert next_status(ws)["msg"] == ("subscribe: Cannot infer topic type for topic "
+                                          "/never_advertised as it is not yet advertised")
+        ws.send(json.dumps({"op": "publish", "topic": "/turtle1/cmd_vel",
+                            "msg": {"linear": {"q": 1}}}))
+        assert next_status(ws)["msg"] == ("publish: Message type geometry_msgs/Twist does not "
+                                          "have a field linear.q")
+        ws.send(json.dumps({"op": "publish", "topic": "/turtle1/cmd_vel",
+                            "msg": {"linear": {"x": "fast"}}}))
+        assert next_status(ws)["msg"] == ("publish: geometry_msgs/Twist message requires a "
+                                          "float64 for field linear.x, but got a <class 'str'>")
+        ws.send(json.dumps({"op": "subscribe", "topic": "/chatter", "type": "std_msgs/Int32"}))
+        assert "already established with type std_msgs/String" in next_status(ws)["msg"]
+        # the bad client still works, and so does the bystander
+        ws.send(json.dumps({"op": "call_service", "service": "/rosapi/topic_type",
+                            "args": {"topic": "/chatter"}, "id": "c1"}))
+        reply = json.loads(ws.recv(timeout=10))
+        assert reply == {"op": "service_response", "service": "/rosapi/topic_type",
+                         "values": {"type": "std_msgs/String"}, "result": True, "id": "c1"}
+        assert json.loads(bystander.recv(timeout=10))["op"] == "publish"
+
+
+def test_oversize_frame_closes_only_that_client(tmp_path, minros_core, ros_home):
+    from websockets.exceptions import ConnectionClosed
+
+    web, port = start_web(minros_core, ros_home, "--max-message-size", "1000")
+    out = ""
+    try:
+        with raw_client(f"ws://127.0.0.1:{port}") as other, raw_client(f"ws://127.0.0.1:{port}") as ws:
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t"}))
+            assert json.loads(ws.recv(timeout=10))["result"] is True  # its handler is running
+            ws.send(json.dumps({"op": "publish", "topic": "/x", "msg": {"data": "y" * 5000}}))
+            with pytest.raises(ConnectionClosed) as closed:
+                ws.recv(timeout=10)
+            assert closed.value.sent is not None and closed.value.sent.code == 1009
+            other.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t"}))
+            assert json.loads(other.recv(timeout=10))["result"] is True
+        out = web.read_until("sent a message larger than 1000 bytes", timeout=15)
+    finally:
+        out += web.stop()
+    assert "Traceback" not in out
+
+
+def test_token_is_required(minros_core, ros_home):
+    from websockets.exceptions import InvalidStatus
+
+    web, port = start_web(minros_core, ros_home, "--token", "s3cret")
+    try:
+        with pytest.raises(InvalidStatus) as refused:
+            raw_client(f"ws://127.0.0.1:{port}/?token=wrong")
+        assert refused.value.response.status_code == 401
+        assert b"wrong or missing token" in refused.value.response.body
+        with pytest.raises(urllib.error.HTTPError) as http_refused:
+            urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10)
+        assert http_refused.value.code == 401
+        with raw_client(f"ws://127.0.0.1:{port}/?token=s3cret") as ws:
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t"}))
+            assert json.loads(ws.recv(timeout=10))["result"] is True
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/?token=s3cret", timeout=10) as r:
+            assert r.status == 200
+    finally:
+        out = web.stop()
+    assert "wrong or missing token" in out
+
+
+def test_client_that_never_reads_is_closed_and_others_keep_receiving(minros_core, ros_home):
+    """A rosbridge client subscribes to a 1 MB/s stream and stops reading: the server keeps
+    only its latest messages, closes it after --send-timeout, and another client is served."""
+    env = ros_env(minros_core, ros_home)
+    pub = Proc([PYTHON, "-m", "minros", "topic", "pub", "-r", "50", "/blob", "std_msgs/String",
+                "data: '" + "z" * 20000 + "'"], env)
+    web, port = start_web(minros_core, ros_home, "--send-timeout", "2")
+    try:
+        stalled = socket.create_connection(("127.0.0.1", port))
+        stalled.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        stalled.sendall(b"GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                        b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n")
+        assert b"101 Switching Protocols" in stalled.recv(4096)
+        frame = json.dumps({"op": "subscribe", "topic": "/blob", "type": "std_msgs/String"}).encode()
+        stalled.sendall(bytes([0x81, 0x80 | len(frame)]) + b"\0\0\0\0" + frame)  # masked, key 0
+        received = []
+        with raw_client(f"ws://127.0.0.1:{port}") as ws:
+            ws.send(json.dumps({"op": "subscribe", "topic": "/blob", "type": "std_msgs/String"}))
+            deadline = time.monotonic() + 8
+            while time.monotonic() < deadline:
+                received.append(json.loads(ws.recv(timeout=5)))
+            assert len(received) > 100  # ~50 Hz for 8 s while the stalled client is there
+        out = web.read_until("has not read anything", timeout=10)
+        assert "closing client" in out
+        stalled.close()
+    finally:
+        out = web.stop()
+        pub.stop()
+    assert "Traceback" not in out
+
+
+# -- launch files ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("package, launch_file, needle", [
+    ("rosbridge_server", "rosbridge_websocket.launch", "rosbridge_websocket"),
+    ("foxglove_bridge", "foxglove_bridge.launch", "foxglove_bridge"),
+])
+def test_launch_files_start_the_server(minros_core, ros_home, package, launch_file, needle):
+    port = free_port()
+    launch = Proc([PYTHON, "-m", "minros", "launch", package, launch_file, f"port:={port}"],
+                  ros_env(minros_core, ros_home))
+    try:
+        launch.read_until("listening on", timeout=30)
+        with raw_client(f"ws://127.0.0.1:{port}") as ws:
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/nodes", "id": "n"}))
+            reply = json.loads(ws.recv(timeout=10))
+        assert f"/{needle}" in reply["values"]["nodes"]
+    finally:
+        launch.stop()
+
+
+def test_minros_web_without_master_says_how_to_fix(tmp_path):
+    port = free_port()
+    done = subprocess.run([PYTHON, "-m", "minros", "web", "--port", str(free_port())],
+                          env=ros_env(port, tmp_path), capture_output=True, text=True, timeout=30)
+    assert done.returncode == 1
+    assert done.stderr.strip().startswith("minros web: error: cannot reach the ROS master at")
+    assert "minros core" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_port_in_use_is_one_line(minros_core, ros_home):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        done = subprocess.run([PYTHON, "-m", "minros", "web", "--port", str(port)],
+                              env=ros_env(minros_core, ros_home), capture_output=True, text=True,
+                              timeout=30)
+    assert done.returncode == 1
+    assert f"cannot listen on 127.0.0.1:{port}" in done.stderr and "--port" in done.stderr
+    assert "Traceback" not in done.stderr
+
+

@@ -1,0 +1,83 @@
+"""roslibpy (the PyPI rosbridge client) against `minros web`, run as a subprocess by
+tests/integration/test_web.py: one scenario, one ``RESULT {json}`` line.
+
+    python roslibpy_client.py WS_URL   (turtlesim must be running on the graph)
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import threading
+import time
+
+import roslibpy
+
+
+def main(url: str) -> int:
+    out: dict = {}
+    ros = roslibpy.Ros(url)
+    ros.run(timeout=10)
+    out["connected"] = ros.is_connected
+    out["topics"] = ros.get_topics()
+    out["topic_type"] = ros.get_topic_type("/turtle1/pose")
+    out["nodes"] = ros.get_nodes()
+    out["services"] = ros.get_services()
+    out["service_type"] = ros.get_service_type("/spawn")
+    out["message_details"] = ros.get_message_details("geometry_msgs/Twist")
+    out["request_details"] = ros.get_service_request_details("turtlesim/Spawn")
+
+    poses = []
+    got_pose = threading.Event()
+
+    def on_pose(msg: dict) -> None:
+        poses.append(msg)
+        got_pose.set()
+
+    pose = roslibpy.Topic(ros, "/turtle1/pose", "turtlesim/Pose")
+    pose.subscribe(on_pose)
+    got_pose.wait(10)
+    out["first_pose"] = poses[0] if poses else None
+    cmd = roslibpy.Topic(ros, "/turtle1/cmd_vel", "geometry_msgs/Twist")
+    cmd.advertise()
+    for _ in range(15):
+        cmd.publish(roslibpy.Message({"linear": {"x": 2.0, "y": 0.0, "z": 0.0},
+                                      "angular": {"x": 0.0, "y": 0.0, "z": 0.0}}))
+        time.sleep(0.1)
+    time.sleep(1.0)
+    out["last_pose"] = poses[-1] if poses else None
+    pose.unsubscribe()
+    cmd.unadvertise()
+
+    spawn = roslibpy.Service(ros, "/spawn", "turtlesim/Spawn")
+    out["spawn"] = spawn.call(roslibpy.ServiceRequest({"x": 2.0, "y": 3.0, "theta": 0.0,
+                                                       "name": "webturtle"}), timeout=10)
+    try:
+        spawn.call(roslibpy.ServiceRequest({"x": "not a number"}), timeout=10)
+        out["bad_call"] = "no error"
+    except Exception as exc:
+        out["bad_call"] = str(exc)
+
+    param = roslibpy.Param(ros, "/web_test/gains")
+    param.set({"kp": 1.5, "names": ["a", "b"]})
+    out["param"] = param.get()
+    out["param_names"] = ros.get_params()
+
+    def add(request: dict, response: dict) -> bool:
+        response["sum"] = request["a"] + request["b"]
+        return True
+
+    server = roslibpy.Service(ros, "/web_add", "rospy_tutorials/AddTwoInts")
+    server.advertise(add)
+    time.sleep(0.5)
+    client = roslibpy.Service(ros, "/web_add", "rospy_tutorials/AddTwoInts")
+    out["advertised_call"] = client.call(roslibpy.ServiceRequest({"a": 20, "b": 22}), timeout=10)
+    server.unadvertise()
+    out["time"] = ros.get_time()
+    ros.terminate()
+    print("RESULT " + json.dumps(out, default=dict), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1]))
