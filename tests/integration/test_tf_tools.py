@@ -274,3 +274,98 @@ def test_turtle_tf_demo_turtle2_follows_turtle1(minros_core, ros_home, tmp_path)
     assert result["moved"] > 0.5, result  # turtle1 got away from turtle2...
     assert result["end"] <= 0.5, result   # ...and turtle2 caught up, steered through tf
     assert "Traceback" not in launch_out
+
+
+BAD_CASTER = r'''
+import math
+import rospy
+from geometry_msgs.msg import TransformStamped
+from tf2_msgs.msg import TFMessage
+
+def stamped(parent, child, stamp, x=0.0, w=1.0):
+    t = TransformStamped()
+    t.header.frame_id, t.child_frame_id, t.header.stamp = parent, child, stamp
+    t.transform.translation.x = x
+    t.transform.rotation.w = w
+    return t
+
+rospy.init_node("bad_caster")
+pub = rospy.Publisher("/tf", TFMessage, queue_size=100)
+fixed = rospy.Time(1000)
+print("casting", flush=True)
+rate = rospy.Rate(50)
+
+def cast():
+    now = rospy.Time.now()
+    pub.publish(TFMessage([
+        stamped("world", "good", now, 1.0),
+        stamped("world", "nan_frame", now, float("nan")),   # TF_NAN_INPUT
+        stamped("world", "world", now),                      # TF_SELF_TRANSFORM
+        stamped("world", "squashed", now, w=3.0),            # TF_DENORMALIZED_QUATERNION
+        stamped("c2", "c1", now), stamped("c1", "c2", now),  # a cycle
+        stamped("/world", "/slashed", now, 2.0),             # one leading '/' is stripped
+        stamped("world", "repeat", fixed),                   # TF_REPEATED_DATA from the 2nd on
+    ]))
+
+try:
+    while not rospy.is_shutdown():
+        cast()
+        rate.sleep()
+except rospy.ROSInterruptException:
+    pass
+'''
+
+BAD_READER = r'''
+import time
+import rospy, tf2_ros
+rospy.init_node("bad_reader")
+buf = tf2_ros.Buffer()
+tf2_ros.TransformListener(buf)
+buf.can_transform("world", "good", rospy.Time(), rospy.Duration(20))
+time.sleep(3.0)  # about 150 messages, each with every problem
+def ask(target, source):
+    try:
+        t = buf.lookup_transform(target, source, rospy.Time(), rospy.Duration(0.1))
+        return "ok x=%g" % t.transform.translation.x
+    except tf2_ros.TransformException as exc:
+        return type(exc).__name__
+for pair in (("world", "good"), ("world", "slashed"), ("/world", "good"), ("world", "nan_frame"),
+             ("world", "squashed"), ("c1", "world"), ("world", "repeat")):
+    print("ASK %s %s -> %s" % (pair[0], pair[1], ask(*pair)), flush=True)
+print("DONE", flush=True)
+'''
+
+
+def test_a_misbehaving_broadcaster_gets_tf2s_errors_rate_limited(minros_core, ros_home, tmp_path):
+    """NaN, self transforms, bad quaternions, a cycle, leading slashes and repeated stamps on
+    the wire: the listener reports each problem (not 150 times), keeps the good frames,
+    answers lookups with tf2's exceptions, and neither crashes nor hangs."""
+    env = ros_env(minros_core, ros_home)
+    caster_script, reader_script = tmp_path / "caster.py", tmp_path / "reader.py"
+    caster_script.write_text(BAD_CASTER)
+    reader_script.write_text(BAD_READER)
+    caster = Proc([PYTHON, str(caster_script)], env)
+    reader = None
+    try:
+        caster.read_until("casting", 30)
+        reader = Proc([PYTHON, str(reader_script)], env)
+        out = reader.read_until("DONE", 60)
+    finally:
+        if reader is not None:
+            reader.stop()
+        caster_out = caster.stop()
+    answers = dict(line.split(" -> ") for line in out.splitlines() if line.startswith("ASK "))
+    assert answers == {
+        "ASK world good": "ok x=1",
+        "ASK world slashed": "ok x=2",
+        "ASK /world good": "InvalidArgumentException",
+        "ASK world nan_frame": "LookupException",
+        "ASK world squashed": "LookupException",
+        "ASK c1 world": "LookupException",  # the loop guard
+        "ASK world repeat": "ok x=0",
+    }
+    for code in ("TF_NAN_INPUT", "TF_SELF_TRANSFORM", "TF_DENORMALIZED_QUATERNION", "TF_REPEATED_DATA"):
+        count = out.count(code)
+        assert 1 <= count <= 2, (code, count, out)  # reported, then rate-limited
+    assert 'TF_REPEATED_DATA ignoring data with redundant timestamp for frame repeat (parent world)' in out
+    assert "Traceback" not in out + caster_out

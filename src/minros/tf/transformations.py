@@ -77,6 +77,9 @@ _TUPLE2AXES = {v: k for k, v in _AXES2TUPLE.items()}
 
 def _axes(axes: Any) -> Tuple[int, int, int, int, int, int]:
     """(i, j, k, parity, repetition, frame) of an axes string or 4-tuple."""
+    known = _AXES_INFO.get(axes) if isinstance(axes, str) else None
+    if known is not None:
+        return known
     try:
         first, parity, repetition, frame = _AXES2TUPLE[axes.lower()]
     except (AttributeError, KeyError):
@@ -88,6 +91,11 @@ def _axes(axes: Any) -> Tuple[int, int, int, int, int, int]:
     j = _NEXT_AXIS[first + parity]
     k = _NEXT_AXIS[first - parity + 1]
     return first, j, k, parity, repetition, frame
+
+
+#: the parsed form of every axes string, so that hot loops skip the parsing
+_AXES_INFO: Dict[str, Tuple[int, int, int, int, int, int]] = {}
+_AXES_INFO.update((name, _axes(name)) for name in _AXES2TUPLE)
 
 
 def _vec(data: Any, n: int) -> numpy.ndarray:
@@ -517,14 +525,13 @@ def _euler_quaternion(ai: float, aj: float, ak: float, axes: Any) -> Tuple[float
     if frame:  # rotating frame: the static sequence in reverse order
         ai, ak = ak, ai
     # q = q_last(ak) q_mid(aj) q_first(ai), each q_axis(a) = (sin(a/2) e_axis, cos(a/2))
-    axis_ids = (i, j, i if repetition else k)
-    quats = []
-    for axis, angle in zip(axis_ids, (ai, aj, ak)):
-        half = angle / 2.0
-        q = [0.0, 0.0, 0.0, math.cos(half)]
-        q[axis] = math.sin(half)
-        quats.append(q)
-    return _qmul(_qmul(quats[2], quats[1]), quats[0])
+    first = [0.0, 0.0, 0.0, math.cos(ai / 2.0)]
+    first[i] = math.sin(ai / 2.0)
+    middle = [0.0, 0.0, 0.0, math.cos(aj / 2.0)]
+    middle[j] = math.sin(aj / 2.0)
+    last = [0.0, 0.0, 0.0, math.cos(ak / 2.0)]
+    last[i if repetition else k] = math.sin(ak / 2.0)
+    return _qmul(_qmul(last, middle), first)
 
 
 def _qmul(a: Sequence[float], b: Sequence[float]) -> Tuple[float, float, float, float]:
