@@ -368,6 +368,7 @@ class BufferCore:
         self.cache_time_ns = cache_ns
         self.log = log or _default_log
         self._throttle = _Throttle(warning_interval, clock)
+        self._reports: List[Tuple[int, str]] = []
         self._lock = threading.Lock()
         # Frame 0 is "NO_PARENT", the parent of nothing; caches[i] is None for a frame that
         # has only been seen as a parent.
@@ -383,12 +384,14 @@ class BufferCore:
     def set_transform(self, transform: Any, authority: str, is_static: bool = False) -> bool:
         """Insert a geometry_msgs/TransformStamped; False (and a log line) if refused."""
         with self._lock:
-            return self._insert(transform, authority, is_static)
+            ok = self._insert(transform, authority, is_static)
+        if self._reports:
+            self._emit_reports()
+        return ok
 
     def set_transform_static(self, transform: Any, authority: str) -> bool:
         """Insert a transform valid at any time (what ``/tf_static`` carries)."""
-        with self._lock:
-            return self._insert(transform, authority, True)
+        return BufferCore.set_transform(self, transform, authority, True)
 
     def set_transforms(self, transforms: Iterable[Any], authority: str, is_static: bool = False) -> None:
         """Insert every transform of a tf2_msgs/TFMessage under one lock (the listener's path)."""
@@ -396,18 +399,28 @@ class BufferCore:
         with self._lock:
             for transform in transforms:
                 insert(transform, authority, is_static)
+        if self._reports:
+            self._emit_reports()
 
     def _report(self, level: int, code: str, frame: str, text: str) -> None:
+        """Queue a diagnostic unless rate-limited; ``_emit_reports`` logs it after the lock is
+        released, so a slow log sink never holds up lookups."""
         suppressed = self._throttle.admit((code, frame))
         if suppressed is None:
             return
         if suppressed:
             text += (f" ({suppressed} more like this in the last "
                      f"{self._throttle.interval:g} s not shown)")
-        try:
-            self.log(level, text)
-        except Exception:  # a broken log sink must not break the receive thread
-            pass
+        self._reports.append((level, text))
+
+    def _emit_reports(self) -> None:
+        with self._lock:
+            reports, self._reports = self._reports, []
+        for level, text in reports:
+            try:
+                self.log(level, text)
+            except Exception:  # a broken log sink must not break the receive thread
+                pass
 
     def _insert(self, transform: Any, authority: str, is_static: bool) -> bool:
         header = transform.header
@@ -841,9 +854,11 @@ class BufferCore:
         t = to_nsec(time)
         if target_frame == source_frame:
             return True, ""
-        if self._warn_frame_id("canTransform argument target_frame", target_frame):
-            return False, ""
-        if self._warn_frame_id("canTransform argument source_frame", source_frame):
+        with self._lock:
+            bad = (self._warn_frame_id("canTransform argument target_frame", target_frame)
+                   or self._warn_frame_id("canTransform argument source_frame", source_frame))
+        if bad:
+            self._emit_reports()
             return False, ""
         with self._lock:
             target_id = self._ids.get(target_frame, 0)
@@ -862,10 +877,14 @@ class BufferCore:
                                 source_time: Any, fixed_frame: str) -> Tuple[bool, str]:
         """(possible, why not) for lookup_transform_full_core with the same arguments."""
         tt, st = to_nsec(target_time), to_nsec(source_time)
-        for name, frame in (("target_frame", target_frame), ("source_frame", source_frame),
-                            ("fixed_frame", fixed_frame)):
-            if self._warn_frame_id(f"canTransform argument {name}", frame):
-                return False, ""
+        with self._lock:
+            bad = any(self._warn_frame_id(f"canTransform argument {name}", frame)
+                      for name, frame in (("target_frame", target_frame),
+                                          ("source_frame", source_frame),
+                                          ("fixed_frame", fixed_frame)))
+        if bad:
+            self._emit_reports()
+            return False, ""
         with self._lock:
             target_id = self._ids.get(target_frame, 0)
             source_id = self._ids.get(source_frame, 0)
