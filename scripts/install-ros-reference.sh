@@ -15,11 +15,13 @@ PKGS="ros-core python3-rosmaster python3-roslaunch rosout
   ros-stereo-msgs python3-stereo-msgs ros-trajectory-msgs python3-trajectory-msgs
   ros-visualization-msgs python3-visualization-msgs ros-tf2-msgs python3-tf2-msgs
   ros-roscpp-msg python3-roscpp-msg ros-rosgraph-msgs python3-rosgraph-msgs
-  python3-cv-bridge python3-numpy libroscpp-dev g++ pkg-config python3-catkin-pkg"
+  python3-cv-bridge python3-numpy libroscpp-dev g++ pkg-config python3-catkin-pkg
+  python3-tf2-ros python3-tf python3-tf2-geometry-msgs tf2-tools tf-tools"
 # Tools the tests drive besides ROS: a virtual display for turtlesim's window, zsh for
 # devel/setup.zsh; python3-venv and python3-tk so that minros's own venv can be built on the
-# same interpreter as the reference (scripts/test.sh), turtlesim's Tk window included.
-TEST_TOOLS="xvfb zsh python3-venv python3-tk"
+# same interpreter as the reference (scripts/test.sh), turtlesim's Tk window included;
+# graphviz for view_frames' frames.pdf.
+TEST_TOOLS="xvfb zsh python3-venv python3-tk graphviz"
 # minros web's tests: Debian's Chromium for roslib in a real browser (Playwright drives it),
 # node and npm for Foxglove's and roslib's own client libraries (tests/web/js, npm ci).
 WEB_TEST_TOOLS="chromium nodejs npm"
@@ -27,6 +29,8 @@ if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msg
    && command -v rostopic >/dev/null && command -v catkin_create_pkg >/dev/null \
    && pkg-config --exists roscpp std_msgs && command -v Xvfb >/dev/null && command -v zsh >/dev/null \
    && /usr/bin/python3 -c 'import ensurepip, tkinter' 2>/dev/null \
+   && /usr/bin/python3 -c 'import tf2_py, tf2_ros, tf, tf2_geometry_msgs' 2>/dev/null \
+   && [ -x /usr/lib/tf/tf_echo ] && [ -x /usr/lib/tf2_tools/view_frames.py ] && command -v dot >/dev/null \
    && [ -x /usr/bin/chromium ] && command -v node >/dev/null && command -v npm >/dev/null; then
   echo "ROS 1 reference already installed"
   exit 0

@@ -43,6 +43,23 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     },
     "foxglove_bridge": {"foxglove_bridge": "minros.web.foxglove_bridge"},
     "rosapi": {"rosapi_node": "minros.web.rosapi_node"},
+    # tf's tools (minros.tf): names as Debian's tf-tools and tf2-tools install them
+    "tf2_ros": {
+        "static_transform_publisher": "minros.tf.static_transform_publisher",
+    },
+    "tf": {
+        "static_transform_publisher": "minros.tf.tf_static_transform_publisher",
+        "tf_echo": "minros.tf.tf_echo",
+        "tf_monitor": "minros.tf.tf_monitor",
+        "view_frames": "minros.tf.view_frames",
+    },
+    "tf2_tools": {
+        "view_frames.py": "minros.tf.view_frames",
+    },
+    "turtle_tf": {
+        "turtle_tf_broadcaster.py": "minros.tf.turtle_tf.turtle_tf_broadcaster",
+        "turtle_tf_listener.py": "minros.tf.turtle_tf.turtle_tf_listener",
+    },
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...

@@ -1,0 +1,3 @@
+"""tf.broadcaster stand-in (see minros.tf.tf1)."""
+
+from minros.tf.tf1 import TransformBroadcaster  # noqa: F401

@@ -1,0 +1,6 @@
+"""tf2_ros stand-in: Buffer, TransformListener and the broadcasters (behaviour in minros.tf)."""
+
+from minros.tf.broadcaster import StaticTransformBroadcaster, TransformBroadcaster  # noqa: F401
+from minros.tf.buffer import *  # noqa: F403
+from minros.tf.listener import TransformListener  # noqa: F401
+from tf2_py import *  # noqa: F403 (tf2_ros re-exports tf2_py, the exceptions included)

@@ -1,0 +1,3 @@
+"""tf2_ros.transform_listener stand-in (see minros.tf.listener)."""
+
+from minros.tf.listener import *  # noqa: F403

@@ -1,0 +1,271 @@
+"""tf.transformations: ROS's conventions ([x, y, z, w], 'sxyz' axes), checked on their own and
+against Debian's python3-tf on random inputs (hypothesis, through a /usr/bin/python3 oracle)."""
+
+from __future__ import annotations
+
+import functools
+import math
+import subprocess
+
+import numpy
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+import tf
+from minros.tf import transformations as own
+from minros.tf.testing import OracleError, TfOracle, reference_environment
+from support import IN_CI, REFERENCE_PYTHON
+from tf import transformations as T
+
+AXES = sorted(T._AXES2TUPLE)
+
+
+@functools.cache
+def tf_reference_available() -> bool:
+    probe = subprocess.run([REFERENCE_PYTHON, "-c", "import tf2_py, tf2_ros, tf.transformations"],
+                           env=reference_environment(), capture_output=True, timeout=60)
+    return probe.returncode == 0
+
+
+def require_tf_reference() -> None:
+    if tf_reference_available():
+        return
+    if IN_CI:
+        pytest.fail("Debian's python3-tf/python3-tf2-ros are not installed "
+                    "(scripts/install-ros-reference.sh)")
+    pytest.skip("Debian's python3-tf is not installed")
+
+
+@pytest.fixture(scope="module")
+def oracle():
+    require_tf_reference()
+    o = TfOracle(env=reference_environment())
+    yield o
+    o.close()
+
+
+def close(a, b, tol=1e-9):
+    a, b = numpy.asarray(a, dtype=float), numpy.asarray(b, dtype=float)
+    return a.shape == b.shape and numpy.allclose(a, b, rtol=0, atol=tol)
+
+
+# --------------------------------------------------------------------------- conventions
+
+def test_quaternions_are_xyzw_and_axes_follow_ros():
+    assert numpy.allclose(T.quaternion_from_euler(1, 2, 3, "ryxz"),
+                          [0.310622, -0.718287, 0.444435, 0.435953], atol=1e-6)
+    assert numpy.allclose(T.quaternion_about_axis(0.123, (1, 0, 0)),
+                          [0.06146124, 0, 0, 0.99810947], atol=1e-8)
+    assert numpy.allclose(T.euler_from_quaternion([0.06146124, 0, 0, 0.99810947]),
+                          [0.123, 0, 0], atol=1e-7)
+    # yaw about z by 90 degrees, the default static x-y-z order (roll, pitch, yaw)
+    q = T.quaternion_from_euler(0, 0, math.pi / 2)
+    assert numpy.allclose(q, [0, 0, math.sqrt(0.5), math.sqrt(0.5)])
+    assert numpy.allclose(T.quaternion_matrix(q)[:3, :3] @ [1, 0, 0], [0, 1, 0])
+    # static xyz equals rotating zyx with the angles reversed, and the tuple form works
+    assert numpy.allclose(T.euler_matrix(0.1, 0.2, 0.3, "sxyz"), T.euler_matrix(0.3, 0.2, 0.1, "rzyx"))
+    assert numpy.allclose(T.euler_matrix(1, 2, 3, (0, 1, 0, 1)), T.euler_matrix(1, 2, 3, "ryzx"))
+    assert numpy.allclose(numpy.sum(T.euler_matrix(1, 2, 3, "syxz")[0]), -1.34786452)
+    assert numpy.allclose(T.quaternion_multiply([1, -2, 3, 4], [-5, 6, 7, 8]), [-44, -14, 48, 28])
+    with pytest.raises(KeyError, match="unknown Euler axes"):
+        T.euler_matrix(1, 2, 3, "xyz")
+
+
+def test_matrices_from_the_module_documentation():
+    R = T.rotation_matrix(0.123, (1, 2, 3))
+    assert numpy.allclose(T.quaternion_from_matrix(R), [0.0164262, 0.0328524, 0.0492786, 0.9981095])
+    assert numpy.allclose(numpy.sum(T.orthogonalization_matrix([9.8, 12.0, 15.5], [87.2, 80.7, 69.7])),
+                          43.063229)
+    frustum = (0.1, 0.5, 0.2, 0.9, 0.3, 1.7)
+    m = T.clip_matrix(*frustum)
+    assert numpy.allclose(m @ [0.1, 0.2, 0.3, 1], [-1, -1, -1, 1])
+    v = T.clip_matrix(*frustum, perspective=True) @ [0.5, 0.9, 0.3, 1]
+    assert numpy.allclose(v / v[3], [1, 1, -1, 1])
+    ball = T.Arcball()
+    ball.place([320, 320], 320)
+    ball.down([500, 250])
+    ball.drag([475, 275])
+    assert numpy.allclose(numpy.sum(ball.matrix()), 3.90583455)
+    ball = T.Arcball(initial=[0, 0, 0, 1])
+    ball.place([320, 320], 320)
+    ball.setaxes([1, 1, 0], [-1, 1, 0])
+    ball.setconstrain(True)
+    ball.down([400, 200])
+    ball.drag([200, 400])
+    assert numpy.allclose(numpy.sum(ball.matrix()), 0.2055924)
+    ball.next()
+    scale, shear, angles, trans, persp = T.decompose_matrix(T.scale_matrix(0.123))
+    assert scale[0] == pytest.approx(0.123)
+    assert T.vector_norm([]) == 0.0 and list(T.unit_vector([1.0])) == [1.0]
+    assert T.is_same_transform(numpy.identity(4), numpy.identity(4))
+    assert not T.is_same_transform(numpy.identity(4), T.random_rotation_matrix())
+    # tf's own package exposes the module, as `import tf` does in ROS
+    assert tf.transformations.euler_from_quaternion is T.euler_from_quaternion
+
+
+def test_bad_input_raises_value_errors():
+    with pytest.raises(ValueError, match="invalid frustrum"):
+        T.clip_matrix(1, 0, 0, 1, 0, 1)
+    with pytest.raises(ValueError, match="not orthogonal"):
+        T.shear_matrix(0.3, (1, 0, 0), (0, 0, 0), (1, 0, 0))
+    with pytest.raises(ValueError, match="singular"):
+        T.decompose_matrix(numpy.zeros((4, 4)) + numpy.diag([0, 0, 0, 1]))
+    with pytest.raises(ValueError, match="wrong shape"):
+        T.superimposition_matrix(numpy.zeros((3, 2)), numpy.zeros((3, 2)))
+
+
+# --------------------------------------------------------------------------- against Debian
+
+finite = st.floats(-10, 10, allow_nan=False, allow_infinity=False)
+angle = st.floats(-7, 7, allow_nan=False, allow_infinity=False)
+unit_interval = st.floats(0, 1, exclude_max=True)
+vec3 = st.tuples(finite, finite, finite)
+# quaternions away from zero length (the functions treat |q| < eps as identity)
+quat = st.tuples(finite, finite, finite, finite).filter(lambda q: sum(c * c for c in q) > 1e-3)
+direction = vec3.filter(lambda v: sum(c * c for c in v) > 1e-3)
+
+SETTINGS = settings(max_examples=150, deadline=None,
+                    suppress_health_check=[HealthCheck.function_scoped_fixture])
+
+
+def _not_gimbal_locked(q, axes):
+    """Away from the gimbal lock, where the split between the outer angles is a convention
+    decided by rounding (both libraries agree on the rotation there, not on the split)."""
+    i, j, k, parity, repetition, frame = own._axes(axes)
+    m = T.quaternion_matrix(q)
+    if repetition:
+        return math.hypot(m[i, j], m[i, k]) > 1e-6
+    return math.hypot(m[i, i], m[j, i]) > 1e-6
+
+
+@SETTINGS
+@given(a=angle, b=angle, c=angle, axes=st.sampled_from(AXES + [T._AXES2TUPLE["sxyz"], T._AXES2TUPLE["rzxz"]]))
+def test_euler_to_quaternion_and_matrix_match_debian(oracle, a, b, c, axes):
+    sent = {"t": list(axes)} if isinstance(axes, tuple) else axes  # JSON has no tuples
+    assert close(T.quaternion_from_euler(a, b, c, axes), oracle.transformations("quaternion_from_euler", a, b, c, sent))
+    assert close(T.euler_matrix(a, b, c, axes), oracle.transformations("euler_matrix", a, b, c, sent))
+
+
+@SETTINGS
+@given(q=quat, axes=st.sampled_from(AXES))
+def test_euler_from_quaternion_and_matrix_match_debian(oracle, q, axes):
+    assume(_not_gimbal_locked(q, axes))
+    assert close(T.euler_from_quaternion(q, axes), oracle.transformations("euler_from_quaternion", q, axes))
+    m = T.quaternion_matrix(q)
+    assert close(T.euler_from_matrix(m, axes), oracle.transformations("euler_from_matrix", m, axes))
+
+
+@SETTINGS
+@given(q0=quat, q1=quat, fraction=st.floats(-1, 2), spin=st.integers(-1, 1), shortest=st.booleans())
+def test_quaternion_algebra_matches_debian(oracle, q0, q1, fraction, spin, shortest):
+    assert close(T.quaternion_matrix(q0), oracle.transformations("quaternion_matrix", q0))
+    m = T.quaternion_matrix(q0)
+    assert close(T.quaternion_from_matrix(m), oracle.transformations("quaternion_from_matrix", m))
+    assert close(T.quaternion_multiply(q0, q1), oracle.transformations("quaternion_multiply", q0, q1))
+    assert close(T.quaternion_inverse(q0), oracle.transformations("quaternion_inverse", q0))
+    assert close(T.quaternion_conjugate(q0), oracle.transformations("quaternion_conjugate", q0))
+    assert close(T.quaternion_slerp(q0, q1, fraction, spin, shortest),
+                 oracle.transformations("quaternion_slerp", q0, q1, fraction, spin, shortest), 1e-7)
+
+
+@SETTINGS
+@given(a=angle, axis=direction, point=vec3, factor=st.floats(-5, 5).filter(lambda f: abs(f) > 1e-2),
+       eye=vec3, u=st.tuples(unit_interval, unit_interval, unit_interval))
+def test_matrix_constructors_match_debian(oracle, a, axis, point, factor, eye, u):
+    assert close(T.quaternion_about_axis(a, axis), oracle.transformations("quaternion_about_axis", a, axis))
+    assert close(T.random_quaternion(u), oracle.transformations("random_quaternion", u))
+    assert close(T.rotation_matrix(a, axis, point), oracle.transformations("rotation_matrix", a, axis, point), 1e-8)
+    assert close(T.reflection_matrix(point, axis), oracle.transformations("reflection_matrix", point, axis), 1e-8)
+    assert close(T.scale_matrix(factor, point), oracle.transformations("scale_matrix", factor, point), 1e-8)
+    assert close(T.scale_matrix(factor, point, axis),
+                 oracle.transformations("scale_matrix", factor, point, axis), 1e-8)
+    assert close(T.projection_matrix(point, axis), oracle.transformations("projection_matrix", point, axis), 1e-8)
+    if abs(numpy.dot(T.unit_vector(axis), eye)) > 1e-2:  # a direction not parallel to the plane
+        assert close(T.projection_matrix(point, axis, eye),
+                     oracle.transformations("projection_matrix", point, axis, eye), 1e-7)
+    for pseudo in (False, True):
+        assert close(T.projection_matrix(point, axis, perspective=eye, pseudo=pseudo),
+                     oracle.transformations("projection_matrix", point, axis, perspective=eye,
+                                            pseudo=pseudo), 1e-8)
+    assert close(T.translation_matrix(point), oracle.transformations("translation_matrix", point))
+
+
+def same_up_to_scale(a, b):
+    """Two homogeneous matrices that transform alike (also when M[3, 3] is 0)."""
+    a, b = numpy.asarray(a, dtype=float), numpy.asarray(b, dtype=float)
+    a = a / numpy.linalg.norm(a)
+    b = b / numpy.linalg.norm(b)
+    return numpy.allclose(a, b, atol=1e-7) or numpy.allclose(a, -b, atol=1e-7)
+
+
+@SETTINGS
+@given(a=st.floats(-3, 3).filter(lambda v: abs(v) > 1e-3), axis=direction, point=vec3,
+       factor=st.floats(0.1, 5).filter(lambda f: abs(f - 1) > 1e-2), eye=vec3,
+       other=direction)
+def test_decompositions_rebuild_the_same_transform(oracle, a, axis, point, factor, eye, other):
+    """Where the answer is not unique (axis sign, a point on a line or plane) ours rebuilds
+    the matrix; where a part of it is unique (a rotation's angle up to the axis sign, a scale
+    factor) it equals Debian's."""
+    rotation = T.rotation_matrix(a, axis, point)
+    angle, direc, _ = T.rotation_from_matrix(rotation)
+    assert T.is_same_transform(T.rotation_matrix(*T.rotation_from_matrix(rotation)), rotation)
+    theirs = oracle.transformations("rotation_from_matrix", rotation)
+    assert abs(angle) == pytest.approx(abs(theirs[0]), abs=1e-7)
+    assert numpy.allclose(numpy.abs(direc), numpy.abs(theirs[1]), atol=1e-7)
+    mirror = T.reflection_matrix(point, axis)
+    assert T.is_same_transform(T.reflection_matrix(*T.reflection_from_matrix(mirror)), mirror)
+    for scaling in (T.scale_matrix(factor, point), T.scale_matrix(factor, point, axis)):
+        ours = T.scale_from_matrix(scaling)
+        assert T.is_same_transform(T.scale_matrix(*ours), scaling)
+        assert ours[0] == pytest.approx(oracle.transformations("scale_from_matrix", scaling)[0])
+    normal = numpy.cross(axis, other)
+    if numpy.linalg.norm(normal) > 1e-2:
+        shear = T.shear_matrix(a / 3, axis, point, normal)
+        assert T.is_same_transform(T.shear_matrix(*T.shear_from_matrix(shear)), shear)
+    if abs(numpy.dot(T.unit_vector(axis), numpy.subtract(eye, point))) > 1e-1:
+        for pseudo in (False, True):
+            persp = T.projection_matrix(point, axis, perspective=eye, pseudo=pseudo)
+            assert same_up_to_scale(T.projection_matrix(*T.projection_from_matrix(persp, pseudo)), persp)
+    ortho = T.projection_matrix(point, axis)
+    assert T.is_same_transform(T.projection_matrix(*T.projection_from_matrix(ortho)), ortho)
+    if abs(numpy.dot(T.unit_vector(axis), T.unit_vector(other))) > 1e-1:
+        parallel = T.projection_matrix(point, axis, other)
+        assert T.is_same_transform(T.projection_matrix(*T.projection_from_matrix(parallel)), parallel)
+
+
+@SETTINGS
+@given(scale=st.tuples(*[st.floats(0.2, 3)] * 3), shear=st.tuples(*[st.floats(-0.5, 0.5)] * 3),
+       angles=st.tuples(*[st.floats(-1.5, 1.5)] * 3), trans=vec3,
+       persp=st.tuples(*[st.floats(-0.1, 0.1)] * 3))
+def test_compose_and_decompose_match_debian(oracle, scale, shear, angles, trans, persp):
+    p = list(persp) + [1.0]
+    m = T.compose_matrix(scale, shear, angles, trans, p)
+    assert close(m, oracle.transformations("compose_matrix", scale, shear, angles, trans, p), 1e-9)
+    ours = T.decompose_matrix(m)
+    theirs = oracle.transformations("decompose_matrix", m)
+    for a, b in zip(ours, theirs):
+        assert close(a, b, 1e-7)
+
+
+@SETTINGS
+@given(u=st.tuples(unit_interval, unit_interval, unit_interval), trans=vec3,
+       scale=st.floats(0.5, 2), scaling=st.booleans(), usesvd=st.booleans(),
+       seed=st.integers(0, 2 ** 16))
+def test_superimposition_matches_debian(oracle, u, trans, scale, scaling, usesvd, seed):
+    rng = numpy.random.default_rng(seed)
+    v0 = rng.normal(size=(3, 8)) * 3
+    m = T.concatenate_matrices(T.translation_matrix(trans), T.random_rotation_matrix(u),
+                               T.scale_matrix(scale))
+    v1 = (m @ numpy.vstack([v0, numpy.ones(8)]))[:3] + rng.normal(size=(3, 8)) * 1e-3
+    ours = T.superimposition_matrix(v0, v1, scaling, usesvd)
+    assert close(ours, oracle.transformations("superimposition_matrix", v0, v1, scaling, usesvd), 1e-7)
+
+
+def test_errors_match_debian(oracle):
+    with pytest.raises(OracleError, match="ValueError: invalid frustrum"):
+        oracle.transformations("clip_matrix", 1, 0, 0, 1, 0, 1)
+    with pytest.raises(ValueError, match="invalid frustrum"):
+        T.clip_matrix(1, 0, 0, 1, 0, 1)
+    with pytest.raises(OracleError, match="ValueError: direction and normal vectors are not orthogonal"):
+        oracle.transformations("shear_matrix", 0.3, (1, 0, 0), (0, 0, 0), (1, 0, 0))
