@@ -16,14 +16,14 @@ import importlib
 import os
 from typing import Any, Dict
 
+from minros.client.imshow import install as _install_imshow
 from minros.msgs import install_import_hook as _install_import_hook
-from minros.web.imshow import install as _install_imshow
 
 __version__ = "0.1.0"
 
 # `from my_pkg.msg import Foo` for any package on ROS_PACKAGE_PATH, without a build step.
 _install_import_hook()
-# cv2.imshow in an OpenCV without GUI publishes its windows for `minros web` (web/imshow.py).
+# cv2.imshow in an OpenCV without GUI publishes its windows for `minros web` (client/imshow.py).
 _install_imshow()
 
 _EXCEPTIONS = ("ROSException", "ROSSerializationException", "ROSInitException",

@@ -12,8 +12,9 @@ import struct
 import numpy as np
 import pytest
 
+from minros.client import imshow
 from minros.msgs import Duration, Time, get_message_class, get_service_class
-from minros.web import cbor, imshow, rosapi, video
+from minros.web import cbor, rosapi, video
 from minros.web import foxglove_protocol as fp
 from minros.web.convert import ConversionError, message_to_json, populate_message, request_values
 from minros.web.outbox import Outbox

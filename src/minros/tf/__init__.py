@@ -11,7 +11,7 @@ ROS 1's tf2 core is C++ (tf2_py); here every piece is Python:
 * ``transformations``: tf.transformations, written from the mathematics;
 * tools run with ``python -m``: ``static_transform_publisher`` (tf2_ros's),
   ``tf_static_transform_publisher`` (tf's periodic one), ``tf_echo``, ``tf_monitor``,
-  ``view_frames``; ``turtle_tf`` holds the turtlesim tf tutorial's nodes.
+  ``view_frames`` (the turtlesim tf tutorial's nodes are minros.nodes.turtle_tf).
 
 The ROS-named packages ``tf``, ``tf2_ros``, ``tf2_py`` and ``tf2_geometry_msgs`` in
 ``stubs/`` re-export these modules.

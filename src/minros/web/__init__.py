@@ -4,6 +4,7 @@ web_video_server's endpoints on one port, plus the headless ``cv2.imshow`` bridg
 Modules: ``convert`` and ``cbor`` (rosbridge's message encodings), ``foxglove_protocol`` (frame
 codecs), ``rosapi`` (introspection services), ``outbox`` (bounded per-client queues),
 ``rosbridge`` and ``foxglove`` (one client session each), ``video`` (image feeds, JPEG),
-``state`` (the ROS side, one object), ``server`` (the websockets server), ``node`` (running it),
-``imshow`` (imshow windows as image topics). Importing this package imports none of them.
+``state`` (the ROS side, one object), ``server`` (the websockets server), ``node`` (running it).
+Importing this package imports none of them. The nodes' side of the imshow bridge (windows
+published as image topics) is ``minros.client.imshow``, installed by ``import rospy``.
 """

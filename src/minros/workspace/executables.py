@@ -57,8 +57,8 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
         "view_frames.py": "minros.tf.view_frames",
     },
     "turtle_tf": {
-        "turtle_tf_broadcaster.py": "minros.tf.turtle_tf.turtle_tf_broadcaster",
-        "turtle_tf_listener.py": "minros.tf.turtle_tf.turtle_tf_listener",
+        "turtle_tf_broadcaster.py": "minros.nodes.turtle_tf.turtle_tf_broadcaster",
+        "turtle_tf_listener.py": "minros.nodes.turtle_tf.turtle_tf_listener",
     },
 }
 

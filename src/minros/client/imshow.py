@@ -17,7 +17,6 @@ when (and if) the program imports it.
 
 from __future__ import annotations
 
-import importlib.abc
 import importlib.machinery
 import os
 import re
@@ -71,21 +70,25 @@ def displayable(image: Any) -> Any:
     return np.ascontiguousarray(array[:, :, 0]), "mono8"
 
 
-def _node_ready() -> bool:
-    import minros
+# The node runtime and the client library are imported when a window is first shown, not when
+# `import rospy` installs the hook: importing minros (and every tool) stays light.
 
-    return minros.get_node_uri() is not None
+
+def _node_ready() -> bool:
+    from minros import node
+
+    return node.get_node_uri() is not None
 
 
 def _publisher(window: str) -> Any:
-    import minros
+    from minros.client.topics import Publisher  # not at import: `import rospy` stays light
     from sensor_msgs.msg import Image
 
     topic = topic_for(window)
     with _lock:
         pub = _publishers.get(topic)
         if pub is None:
-            pub = minros.Publisher(topic, Image, queue_size=1)
+            pub = Publisher(topic, Image, queue_size=1)
             _publishers[topic] = pub
     if topic not in _announced:
         _announced.add(topic)
@@ -112,7 +115,9 @@ def imshow(winname: str, mat: Any) -> None:
 
     pixels, encoding = displayable(mat)
     msg = Image()
-    msg.header.stamp = __import__("minros").get_rostime()
+    from minros.client import rostime
+
+    msg.header.stamp = rostime.get_rostime()
     msg.header.frame_id = str(winname)
     msg.height, msg.width = int(pixels.shape[0]), int(pixels.shape[1])
     msg.encoding = encoding
@@ -123,13 +128,12 @@ def imshow(winname: str, mat: Any) -> None:
 
 def waitKey(delay: int = 0) -> int:  # noqa: N802 - OpenCV's name
     """No keyboard: wait ``delay`` ms (forever, until shutdown, when ``delay <= 0``); -1."""
-    import minros
+    from minros import node
 
     if delay and delay > 0:
         time.sleep(delay / 1000.0)
         return -1
-    while not minros.is_shutdown():
-        time.sleep(0.1)
+    node.wait_for_shutdown(None)
     return -1
 
 
@@ -182,7 +186,10 @@ def patch(cv2: Any) -> bool:
     return True
 
 
-class _PatchingLoader(importlib.abc.Loader):
+class _PatchingLoader:
+    """A loader that runs cv2's own, then patches the module (the import protocol is duck-typed:
+    subclassing importlib.abc would cost every `import rospy` importlib.resources)."""
+
     def __init__(self, loader: Any) -> None:
         self.loader = loader
 
@@ -197,7 +204,7 @@ class _PatchingLoader(importlib.abc.Loader):
             pass
 
 
-class _Cv2Finder(importlib.abc.MetaPathFinder):
+class _Cv2Finder:
     """Wraps the loader of the top-level ``cv2`` module so it is patched once imported."""
 
     def find_spec(self, fullname: str, path: Any, target: Any = None) -> Any:
