@@ -36,6 +36,11 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
         "mimic": "minros.turtlesim.mimic",
         "draw_square": "minros.turtlesim.draw_square",
     },
+    # the record and play programs that `rosbag record|play` run in ROS 1
+    "rosbag": {
+        "record": "minros.bag.record",
+        "play": "minros.bag.play",
+    },
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...
