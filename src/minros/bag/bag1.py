@@ -389,6 +389,20 @@ _COMPRESSION_FORMATS = {Compression.BZ2: _rb_writer.Writer.CompressionFormat.BZ2
                         Compression.LZ4: _rb_writer.Writer.CompressionFormat.LZ4}
 
 
+def _roslz4_compress(data: bytes) -> bytes:
+    """An LZ4 frame ROS's roslz4 can read: rosbags' frames store the content size, a header
+    field roslz4 rejects ("malformed data"), so the frame is written without it."""
+    import lz4.frame
+
+    return lz4.frame.compress(data, compression_level=0, content_checksum=True, store_size=False)
+
+
+def _set_compression(w: _rb_writer.Writer, compression: str) -> None:
+    w.set_compression(_COMPRESSION_FORMATS[compression])
+    if compression == Compression.LZ4:
+        w.compressor = _roslz4_compress
+
+
 class Bag1Writer:
     """A bag v2.0 being written: rosbags' ``Writer`` with one connection per distinct header,
     chunks closed by size or on request (``flush_chunk``), and data handed to the kernel after
@@ -404,7 +418,7 @@ class Bag1Writer:
                 self.path.unlink()  # rosbag truncates; rosbags refuses an existing file
             self._w = _rb_writer.Writer(self.path)
             if compression != Compression.NONE:
-                self._w.set_compression(_COMPRESSION_FORMATS[compression])
+                _set_compression(self._w, compression)
             self._w.open()
         else:
             self._w = self._reopen(bio, existing, compression)
@@ -419,7 +433,7 @@ class Bag1Writer:
         w.compressor = lambda x: x
         w.compression_format = "none"
         if compression != Compression.NONE:
-            w.set_compression(_COMPRESSION_FORMATS[compression])
+            _set_compression(w, compression)
         conns = [c._replace(owner=w) for c in existing.connections]
         if [c.id for c in conns] != list(range(len(conns))):
             raise ROSBagException("cannot append to a bag whose connection ids are not 0..N-1")

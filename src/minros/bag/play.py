@@ -314,23 +314,20 @@ class Player:
 
         minros.on_shutdown(self.stop.set)
         self.advertise()
-        if not self.opts.quiet:
-            self.out.write(f"\nWaiting {self.opts.delay:.1f} seconds after advertising topics...")
-            self.out.flush()
+        # rosbag's player prints these even with -q, which hides only the status line
+        self.out.write(f"\nWaiting {self.opts.delay:.1f} seconds after advertising topics...")
+        self.out.flush()
         if self.stop.wait(max(self.opts.delay, 0.0)):
             return 0
-        if not self.opts.quiet:
-            self.out.write(" done.\n\n")
+        self.out.write(" done.\n\n")
         if self.opts.wait_for_subscribers:
-            if not self.opts.quiet:
-                self.out.write("Waiting for subscribers.\n")
-                self.out.flush()
+            self.out.write("Waiting for subscribers.\n")
+            self.out.flush()
             while not all(p.get_num_connections() > 0 for p in self.publishers.values()):
                 if self.stop.wait(0.05):
                     return 0
-        if not self.opts.quiet:
-            self.out.write("Hit space to toggle paused, or 's' to step.\n")
-            self.out.flush()
+        self.out.write("Hit space to toggle paused, or 's' to step.\n")
+        self.out.flush()
         keyboard = Keyboard()
         try:
             while True:
@@ -338,7 +335,7 @@ class Player:
                     break
                 if not self.opts.loop:
                     break
-            if not self.stop.is_set() and not self.opts.quiet:
+            if not self.stop.is_set():
                 self.out.write("\nDone.\n")
                 self.out.flush()
             if self.opts.keep_alive:
