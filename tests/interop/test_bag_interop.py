@@ -21,7 +21,15 @@ from typing import Dict, List
 import pytest
 
 from integration.pubsub_scripts import TALKER
-from support import PYTHON, REFERENCE_PYTHON, Proc, reference_env, require_reference, ros_env, wait_until
+from support import (
+    PYTHON,
+    REFERENCE_PYTHON,
+    Proc,
+    reference_env,
+    require_reference,
+    ros_env,
+    wait_until,
+)
 
 pytestmark = pytest.mark.interop
 
@@ -239,7 +247,7 @@ def test_bad_input_one_line_each(debian_rosmaster, ros_home, tmp_path):
         assert fixed.returncode == 0, fixed.stderr
         messages = debian_read(tmp_path / name)
         assert len(messages) >= (300 if name == "unindexed.bag" else 150)
-        assert [m[2][:4] for m in messages] == ["m%03d" % i for i in range(len(messages))]
+        assert [m[2][:4] for m in messages] == [f"m{i:03d}" for i in range(len(messages))]
     play = minros_bag(debian_rosmaster, ros_home, tmp_path, "play", "notabag.bag")
     assert play.returncode == 1 and "notabag.bag" in play.stderr and "not appear to be a bag" in play.stderr
     _no_traceback(play.stdout + play.stderr)
