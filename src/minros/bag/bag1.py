@@ -420,6 +420,7 @@ class Bag1Writer:
             if compression != Compression.NONE:
                 _set_compression(self._w, compression)
             self._w.open()
+            self._w.bio.flush()  # the file header reaches the kernel before any message
         else:
             self._w = self._reopen(bio, existing, compression)
         self._w.chunk_threshold = chunk_threshold
