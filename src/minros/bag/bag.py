@@ -14,7 +14,7 @@ import sys
 import time
 from typing import Any, Callable, Dict, Iterator, List, Optional, Union
 
-from minros.bag import bag1, mcapfile
+from minros.bag import bag1
 from minros.bag.bag1 import ConnInfo
 from minros.bag.errors import (
     COMPRESSIONS,
@@ -106,7 +106,7 @@ class Bag:
         if not os.path.exists(self._filename):
             self._writer = bag1.Bag1Writer(self._filename, self._compression, self._chunk_threshold)
             return
-        if mcapfile.is_mcap(self._filename):
+        if is_mcap(self._filename):
             raise ROSBagException("appending to MCAP files is not supported")
         try:
             scan = bag1.summary_scan(self._filename)
@@ -284,7 +284,7 @@ class Bag:
             conn = conns[cid]
             cls = classes[cid]
             if raw:
-                msg: Any = (conn.datatype, data, conn.md5sum, pos, cls)
+                msg: Any = (conn.datatype, bytes(data), conn.md5sum, pos, cls)
             else:
                 msg = cls()
                 msg.deserialize(data)
@@ -483,15 +483,31 @@ class Bag:
         return info_yaml(self, key, with_freq=not self._skip_index)
 
 
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def is_mcap(path: str) -> bool:
+    """Whether ``path`` starts with MCAP's magic bytes (else it is taken for a bag)."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(len(MCAP_MAGIC)) == MCAP_MAGIC
+    except OSError:
+        return False
+
+
 def _open_reader(path: str, allow_unindexed: bool) -> Any:
     if not os.path.exists(path):
         raise ROSBagException(f"[Errno 2] No such file or directory: '{path}'")
-    if mcapfile.is_mcap(path):
+    if is_mcap(path):
+        from minros.bag import mcapfile  # imported only for MCAP files: rosbag info starts faster
+
         return mcapfile.McapReader(path, allow_unindexed)
     return bag1.Bag1Reader(path, allow_unindexed)
 
 
 def _open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
     if path.endswith(".mcap") or path.endswith(".mcap.active"):
+        from minros.bag import mcapfile
+
         return mcapfile.McapWriter(path, compression, chunk_threshold)
     return bag1.Bag1Writer(path, compression, chunk_threshold)

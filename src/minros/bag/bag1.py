@@ -14,12 +14,14 @@ rosbags (Ternaris) reads and writes the records; minros adds only what it lacks:
 
 from __future__ import annotations
 
+import operator
 import os
+import struct
 from collections import defaultdict
 from dataclasses import dataclass, field
 from io import BytesIO
 from pathlib import Path
-from typing import Callable, Dict, Iterator, List, Optional, Tuple
+from typing import Any, Callable, Dict, Iterator, List, Optional, Tuple
 
 from rosbags.interfaces import (
     Connection,
@@ -40,6 +42,10 @@ from minros.bag.errors import (
 )
 
 MAGIC = b"#ROSBAG V2.0\n"
+_U32 = struct.Struct("<I")
+#: the op field of a CONNECTION record header, as it appears in the header bytes
+_OP_CONNECTION = b"op=\x07"
+_by_time = operator.itemgetter(0)
 #: the file header record is padded to this many bytes (after the magic line)
 FILE_HEADER_LENGTH = 4096
 #: where the first record after the file header starts
@@ -355,18 +361,47 @@ class Bag1Reader:
         return [e.time for e in heapq.merge(*(self._reader.indexes.get(c, []) for c in conn_ids))]
 
     def messages(self, conn_ids: Optional[List[int]], start: Optional[int],
-                 end: Optional[int]) -> Iterator[Tuple[int, int, bytes, Tuple[int, int]]]:
-        """(connection id, time ns, serialized bytes, position) in time order; times inclusive."""
+                 end: Optional[int]) -> Iterator[Tuple[int, int, Any, Tuple[int, int]]]:
+        """(connection id, time ns, serialized bytes, position) in time order; times inclusive.
+
+        The bytes are a memoryview into the decompressed chunk. rosbags' ``Reader.messages``
+        parses every record header and copies every message; the index already says where
+        each message is and to which connection and time it belongs, so this loop only steps
+        over the record header (and any CONNECTION record before it) and slices the data."""
         r = self._reader
         r.load_index()
-        conns = [c for c in r.connections if conn_ids is None or c.id in conn_ids]
-        if not conns:
-            return
-        try:
-            for conn, t, data in r.messages(conns, start, None if end is None else end + 1):
-                yield conn.id, t, data, (0, 0)
-        except ReaderError as exc:
-            raise ROSBagFormatException(str(exc.args[0]) if exc.args else str(exc)) from None
+        assert r.bio is not None
+        entries = []
+        for conn in r.connections:
+            if conn_ids is not None and conn.id not in conn_ids:
+                continue
+            cid = conn.id
+            entries.extend((e.time, e.chunk_pos, e.offset, cid) for e in r.indexes.get(cid, ())
+                           if (start is None or e.time >= start) and (end is None or e.time <= end))
+        entries.sort(key=_by_time)  # stable: equal times keep the connection order, as heapq.merge
+        bio = r.bio
+        current = -1
+        buf = memoryview(b"")
+        for t, chunk_pos, offset, cid in entries:
+            if chunk_pos != current:
+                chunk = r.chunks[chunk_pos]
+                bio.seek(chunk.datapos)
+                data = bio.read(chunk.datasize)
+                if len(data) != chunk.datasize:
+                    raise ROSBagFormatException(f"chunk at {chunk_pos} is cut short")
+                buf = memoryview(chunk.decompressor(data))
+                current = chunk_pos
+            try:
+                while True:
+                    (hlen,) = _U32.unpack_from(buf, offset)
+                    dpos = offset + 4 + hlen
+                    (dlen,) = _U32.unpack_from(buf, dpos)
+                    if _OP_CONNECTION not in buf[offset + 4:dpos]:
+                        break
+                    offset = dpos + 4 + dlen  # a CONNECTION record before the message
+            except struct.error:
+                raise ROSBagFormatException(f"index entry points past chunk at {chunk_pos}") from None
+            yield cid, t, buf[dpos + 4:dpos + 4 + dlen], (chunk_pos, offset)
 
     def close(self) -> None:
         if self._reader.bio is not None:

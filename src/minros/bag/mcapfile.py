@@ -8,7 +8,6 @@ as the profile specifies. The same reader and writer interface as :mod:`minros.b
 
 from __future__ import annotations
 
-import heapq
 from pathlib import Path
 from typing import Dict, Iterator, List, Optional, Tuple
 
@@ -19,21 +18,12 @@ from mcap.writer import CompressionType, Writer
 from minros.bag.bag1 import ChunkSummary, ConnInfo
 from minros.bag.errors import ROSBagException, ROSBagFormatException, ROSBagUnindexedException
 
-MAGIC = b"\x89MCAP0\r\n"
 PROFILE = "ros1"
 SCHEMA_ENCODING = "ros1msg"
 MESSAGE_ENCODING = "ros1"
 
 _COMPRESSION = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
                 "zstd": CompressionType.ZSTD, "bz2": CompressionType.ZSTD}
-
-
-def is_mcap(path: str) -> bool:
-    try:
-        with open(path, "rb") as f:
-            return f.read(len(MAGIC)) == MAGIC
-    except OSError:
-        return False
 
 
 def _conn(channel, schema) -> ConnInfo:
@@ -199,8 +189,3 @@ class McapWriter:
 
     def abort(self) -> None:
         self._f.close()
-
-
-def merge_sorted(*iterators: Iterator[tuple]) -> Iterator[tuple]:
-    """Messages of several sources in time order (field 1 is the time)."""
-    return heapq.merge(*iterators, key=lambda m: m[1])

@@ -8,8 +8,8 @@ import shutil
 import sys
 from typing import Any, Callable, List, Optional
 
-from minros.bag import bag1, mcapfile
-from minros.bag.bag import Bag
+from minros.bag import bag1
+from minros.bag.bag import Bag, is_mcap
 from minros.bag.errors import Compression, ROSBagException, ROSBagUnindexedException
 from minros.bag.progress import ProgressMeter
 
@@ -138,7 +138,7 @@ def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
         except (ROSBagException, OSError) as exc:
             _err(f"ERROR reading {path}: {exc}")
             continue
-        if reindex and mcapfile.is_mcap(path):
+        if reindex and is_mcap(path):
             _err(f"ERROR reading {path}: reindexing MCAP files is not supported by minros")
             continue
         out = path if output_dir is None else os.path.join(output_dir, os.path.basename(path))

@@ -9,6 +9,7 @@ sleeps until a millisecond before each send and waits the rest in short naps.
 from __future__ import annotations
 
 import heapq
+import itertools
 import os
 import select
 import sys
@@ -285,11 +286,15 @@ class Player:
         start = bag_start + int(self.opts.start * 1e9)
         end = start + int(self.opts.duration * 1e9) if self.opts.duration else None
         span = (bag_start, bag_end)
+        stream = self.messages(start, end)
+        first = next(stream, None)  # reading the index and the first chunk is not playing time
+        if first is None:
+            return True
         tr = TimeTranslator(self.opts.rate)
         tr.set(start, time.monotonic())
         last_t: Optional[int] = None
         pause_topics = {t if t.startswith("/") else "/" + t for t in self.opts.pause_topics}
-        for t, i, cid, data in self.messages(start, end):
+        for t, i, cid, data in itertools.chain((first,), stream):
             if last_t is not None and self.opts.skip_empty is not None and \
                     (t - last_t) / 1e9 > self.opts.skip_empty:
                 tr.shift(-((t - last_t) / 1e9 / self.opts.rate))

@@ -20,7 +20,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Deque, Dict, List, Optional, Tuple
 
-from minros.bag import bag1, mcapfile
+from minros.bag import bag1
 from minros.bag.errors import Compression
 
 #: a chunk is closed and written out at least this often (seconds) while messages arrive
@@ -174,6 +174,8 @@ class BagSink:
             os.unlink(self.active)
         chunk = self.opts.chunksize_kb * 1024
         if self.target.endswith(".mcap"):
+            from minros.bag import mcapfile
+
             self.writer = mcapfile.McapWriter(self.active, self.opts.compression, chunk)
         else:
             self.writer = bag1.Bag1Writer(self.active, self.opts.compression, chunk)
