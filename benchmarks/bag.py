@@ -224,6 +224,10 @@ class Bench:
             self.stop(recorder, timeout=300, group=who == "minros")
         from minros.bag import Bag
 
+        # rosbag's wrapper exits at once on SIGINT; its record program is still closing the bag
+        deadline = time.monotonic() + 120
+        while os.path.exists(path + ".active") and time.monotonic() < deadline:
+            time.sleep(0.1)
         if not os.path.exists(path) and os.path.exists(path + ".active"):
             from minros.bag import bag1  # the recorder did not close its bag: count what it holds
 

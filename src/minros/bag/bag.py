@@ -280,6 +280,7 @@ class Bag:
         headers = {cid: c.header for cid, c in conns.items()} if with_header else {}
         classes = {cid: self._class_for(c) for cid, c in conns.items()}
         ids = None if len(conns) == len(source.connections) else list(conns)
+        new_time = Time.__new__
         for cid, t, data, pos in source.messages(ids, start, end):
             conn = conns[cid]
             cls = classes[cid]
@@ -288,7 +289,8 @@ class Bag:
             else:
                 msg = cls()
                 msg.deserialize(data)
-            stamp = Time(t // 1_000_000_000, t % 1_000_000_000)
+            stamp = new_time(Time)  # filled in directly: two __init__ calls per message add up
+            stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
             if with_header:
                 yield BagMessageWithConnectionHeader(conn.topic, msg, stamp, headers[cid])
             else:

@@ -14,6 +14,8 @@ rosbags (Ternaris) reads and writes the records; minros adds only what it lacks:
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import operator
 import os
 import struct
@@ -43,9 +45,9 @@ from minros.bag.errors import (
 
 MAGIC = b"#ROSBAG V2.0\n"
 _U32 = struct.Struct("<I")
-#: the op field of a CONNECTION record header, as it appears in the header bytes
-_OP_CONNECTION = b"op=\x07"
 _by_time = operator.itemgetter(0)
+_chunk_pos = operator.itemgetter(1)
+_offset = operator.itemgetter(2)
 #: the file header record is padded to this many bytes (after the magic line)
 FILE_HEADER_LENGTH = 4096
 #: where the first record after the file header starts
@@ -296,6 +298,16 @@ def _scan_chunk(raw: bytes, pos: int, known: Dict[int, Connection]
     return chunk, entries
 
 
+def _record_op(buf: memoryview, start: int, end: int) -> int:
+    """The ``op`` of the record header in ``buf[start:end]`` (-1 when it has none)."""
+    while start < end:
+        (size,) = _U32.unpack_from(buf, start)
+        if buf[start + 4:start + 7] == b"op=":
+            return buf[start + 7]
+        start += 4 + size
+    return -1
+
+
 class Bag1Reader:
     """A bag v2.0 opened for reading: connections and chunk summaries at once, the message
     index when messages are first read."""
@@ -371,13 +383,17 @@ class Bag1Reader:
         r = self._reader
         r.load_index()
         assert r.bio is not None
-        entries = []
+        entries: List[Tuple[int, int, int, int]] = []
         for conn in r.connections:
             if conn_ids is not None and conn.id not in conn_ids:
                 continue
-            cid = conn.id
-            entries.extend((e.time, e.chunk_pos, e.offset, cid) for e in r.indexes.get(cid, ())
-                           if (start is None or e.time >= start) and (end is None or e.time <= end))
+            index = r.indexes.get(conn.id, [])  # sorted by time
+            lo = 0 if start is None else bisect.bisect_left(index, (start,))
+            hi = len(index) if end is None else bisect.bisect_right(index, (end,))
+            part = index[lo:hi]
+            # (time, chunk_pos, offset, connection) built by C-level iterators, not per-entry Python
+            entries.extend(zip(map(_by_time, part), map(_chunk_pos, part), map(_offset, part),
+                               itertools.repeat(conn.id)))
         entries.sort(key=_by_time)  # stable: equal times keep the connection order, as heapq.merge
         bio = r.bio
         current = -1
@@ -396,7 +412,7 @@ class Bag1Reader:
                     (hlen,) = _U32.unpack_from(buf, offset)
                     dpos = offset + 4 + hlen
                     (dlen,) = _U32.unpack_from(buf, dpos)
-                    if _OP_CONNECTION not in buf[offset + 4:dpos]:
+                    if _record_op(buf, offset + 4, dpos) != RecordType.CONNECTION:
                         break
                     offset = dpos + 4 + dlen  # a CONNECTION record before the message
             except struct.error:
