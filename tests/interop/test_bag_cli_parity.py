@@ -35,10 +35,10 @@ with Bag(sys.argv[1], "w", chunk_threshold=4000) as b:
 
 
 def _run(minros: bool, *argv: str, cwd: Path, timeout: float = 60) -> subprocess.CompletedProcess:
-    """``minros TOOL ...`` or Debian's ``rosTOOL ...`` (TOOL: bag, topic, msg)."""
+    """minros's ``rosTOOL ...`` console script or Debian's (TOOL: bag, topic, msg)."""
     env = dict(os.environ, TZ="UTC")
     if minros:
-        cmd = [PYTHON, "-m", "minros", *argv]
+        cmd = [str(Path(PYTHON).parent / f"ros{argv[0]}"), *argv[1:]]
     else:
         cmd, env = [f"/usr/bin/ros{argv[0]}", *argv[1:]], reference_env(env)
     return subprocess.run(cmd, env=env, cwd=cwd, capture_output=True, text=True, timeout=timeout)

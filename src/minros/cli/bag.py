@@ -27,10 +27,10 @@ DESCRIPTIONS = {
 }
 
 
-def _parser(prog: str, usage: str, description: str) -> optparse.OptionParser:
+def _parser(prog: str, usage: str, description: str, **kw) -> optparse.OptionParser:
     """``prog`` is the tool ("rosbag" or "minros bag"): usage errors read "<prog>: error: ..."."""
     return optparse.OptionParser(usage=usage.replace("rosbag", prog, 1), description=description,
-                                 prog=prog)
+                                 prog=prog, **kw)
 
 
 def _fail(text: str, status: int = 1) -> int:
@@ -51,8 +51,8 @@ def _handle_split(option, opt_str, value, parser) -> None:
 
 
 def record_parser(prog: str, node: bool = False) -> optparse.OptionParser:
-    p = _parser(prog, "rosbag record TOPIC1 [TOPIC2 TOPIC3 ...]", DESCRIPTIONS["record"])
-    p.formatter = optparse.IndentedHelpFormatter()
+    p = _parser(prog, "rosbag record TOPIC1 [TOPIC2 TOPIC3 ...]", DESCRIPTIONS["record"],
+                formatter=optparse.IndentedHelpFormatter())
     p.add_option("-a", "--all", dest="all", default=False, action="store_true", help="record all topics")
     p.add_option("-e", "--regex", dest="regex", default=False, action="store_true", help="match topics using regular expressions")
     p.add_option("-p", "--publish", dest="publish", default=False, action="store_true", help="publish a msg when the record begin")

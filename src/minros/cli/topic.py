@@ -230,7 +230,7 @@ def _echo_bag(path: str, topic: str | None, args: Any, filter_fn: Callable | Non
     """rostopic echo -b: the messages of ``topic`` (or, with -a, of every topic) in a bag."""
     echo: _Echo | None = None
     with _open_bag(path) as bag:
-        for top, raw, _t, header in bag.read_messages(raw=True, return_connection_header=True):
+        for top, raw, stamp, header in bag.read_messages(raw=True, return_connection_header=True):
             if top[0] != "/":
                 top = resolve(NAME, top)
             field = ""
@@ -241,6 +241,7 @@ def _echo_bag(path: str, topic: str | None, args: Any, filter_fn: Callable | Non
             if echo is None:
                 echo = _Echo(topic or top, field, args, filter_fn, top)
             echo.real_topic = top
+            echo.stamp = stamp
             echo(_BagMsg(raw[1], {k: v.decode() for k, v in header.items()}))
             if echo.done:
                 break
@@ -419,6 +420,8 @@ class _Echo:
         self._typed_class: Any = None
         self.lock = threading.Lock()
         self.out = sys.stdout
+        #: the time -p prints: a bag message's receive time, else now
+        self.stamp: Any = None
 
     def __call__(self, raw: Any) -> None:
         if self.done:
@@ -457,7 +460,7 @@ class _Echo:
         if data is None:
             return
         self.count += 1
-        now = _now()
+        now = self.stamp if self.stamp is not None else _now()
         offset = now if self.offset else None
         if self.plot:
             if self.first:
