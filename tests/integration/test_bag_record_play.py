@@ -59,7 +59,7 @@ def _play(port: int, home: Path, tmp_path: Path, topics: str, expect: int, *args
     try:
         collect.read_until("ready", 20)
         start = time.time()
-        play = subprocess.run([PYTHON, "-m", "minros", "bag", "play", "-d", "0.5", *args, "in.bag"],
+        play = subprocess.run([PYTHON, "-m", "minros", "bag", "play", "in.bag", "-d", "0.5", *args],
                               env=ros_env(port, home), cwd=tmp_path, capture_output=True,
                               text=True, timeout=60, stdin=stdin)
         assert play.returncode == 0, play.stderr
@@ -112,7 +112,7 @@ def test_play_pause_and_step_keys(minros_core, ros_home, tmp_path):
     try:
         collect.read_until("ready", 20)
         player = subprocess.Popen([PYTHON, "-m", "minros", "bag", "play", "--pause", "-d", "0.5",
-                                   "--topics", "/q", "in.bag"], env=ros_env(minros_core, ros_home),
+                                   "--topics", "/q", "--bags", "in.bag"], env=ros_env(minros_core, ros_home),
                                   cwd=tmp_path, stdin=slave_fd, stdout=subprocess.PIPE,
                                   stderr=subprocess.STDOUT, start_new_session=True)
         time.sleep(2.5)  # paused: nothing may arrive
