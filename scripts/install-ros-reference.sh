@@ -6,7 +6,7 @@ set -euo pipefail
 if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
 PKGS="ros-core python3-rosmaster python3-roslaunch rosout
   python3-rospy python3-rostopic python3-rosnode python3-rosparam python3-rosservice
-  python3-rosbag python3-rosmsg python3-genpy python3-genmsg
+  python3-rosbag python3-roslz4 python3-rosmsg python3-genpy python3-genmsg
   ros-std-msgs python3-std-msgs libstd-msgs-dev ros-std-srvs python3-std-srvs libstd-srvs-dev
   ros-sensor-msgs python3-sensor-msgs libsensor-msgs-dev
   ros-geometry-msgs python3-geometry-msgs libgeometry-msgs-dev
@@ -26,6 +26,7 @@ TEST_TOOLS="xvfb zsh python3-venv python3-tk graphviz"
 # node and npm for Foxglove's and roslib's own client libraries (tests/web/js, npm ci).
 WEB_TEST_TOOLS="chromium nodejs npm"
 if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msgs.msg, tf2_msgs.msg' 2>/dev/null \
+   && /usr/bin/python3 -c 'import rosbag, roslz4' 2>/dev/null && [ -x /usr/lib/rosbag/record ] \
    && command -v rostopic >/dev/null && command -v catkin_create_pkg >/dev/null \
    && pkg-config --exists roscpp std_msgs && command -v Xvfb >/dev/null && command -v zsh >/dev/null \
    && /usr/bin/python3 -c 'import ensurepip, tkinter' 2>/dev/null \

@@ -26,6 +26,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "pkg": ("minros.cli.pkg", "find and list packages (rospack)"),
     "ws": ("minros.cli.ws", "catkin workspaces: init, create_pkg, make"),
     "web": ("minros.cli.web", "rosbridge, rosapi, Foxglove and video for browsers, on one port"),
+    "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -44,6 +45,7 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "catkin_init_workspace": ("ws", ["init"]),
     "catkin_create_pkg": ("ws", ["create_pkg"]),
     "catkin_make": ("ws", ["make"]),
+    "rosbag": ("bag", []),
 }
 
 
@@ -119,6 +121,7 @@ rospack = _alias("rospack")
 catkin_init_workspace = _alias("catkin_init_workspace")
 catkin_create_pkg = _alias("catkin_create_pkg")
 catkin_make = _alias("catkin_make")
+rosbag = _alias("rosbag")
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -31,6 +31,8 @@ def _parser(kind: str, prog: str) -> argparse.ArgumentParser:
                            else "alias for show")
         p.add_argument("-r", "--raw", action="store_true",
                        help=f"show raw {'message' if kind == 'msg' else 'service'} text, including comments")
+        if kind == "msg":
+            p.add_argument("-b", "--bag", metavar="BAGFILE", help="show message from .bag file")
         p.add_argument("type", nargs="?", help=f"{what} (pkg/Type, or Type to search)")
     p = sub.add_parser("md5", help=f"display {what} md5sum")
     p.add_argument("type", nargs="?", help=what)
@@ -96,6 +98,8 @@ def _run(args: argparse.Namespace, kind: str, prog: str, parser: argparse.Argume
             print(f"{prog}: invalid {what} '{type_name}': refer to types as 'package_name/Type'",
                   file=sys.stderr)
             return 2
+        if command in ("show", "info") and getattr(args, "bag", None):
+            return _show_from_bag(args.bag, type_name, args.raw, prog)
         show: Callable[[str], str]
         if command in ("show", "info"):
             text_of = registry.message_text if kind == "msg" else registry.service_text
@@ -149,6 +153,34 @@ def _run(args: argparse.Namespace, kind: str, prog: str, parser: argparse.Argume
         return 0
     parser.error(f"unknown command {command}")
     return 2
+
+
+def _show_from_bag(path: str, type_name: str, raw: bool, prog: str) -> int:
+    """rosmsg show -b: the definition of ``type_name`` as the bag stores it."""
+    import os
+
+    from minros.bag import Bag, ROSBagException
+
+    if not os.path.exists(path):
+        print(f"ERROR: bag file [{path}] does not exist", file=sys.stderr)
+        return 1
+    try:
+        with Bag(path) as bag:
+            conn = next((c for c in bag._connections.values() if c.datatype == type_name), None)
+    except ROSBagException as exc:
+        print(f"{prog}: ERROR reading {path}: {exc}", file=sys.stderr)
+        return 1
+    if conn is None:
+        return 0  # rosmsg prints nothing for a type the bag does not hold
+    if raw:
+        print(conn.msg_def)
+        return 0
+    from minros.msgs import generate_dynamic
+    from minros.msgs.registry import spec_to_text
+
+    cls = generate_dynamic(type_name, conn.msg_def)[type_name]
+    print(spec_to_text(cls._context.get_spec(type_name), cls._context))
+    return 0
 
 
 def _describe(show: Callable[[str], str], type_name: str, kind: str, command: str) -> str | None:

@@ -182,11 +182,72 @@ def _print_list(master: Master, pubs: list, subs: list, pubs_only: bool, subs_on
     print("\n".join(f"{indent}{t}" for t in sorted(topics)))
 
 
-def _no_bags(path: str) -> None:
-    """minros's rostopic reads no bag files; a missing one is reported as rostopic does."""
+def _open_bag(path: str) -> Any:
+    """The bag at ``path`` for reading; problems are reported as rostopic reports them."""
     if not os.path.exists(path):
         raise ToolError(f"bag file [{path}] does not exist")
-    raise ToolError("reading bag files is not supported by minros's rostopic")
+    from minros.bag import Bag, ROSBagException, ROSBagUnindexedException
+
+    try:
+        return Bag(path)
+    except ROSBagUnindexedException:
+        raise ToolError(f"bag unindexed: {path}.  Run rosbag reindex.") from None
+    except ROSBagException as exc:
+        raise ToolError(f"reading {path}: {exc}") from None
+
+
+def _list_bag(path: str, topic: str | None) -> int:
+    """rostopic list -b: the topics in order of their first message, or one topic's count."""
+    with _open_bag(path) as bag:
+        if topic:
+            ns = names.make_global_ns(topic)
+            stamps = [t for top, _m, t in bag.read_messages(raw=True) if top == topic or top.startswith(ns)]
+            if not stamps:
+                raise ToolError(f"no messages of [{topic}] in {path}")
+            first, last = (time.strftime("%d %b %Y %H:%M:%S", time.localtime(t.to_sec()))
+                           for t in (stamps[0], stamps[-1]))
+            print(f"{len(stamps)} message(s) from {first} to {last}")
+            return 0
+        seen: Dict[str, None] = {}
+        for top, _m, _t in bag.read_messages(raw=True):
+            if top not in seen:
+                seen[top] = None
+                print(top)
+    return 0
+
+
+class _BagMsg:
+    """A message read from a bag, in the shape the echo callback takes (AnyMsg's)."""
+
+    __slots__ = ("_buff", "_connection_header")
+
+    def __init__(self, buff: bytes, header: Dict[str, str]) -> None:
+        self._buff = buff
+        self._connection_header = header
+
+
+def _echo_bag(path: str, topic: str | None, args: Any, filter_fn: Callable | None) -> int:
+    """rostopic echo -b: the messages of ``topic`` (or, with -a, of every topic) in a bag."""
+    echo: _Echo | None = None
+    with _open_bag(path) as bag:
+        for top, raw, stamp, header in bag.read_messages(raw=True, return_connection_header=True):
+            if top[0] != "/":
+                top = resolve(NAME, top)
+            field = ""
+            if topic is not None and top != topic:
+                if not topic.startswith(top + "/"):
+                    continue
+                field = topic[len(top) + 1:]
+            if echo is None:
+                echo = _Echo(topic or top, field, args, filter_fn, top)
+            echo.real_topic = top
+            echo.stamp = stamp
+            echo(_BagMsg(raw[1], {k: v.decode() for k, v in header.items()}))
+            if echo.done:
+                break
+    if echo is not None and echo.error:
+        raise ToolError(echo.error)
+    return 0
 
 
 def _cmd_list(argv: List[str], prog: str) -> int:
@@ -206,7 +267,7 @@ def _cmd_list(argv: List[str], prog: str) -> int:
         for flag, given in (("-s", args.subscribers), ("-p", args.publishers), ("--host", args.hostname)):
             if given:
                 p.error(f"{flag} option is not valid with bags")
-        _no_bags(args.bag)
+        return _list_bag(args.bag, resolve(NAME, args.namespace[0]) if args.namespace else None)
     if args.publishers and args.subscribers:
         p.error("you may only specify one of -p, -s")
     master = _master()
@@ -359,6 +420,8 @@ class _Echo:
         self._typed_class: Any = None
         self.lock = threading.Lock()
         self.out = sys.stdout
+        #: the time -p prints: a bag message's receive time, else now
+        self.stamp: Any = None
 
     def __call__(self, raw: Any) -> None:
         if self.done:
@@ -397,7 +460,7 @@ class _Echo:
         if data is None:
             return
         self.count += 1
-        now = _now()
+        now = self.stamp if self.stamp is not None else _now()
         offset = now if self.offset else None
         if self.plot:
             if self.first:
@@ -477,7 +540,8 @@ def _cmd_echo(argv: List[str], prog: str) -> int:
         p.error("Fixed width for numeric values must be at least 2")
     args.fixed_numeric_width = width
     if args.bag:
-        _no_bags(args.bag)
+        return _echo_bag(args.bag, resolve(NAME, topics[0]) if topics else None, args,
+                         _compile_filter(args.filter_expr))
     topic = resolve(NAME, topics[0])
     filter_fn = _compile_filter(args.filter_expr)
     master = _check_master()

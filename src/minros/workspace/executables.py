@@ -60,6 +60,11 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
         "turtle_tf_broadcaster.py": "minros.nodes.turtle_tf.turtle_tf_broadcaster",
         "turtle_tf_listener.py": "minros.nodes.turtle_tf.turtle_tf_listener",
     },
+    # the record and play programs that `rosbag record|play` run in ROS 1
+    "rosbag": {
+        "record": "minros.cli.bag_record",
+        "play": "minros.cli.bag_play",
+    },
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...

@@ -1,0 +1,515 @@
+"""The ``rosbag.Bag`` API over bag v2.0 files (rosbags) and MCAP files (mcap).
+
+Messages come back as minros message classes: the installed class when its md5 sum matches
+the bag's, else one generated from the definition stored in the bag, so types nobody installed
+read all the same. Timestamps are ``rospy.Time`` (``minros.Time``), as in rosbag.
+"""
+
+from __future__ import annotations
+
+import collections
+import io
+import os
+import sys
+import time
+from typing import Any, Callable, Dict, Iterator, List, Optional, Union
+
+from minros.bag import bag1
+from minros.bag.bag1 import ConnInfo
+from minros.bag.errors import (
+    COMPRESSIONS,
+    Compression,
+    ROSBagException,
+    ROSBagUnindexedException,
+)
+
+BagMessage = collections.namedtuple("BagMessage", "topic message timestamp")
+BagMessageWithConnectionHeader = collections.namedtuple(
+    "BagMessageWithConnectionHeader", "topic message timestamp connection_header")
+TopicTuple = collections.namedtuple("TopicTuple", ["msg_type", "message_count", "connections", "frequency"])
+TypesAndTopicsTuple = collections.namedtuple("TypesAndTopicsTuple", ["msg_types", "topics"])
+CompressionTuple = collections.namedtuple("CompressionTuple", ["compression", "uncompressed", "compressed"])
+
+
+def _to_nsec(t: Any) -> int:
+    if t is None:
+        return time.time_ns()
+    if isinstance(t, int):
+        return t * 1_000_000_000
+    if isinstance(t, float):
+        return int(round(t * 1e9))
+    return int(t.to_nsec())
+
+
+def _time(ns: int) -> Any:
+    from minros import Time
+
+    return Time(ns // 1_000_000_000, ns % 1_000_000_000)
+
+
+def _str(value: Any) -> str:
+    return value.decode() if isinstance(value, (bytes, bytearray)) else str(value)
+
+
+def _canonical(topic: str) -> str:
+    """rosbag matches topics after roslib.names.canonicalize_name (no doubled or trailing /)."""
+    if not topic or topic == "/":
+        return topic
+    out = "/".join(p for p in topic.split("/") if p)
+    return ("/" + out) if topic.startswith("/") else out
+
+
+class Bag:
+    """A bag file opened for reading ('r'), writing ('w') or appending ('a')."""
+
+    def __init__(self, f: Union[str, os.PathLike], mode: str = "r",
+                 compression: str = Compression.NONE, chunk_threshold: int = 768 * 1024,
+                 allow_unindexed: bool = False, options: Optional[dict] = None,
+                 skip_index: bool = False) -> None:
+        if options is not None:
+            if type(options) is not dict:
+                raise ValueError("options must be of type dict")
+            compression = options.get("compression", compression)
+            chunk_threshold = options.get("chunk_threshold", chunk_threshold)
+        if compression not in COMPRESSIONS:
+            raise ValueError("compression must be one of: " + ", ".join(COMPRESSIONS))
+        if chunk_threshold < 0:
+            raise ValueError("chunk_threshold must be greater than or equal to zero")
+        if not f:
+            raise ValueError("filename (or stream) is invalid")
+        if isinstance(f, io.IOBase):
+            raise ValueError("minros's Bag opens files by name: pass the path, not a stream")
+        if mode not in ("r", "w", "a"):
+            raise ValueError(f'mode "{mode}" is invalid')
+        self._filename = os.fspath(f)
+        self._mode = mode
+        self._compression = compression
+        self._chunk_threshold = chunk_threshold
+        self._skip_index = skip_index
+        self._reader: Any = None
+        self._writer: Any = None
+        self._pending_scan = False
+        self._classes: Dict[int, Any] = {}
+        self._topic_conn: Dict[str, int] = {}
+        self._closed = False
+        if mode == "r":
+            self._reader = _open_reader(self._filename, allow_unindexed)
+            self._version = self._reader.version
+        elif mode == "w":
+            self._version = 200
+            self._writer = _open_writer(self._filename, compression, chunk_threshold)
+        else:
+            self._version = 200
+            self._open_append(allow_unindexed)
+
+    def _open_append(self, allow_unindexed: bool) -> None:
+        if not os.path.exists(self._filename):
+            self._writer = bag1.Bag1Writer(self._filename, self._compression, self._chunk_threshold)
+            return
+        if is_mcap(self._filename):
+            raise ROSBagException("appending to MCAP files is not supported")
+        try:
+            scan = bag1.summary_scan(self._filename)
+        except ROSBagUnindexedException:
+            if not allow_unindexed:
+                raise
+            self._pending_scan = True  # reindex() or the first write scans the chunks
+            return
+        except OSError as exc:
+            raise ROSBagException(str(exc.strerror or exc)) from None
+        self._writer = bag1.Bag1Writer.append(self._filename, self._compression,
+                                              self._chunk_threshold, scan)
+        self._topic_conn = {c.topic: c.id for c in self._writer.connections.values()}
+
+    # -- context manager, properties ------------------------------------------------------
+
+    def __iter__(self) -> Iterator[BagMessage]:
+        return self.read_messages()
+
+    def __enter__(self) -> Bag:
+        return self
+
+    def __exit__(self, exc_type, exc_value, traceback) -> None:
+        self.close()
+
+    @property
+    def options(self) -> dict:
+        return {"compression": self._compression, "chunk_threshold": self._chunk_threshold}
+
+    @property
+    def filename(self) -> str:
+        return self._filename
+
+    @property
+    def version(self) -> Any:
+        return self._version
+
+    @property
+    def mode(self) -> str:
+        return self._mode
+
+    @property
+    def size(self) -> int:
+        if self._closed:
+            raise ValueError("I/O operation on closed bag")
+        if self._writer is not None:
+            return self._writer.tell()
+        return os.path.getsize(self._filename)
+
+    def _get_compression(self) -> str:
+        return self._compression
+
+    def _set_compression(self, compression: str) -> None:
+        if compression not in COMPRESSIONS:
+            raise ValueError("compression must be one of: " + ", ".join(COMPRESSIONS))
+        if self._writer is not None and compression != self._compression:
+            if self._writer.connections:
+                raise ROSBagException("set the compression before writing the first message")
+            self._writer.abort()
+            self._writer = _open_writer(self._filename, compression, self._chunk_threshold)
+        self._compression = compression
+
+    compression = property(_get_compression, _set_compression)
+
+    def _get_chunk_threshold(self) -> int:
+        return self._chunk_threshold
+
+    def _set_chunk_threshold(self, chunk_threshold: int) -> None:
+        if chunk_threshold < 0:
+            raise ValueError("chunk_threshold must be greater than or equal to zero")
+        self.flush()
+        self._chunk_threshold = chunk_threshold
+        if self._writer is not None and hasattr(self._writer, "_w"):
+            if isinstance(self._writer, bag1.Bag1Writer):
+                self._writer._w.chunk_threshold = chunk_threshold
+
+    chunk_threshold = property(_get_chunk_threshold, _set_chunk_threshold)
+
+    # -- the index as seen by readers ----------------------------------------------------
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise ValueError("I/O operation on closed bag")
+
+    def _source(self) -> Any:
+        """The reader (in 'w'/'a' mode: a summary of what was written so far)."""
+        self._check_open()
+        if self._reader is None:
+            raise ROSBagException(f"bag {self._filename} is open for writing; "
+                                  "reopen it in mode 'r' to read it")
+        return self._reader
+
+    @property
+    def _connections(self) -> Dict[int, ConnInfo]:
+        if self._reader is not None:
+            return self._reader.connections
+        return self._writer.connections if self._writer is not None else {}
+
+    def _chunk_summaries(self) -> List[bag1.ChunkSummary]:
+        if self._reader is not None:
+            return getattr(self._reader, "chunks", [])
+        return self._writer.chunk_summaries() if self._writer is not None else []
+
+    def _counts(self) -> Dict[int, int]:
+        if self._reader is not None and hasattr(self._reader, "counts"):
+            return dict(self._reader.counts)
+        counts: Dict[int, int] = {}
+        for chunk in self._chunk_summaries():
+            for cid, n in chunk.counts.items():
+                counts[cid] = counts.get(cid, 0) + n
+        return counts
+
+    def _time_range(self) -> Optional[tuple]:
+        if self._reader is not None and hasattr(self._reader, "start"):
+            if not any(self._counts().values()):
+                return None
+            return self._reader.start, self._reader.end
+        chunks = [c for c in self._chunk_summaries() if c.counts]
+        if not chunks:
+            return None
+        return min(c.start for c in chunks), max(c.end for c in chunks)
+
+    def _get_connections(self, topics: Any = None,
+                         connection_filter: Optional[Callable] = None) -> Iterator[ConnInfo]:
+        if topics:
+            wanted = {_canonical(t) for t in ([topics] if isinstance(topics, str) else topics)}
+        for c in self._connections.values():
+            if topics and c.topic not in wanted and _canonical(c.topic) not in wanted:
+                continue
+            if connection_filter and not connection_filter(c.topic, c.datatype, c.md5sum,
+                                                           c.msg_def, c.header):
+                continue
+            yield c
+
+    def _class_for(self, conn: ConnInfo) -> Any:
+        cls = self._classes.get(conn.id)
+        if cls is None:
+            from minros.tools.decode import DecodeError, load_class
+
+            try:
+                cls = load_class(conn.datatype, conn.md5sum, conn.msg_def)
+            except DecodeError as exc:
+                raise ROSBagException(str(exc)) from None
+            if conn.md5sum not in ("", "*") and cls._md5sum != conn.md5sum:
+                print(f"WARNING: For type [{conn.datatype}] stored md5sum [{conn.md5sum}] does not "
+                      f"match message definition [{cls._md5sum}].", file=sys.stderr)
+            self._classes[conn.id] = cls
+        return cls
+
+    # -- reading -------------------------------------------------------------------------
+
+    def read_messages(self, topics: Any = None, start_time: Any = None, end_time: Any = None,
+                      connection_filter: Optional[Callable] = None, raw: bool = False,
+                      return_connection_header: bool = False) -> Iterator[Any]:
+        """Messages in time order, optionally of some topics, within [start_time, end_time].
+
+        Yields ``BagMessage(topic, message, timestamp)``; with ``raw=True`` the message is
+        ``(datatype, serialized bytes, md5sum, position, class)``."""
+        source = self._source()
+        conns = {c.id: c for c in self._get_connections(topics, connection_filter)}
+        if not conns:
+            return iter(())
+        start = None if start_time is None else _to_nsec(start_time)
+        end = None if end_time is None else _to_nsec(end_time)
+        return self._read(source, conns, start, end, raw, return_connection_header)
+
+    def _read(self, source: Any, conns: Dict[int, ConnInfo], start: Optional[int],
+              end: Optional[int], raw: bool, with_header: bool) -> Iterator[Any]:
+        from minros import Time
+
+        headers = {cid: c.header for cid, c in conns.items()} if with_header else {}
+        classes = {cid: self._class_for(c) for cid, c in conns.items()}
+        ids = None if len(conns) == len(source.connections) else list(conns)
+        new_time = Time.__new__
+        for cid, t, data, pos in source.messages(ids, start, end):
+            conn = conns[cid]
+            cls = classes[cid]
+            if raw:
+                msg: Any = (conn.datatype, bytes(data), conn.md5sum, pos, cls)
+            else:
+                msg = cls()
+                msg.deserialize(data)
+            stamp = new_time(Time)  # filled in directly: two __init__ calls per message add up
+            stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
+            if with_header:
+                yield BagMessageWithConnectionHeader(conn.topic, msg, stamp, headers[cid])
+            else:
+                yield BagMessage(conn.topic, msg, stamp)
+
+    def get_message_count(self, topic_filters: Any = None) -> int:
+        counts = self._counts()
+        if topic_filters is None:
+            return sum(counts.values())
+        return sum(counts.get(c.id, 0) for c in self._get_connections(topic_filters))
+
+    def get_start_time(self) -> float:
+        rng = self._time_range()
+        if rng is None:
+            raise ROSBagException("Bag contains no message")
+        return rng[0] / 1e9
+
+    def get_end_time(self) -> float:
+        rng = self._time_range()
+        if rng is None:
+            raise ROSBagException("Bag contains no message")
+        return rng[1] / 1e9
+
+    def _frequencies(self, topics: List[str]) -> Dict[str, float]:
+        out: Dict[str, float] = {}
+        if self._reader is None:
+            return out
+        for topic in topics:
+            ids = [c.id for c in self._get_connections(topic)]
+            stamps = self._reader.index_times(ids)
+            if len(stamps) > 1:
+                periods = sorted(b - a for a, b in zip(stamps, stamps[1:]))
+                n = len(periods)
+                med = periods[n // 2] if n % 2 else (periods[n // 2 - 1] + periods[n // 2]) / 2
+                if med > 0:
+                    out[topic] = 1e9 / med
+        return out
+
+    def _topic_table(self, topic_filters: Any = None, with_freq: bool = False) -> dict:
+        counts = self._counts()
+        if topic_filters is not None:
+            names = [topic_filters] if not isinstance(topic_filters, list) else topic_filters
+        else:
+            names = [c.topic for c in self._connections.values()]
+        table = {}
+        for topic in sorted(set(names)):
+            conns = [c for c in self._get_connections(topic) if counts.get(c.id, 0) or self._writer]
+            if not conns:
+                continue
+            table[topic] = (conns[0].datatype, sum(counts.get(c.id, 0) for c in conns), len(conns))
+        freqs = self._frequencies(list(table)) if with_freq else {}
+        return {t: TopicTuple(d, n, k, freqs.get(t)) for t, (d, n, k) in table.items()}
+
+    def _datatypes(self) -> Dict[str, tuple]:
+        seen: Dict[str, tuple] = {}
+        counts = self._counts()
+        for c in self._connections.values():
+            if c.datatype not in seen and (counts.get(c.id, 0) or self._writer):
+                seen[c.datatype] = (c.md5sum, c.msg_def)
+        return dict(sorted(seen.items()))
+
+    def get_type_and_topic_info(self, topic_filters: Any = None) -> TypesAndTopicsTuple:
+        types = {name: md5 for name, (md5, _d) in self._datatypes().items()}
+        topics = self._topic_table(topic_filters, with_freq=self._reader is not None and not self._skip_index)
+        return TypesAndTopicsTuple(msg_types=types, topics=topics)
+
+    def get_compression_info(self) -> CompressionTuple:
+        chunks = self._chunk_summaries()
+        if not chunks:
+            return CompressionTuple(self._compression, 0, 0)
+        by: Dict[str, int] = collections.Counter(c.compression for c in chunks)
+        main = sorted(((n, k) for k, n in by.items()), reverse=True)[0][1]
+        return CompressionTuple(main, sum(c.uncompressed_size for c in chunks),
+                                sum(c.compressed_size for c in chunks))
+
+    @property
+    def _uncompressed_size(self) -> int:
+        chunks = self._chunk_summaries()
+        return sum(c.uncompressed_size for c in chunks) if chunks else self.size
+
+    # -- writing -------------------------------------------------------------------------
+
+    def _ensure_writer(self) -> None:
+        if self._writer is None and self._pending_scan:
+            for _ in self.reindex():
+                pass
+
+    def write(self, topic: str, msg: Any, t: Any = None, raw: bool = False,
+              connection_header: Optional[dict] = None) -> None:
+        """Add a message (or, with ``raw``, a (type, bytes, md5sum[, position], class) tuple)."""
+        self._check_open()
+        if self._mode == "r":
+            raise ValueError("bag is open for reading; open it with mode 'w' or 'a' to write")
+        if not topic:
+            raise ValueError("topic is invalid")
+        if msg is None or (raw and not msg):
+            raise ValueError("msg is invalid")
+        self._ensure_writer()
+        t_ns = _to_nsec(t)
+        header = {_str(k): _str(v) for k, v in (connection_header or {}).items()}
+        if raw:
+            if len(msg) == 5:
+                msg_type, data, md5sum, _pos, pytype = msg
+            elif len(msg) == 4:
+                msg_type, data, md5sum, pytype = msg
+            else:
+                raise ValueError("msg must be of length 4 or 5")
+        else:
+            buff = getattr(msg, "_buff", None)
+            if buff is not None and getattr(msg, "_type", "") == "*":  # AnyMsg: bytes as received
+                data = bytes(buff)
+                header = header or {_str(k): _str(v) for k, v in
+                                    (getattr(msg, "_connection_header", None) or {}).items()}
+                msg_type, md5sum, pytype = header.get("type", ""), header.get("md5sum", ""), None
+                if not msg_type:
+                    raise ROSBagException("cannot write an AnyMsg without its connection header")
+            else:
+                out = io.BytesIO()
+                msg.serialize(out)
+                data = out.getvalue()
+                msg_type, md5sum, pytype = msg._type, msg._md5sum, type(msg)
+        cid = self._topic_conn.get(topic)
+        if cid is None:
+            if not header:
+                if pytype is None:
+                    from minros.tools.decode import DecodeError, load_class
+
+                    try:
+                        pytype = load_class(msg_type, md5sum, "")
+                    except DecodeError:
+                        raise ROSBagException("cannot locate message class and no message class "
+                                              f"provided for [{msg_type}]") from None
+                header = {"topic": topic, "type": msg_type, "md5sum": md5sum,
+                          "message_definition": pytype._full_text}
+            cid = self._writer.connection(
+                topic, header.get("type", msg_type), header.get("md5sum", md5sum),
+                header.get("message_definition", ""), header.get("callerid"), header.get("latching"))
+            self._topic_conn[topic] = cid
+        self._writer.write(cid, t_ns, data)
+
+    def flush(self) -> None:
+        """Write the open chunk to disk."""
+        self._check_open()
+        if self._writer is not None:
+            self._writer.flush_chunk()
+
+    def reindex(self) -> Iterator[int]:
+        """Rebuild the index from the chunks; yields the offset of each chunk (for progress)."""
+        self._check_open()
+        if self._mode == "r":
+            positions: List[int] = []
+            if not isinstance(self._reader, bag1.Bag1Reader):
+                return iter(())
+            self._reader.reindex(positions.append)
+            return iter(positions)
+        return self._reindex_for_append()
+
+    def _reindex_for_append(self) -> Iterator[int]:
+        from pathlib import Path
+
+        scan = bag1.ScanResult()
+        yield from bag1.iter_scan(Path(self._filename), scan)
+        if self._writer is not None:
+            self._writer.abort()
+        self._writer = bag1.Bag1Writer.append(self._filename, self._compression,
+                                              self._chunk_threshold, scan)
+        self._topic_conn = {c.topic: c.id for c in self._writer.connections.values()}
+        self._pending_scan = False
+
+    def close(self) -> None:
+        """Close the bag (writing the index when writing). Closing twice does nothing."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            if self._writer is not None:
+                self._writer.close()
+        finally:
+            if self._reader is not None:
+                self._reader.close()
+
+    # -- rosbag info ---------------------------------------------------------------------
+
+    def __str__(self) -> str:
+        from minros.bag.info import info_text
+
+        return info_text(self, with_freq=not self._skip_index)
+
+    def _get_yaml_info(self, key: Optional[str] = None) -> Optional[str]:
+        from minros.bag.info import info_yaml
+
+        return info_yaml(self, key, with_freq=not self._skip_index)
+
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def is_mcap(path: str) -> bool:
+    """Whether ``path`` starts with MCAP's magic bytes (else it is taken for a bag)."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(len(MCAP_MAGIC)) == MCAP_MAGIC
+    except OSError:
+        return False
+
+
+def _open_reader(path: str, allow_unindexed: bool) -> Any:
+    if not os.path.exists(path):
+        raise ROSBagException(f"[Errno 2] No such file or directory: '{path}'")
+    if is_mcap(path):
+        from minros.bag import mcapfile  # imported only for MCAP files: rosbag info starts faster
+
+        return mcapfile.McapReader(path, allow_unindexed)
+    return bag1.Bag1Reader(path, allow_unindexed)
+
+
+def _open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
+    if path.endswith(".mcap") or path.endswith(".mcap.active"):
+        from minros.bag import mcapfile
+
+        return mcapfile.McapWriter(path, compression, chunk_threshold)
+    return bag1.Bag1Writer(path, compression, chunk_threshold)

@@ -1,0 +1,272 @@
+"""minros.bag without processes: the Bag API over bag 2.0 and MCAP, reindexing, appending,
+rosbag info's layout, and the recorder's pure parts (names, durations, queue, writer)."""
+
+from __future__ import annotations
+
+import io
+import os
+import time
+from pathlib import Path
+
+import pytest
+
+import minros
+from minros.bag import Bag, Compression, ROSBagException, ROSBagUnindexedException, bag1
+from minros.bag.info import duration_str, human_frequency, human_size
+from minros.bag.play import TimeTranslator, raw_class
+from minros.bag.progress import ProgressMeter
+from minros.bag.record import (
+    FLUSH_INTERVAL,
+    BagSink,
+    RecordOptions,
+    RecordQueue,
+    bag_filename,
+    parse_duration,
+    topic_matches,
+)
+from std_msgs.msg import Int32, String
+
+
+def _fill(path: Path, n: int = 100, compression: str = Compression.NONE, chunk: int = 2000) -> None:
+    with Bag(str(path), "w", compression=compression, chunk_threshold=chunk) as b:
+        for i in range(n):
+            b.write("/s", String(f"m{i:03d}"), minros.Time(100 + i // 10, (i % 10) * 100_000_000))
+            if i % 2 == 0:
+                b.write("/i", Int32(i), minros.Time(100 + i // 10, (i % 10) * 100_000_000 + 1))
+
+
+@pytest.mark.parametrize("name,compression", [("a.bag", "none"), ("b.bag", "lz4"), ("c.bag", "bz2"),
+                                              ("d.mcap", "none"), ("e.mcap", "lz4")])
+def test_round_trip(tmp_path, name, compression):
+    path = tmp_path / name
+    _fill(path, compression=compression)
+    with Bag(str(path)) as b:
+        assert b.get_message_count() == 150
+        assert b.get_message_count("/i") == 50
+        assert b.get_start_time() == 100.0 and b.get_end_time() == pytest.approx(109.900000001)
+        info = b.get_type_and_topic_info()
+        assert info.msg_types == {"std_msgs/Int32": Int32._md5sum, "std_msgs/String": String._md5sum}
+        assert info.topics["/s"].message_count == 100 and info.topics["/s"].frequency == pytest.approx(10.0)
+        msgs = list(b.read_messages(topics=["/s"], start_time=minros.Time(101), end_time=minros.Time(102)))
+        assert [m.message.data for m in msgs] == [f"m{i:03d}" for i in range(10, 21)]  # inclusive
+        assert type(msgs[0].message) is String and msgs[0].timestamp == minros.Time(101)
+        everything = list(b.read_messages())
+        assert [m.timestamp for m in everything] == sorted(m.timestamp for m in everything)
+        raw = next(iter(b.read_messages("/i", raw=True, return_connection_header=True)))
+        datatype, data, md5, _pos, cls = raw.message
+        assert (datatype, data, md5, cls) == ("std_msgs/Int32", b"\0\0\0\0", Int32._md5sum, Int32)
+        assert raw.connection_header["type"] == b"std_msgs/Int32"
+        if name.endswith(".bag"):
+            assert b.get_compression_info().compression == compression
+
+
+def test_unknown_type_is_read_from_its_stored_definition(tmp_path):
+    path = str(tmp_path / "x.bag")
+    from minros.msgs import generate_dynamic
+
+    cls = generate_dynamic("nobody/Thing", "float64 x\nstring[] names\n")["nobody/Thing"]
+    with Bag(path, "w") as b:
+        b.write("/thing", cls(x=2.5, names=["a", "b"]), minros.Time(5))
+        with pytest.raises(ROSBagException, match="cannot locate message class"):
+            b.write("/raw", ("nobody/Else", b"", "0" * 32, None), minros.Time(5), raw=True)
+    with Bag(path) as b:
+        (msg,) = [m.message for m in b.read_messages()]
+    assert (msg._type, msg.x, msg.names) == ("nobody/Thing", 2.5, ["a", "b"])
+
+
+def test_append_keeps_the_old_messages(tmp_path):
+    path = tmp_path / "a.bag"
+    _fill(path, n=20)
+    with Bag(str(path), "a") as b:
+        b.write("/s", String("late"), minros.Time(500))
+        b.write("/new", Int32(7), minros.Time(501))
+    with Bag(str(path)) as b:
+        assert b.get_message_count() == 32
+        assert [m.message.data for m in b.read_messages("/new")] == [7]
+        assert b.get_end_time() == 501.0
+
+
+def test_truncated_bag_is_unindexed_and_reindex_recovers_whole_chunks(tmp_path):
+    path = tmp_path / "t.bag"
+    _fill(path, n=300)
+    size = path.stat().st_size
+    os.truncate(path, size * 2 // 3)
+    with pytest.raises(ROSBagUnindexedException):
+        Bag(str(path))
+    with Bag(str(path), allow_unindexed=True) as b:  # read through a scan of the chunks
+        readable = b.get_message_count()
+    assert readable > 150
+    positions = []
+    scan = bag1.reindex_in_place(str(path), positions.append)
+    assert scan.stopped and positions == sorted(positions)
+    with Bag(str(path)) as b:
+        data = [m.message.data for m in b.read_messages("/s")]
+        assert b.get_message_count() == readable
+    assert len(data) >= 100
+    assert data == [f"m{i:03d}" for i in range(len(data))]
+
+
+def test_reindex_through_the_append_api_yields_chunk_offsets(tmp_path):
+    path = tmp_path / "r.bag"
+    _fill(path, n=50)
+    raw = bytearray(path.read_bytes())
+    at = raw.index(b"index_pos=") + len("index_pos=")
+    raw[at:at + 8] = bytes(8)
+    path.write_bytes(bytes(raw))
+    b = Bag(str(path), "a", allow_unindexed=True)
+    offsets = list(b.reindex())
+    b.close()
+    assert offsets and offsets[0] == bag1.DATA_START
+    with Bag(str(path)) as b:
+        assert b.get_message_count() == 75
+
+
+def test_not_a_bag(tmp_path):
+    path = tmp_path / "x.bag"
+    path.write_text("not a bag\n")
+    with pytest.raises(ROSBagException, match="This does not appear to be a bag file"):
+        Bag(str(path))
+    path.write_bytes(b"")
+    with pytest.raises(ROSBagException, match="empty file"):
+        Bag(str(path))
+
+
+def test_info_layout(tmp_path, monkeypatch):
+    monkeypatch.setenv("TZ", "UTC")
+    time.tzset()
+    path = tmp_path / "i.bag"
+    _fill(path, n=20, chunk=10**6)
+    with Bag(str(path), skip_index=True) as b:
+        text = str(b)
+        yaml_text = b._get_yaml_info()
+        key = b._get_yaml_info("topics[0].messages")
+    time.tzset()
+    assert text == (
+        f"path:        {path}\n"
+        "version:     2.0\n"
+        "duration:    1.9s\n"
+        "start:       Jan 01 1970 00:01:40.00 (100.00)\n"
+        "end:         Jan 01 1970 00:01:41.90 (101.90)\n"
+        f"size:        {human_size(path.stat().st_size)}\n"
+        "messages:    30\n"
+        "compression: none [1/1 chunks]\n"
+        "types:       std_msgs/Int32  [da5909fbe378aeaf85e547e830cc1bb7]\n"
+        "             std_msgs/String [992ce8a1687cec8c8bd883ec73ca41d1]\n"
+        "topics:      /i   10 msgs    : std_msgs/Int32 \n"
+        "             /s   20 msgs    : std_msgs/String")
+    assert "messages: 30\nindexed: True\ncompression: none\n" in yaml_text
+    assert key == "10"
+
+
+def test_human_units():
+    assert human_size(1536) == "1.5 KB" and human_size(3 * 1024**3) == "3.0 GB"
+    assert human_frequency(999.0) == "999.0 Hz" and human_frequency(1500) == "1.5 kHz"
+    assert duration_str(59.94) == "59.9s" and duration_str(125) == "2:05s (125s)"
+    assert duration_str(3725) == "1hr 2:05s (3725s)"
+
+
+def test_progress_meter_draws_rosbags_bar():
+    out = io.StringIO()
+    meter = ProgressMeter("x.bag", 2048, out=out)
+    meter.step(1024, force_update=True)
+    meter.finish()
+    text = out.getvalue()
+    assert "x.bag" in text and " 50%" in text and "1.0 KB /   2.0 KB" in text
+    assert text.endswith("100%              2.0 KB 00:00    \n")
+
+
+# -- recorder pieces -----------------------------------------------------------------------
+
+def test_bag_filenames():
+    now = time.mktime((2026, 3, 4, 5, 6, 7, 0, 0, -1))
+    assert bag_filename(None, "run", None) == "run.bag"
+    assert bag_filename(None, "run.bag", 2) == "run_2.bag"
+    assert bag_filename(None, "run.mcap", None) == "run.mcap"
+    assert bag_filename("pre", None, None, now) == "pre_2026-03-04-05-06-07.bag"
+    assert bag_filename(None, None, 0, now) == "2026-03-04-05-06-07_0.bag"
+
+
+def test_parse_duration():
+    assert parse_duration("30") == 30 and parse_duration("1.5m") == 90 and parse_duration("2h") == 7200
+    for bad in ("", "x", "5d", "0"):
+        with pytest.raises(ValueError):
+            parse_duration(bad)
+
+
+def test_topic_matches():
+    import re
+
+    pats = [re.compile("/cam.*")]
+    assert topic_matches("/camera/image", pats, None)
+    assert not topic_matches("/camera/image", pats, re.compile(".*image"))
+    assert not topic_matches("/x/camera", pats, None)  # a whole-name match, as boost::regex_match
+
+
+def test_queue_drops_oldest_and_counts_per_topic():
+    q = RecordQueue(limit_bytes=100)
+    for i in range(5):
+        q.push(("/a" if i < 3 else "/b", i, b"x" * 40, {}))
+    assert dict(q.drops) == {"/a": 3}
+    assert [q.pop(0)[1], q.pop(0)[1]] == [3, 4]
+    assert q.pop(0) is None and q.take_new_drops() == 3 and q.take_new_drops() == 0
+    big = RecordQueue(limit_bytes=10)
+    big.push(("/img", 0, b"y" * 50, {}))  # one message larger than the buffer still goes through
+    assert big.pop(0)[1] == 0 and not big.drops
+
+
+HEADER = {"type": "std_msgs/String", "md5sum": String._md5sum, "message_definition": "string data\n",
+          "callerid": "/talker", "latching": "0"}
+
+
+def _item(i: int, t: float) -> tuple:
+    buff = io.BytesIO()
+    String(f"m{i}").serialize(buff)
+    return ("/chatter", int(t * 1e9), buff.getvalue(), HEADER)
+
+
+def test_sink_hands_chunks_to_the_kernel_on_a_time_bound(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    logs = []
+    sink = BagSink(RecordOptions(name="live"), lambda level, text: logs.append(text))
+    sink.write(_item(0, 10.0))
+    sink.maybe_flush(sink.chunk_started + FLUSH_INTERVAL / 2)
+    assert bag1.scan_chunks(tmp_path / "live.bag.active").chunks == []
+    sink.maybe_flush(sink.chunk_started + FLUSH_INTERVAL)
+    # what a SIGKILL now would leave: a .bag.active whose chunks reindex finds
+    scan = bag1.scan_chunks(tmp_path / "live.bag.active")
+    assert [sum(c.counts.values()) for c in scan.chunks] == [1]
+    sink.close_current()
+    assert logs == ["Recording to 'live.bag'."]
+    with Bag("live.bag") as b:
+        (conn,) = b._connections.values()
+        assert (conn.callerid, conn.latching) == ("/talker", "0")
+
+
+def test_sink_splits_by_duration_and_keeps_max_splits(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    sink = BagSink(RecordOptions(name="part", split=True, duration="1", max_splits=2),
+                   lambda level, text: None)
+    for i in range(8):
+        sink.write(_item(i, 100 + i * 0.5))
+    sink.close_current()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["part_2.bag", "part_3.bag"]
+    with Bag("part_3.bag") as b:
+        assert [m.message.data for m in b.read_messages()] == ["m6", "m7"]
+
+
+def test_raw_class_publishes_stored_bytes():
+    from minros.bag.bag1 import ConnInfo
+
+    cls = raw_class(ConnInfo(0, "/x", "nobody/Thing", "0123" * 8, "int8 a\n", None, "1"))
+    buff = io.BytesIO()
+    cls(b"\x07").serialize(buff)
+    assert buff.getvalue() == b"\x07"
+    assert (cls._type, cls._md5sum, cls._full_text, cls._has_header) == ("nobody/Thing", "0123" * 8, "int8 a\n", False)
+
+
+def test_time_translator():
+    tr = TimeTranslator(rate=2.0)
+    tr.set(10_000_000_000, 50.0)
+    assert tr.real(12_000_000_000) == 51.0
+    tr.shift(0.25)
+    assert tr.real(12_000_000_000) == 51.25
