@@ -6,7 +6,8 @@ Two mechanisms share one implementation (:func:`namespace_hooks`):
   writes into a catkin devel space) whose PEP 562 ``__getattr__`` asks the registry for a
   class the first time a name is used;
 * an import hook appended to ``sys.meta_path`` so any package on ROS_PACKAGE_PATH with
-  ``msg/`` or ``srv/`` folders imports as ``<pkg>.msg``/``<pkg>.srv`` even with no stub.
+  ``msg/``, ``srv/`` or ``action/`` folders imports as ``<pkg>.msg``/``<pkg>.srv`` even with no
+  stub, and one with ``cfg/`` scripts as ``<pkg>.cfg.<Name>Config`` (dynamic_reconfigure).
   It is consulted last, so real Python packages always win.
 """
 
@@ -187,14 +188,23 @@ class MsgImportFinder:
         if len(parts) == 1:
             # only packages already discovered (no rescan per failed import of some module)
             package_dir = _package_dir(parts[0], refresh=False)
-            if package_dir is None or not any((package_dir / k).is_dir() for k in ("msg", "srv")):
+            if package_dir is None or not any((package_dir / k).is_dir() for k in _SERVED):
                 return None
             kind = None
         elif len(parts) == 2 and parts[1] in ("msg", "srv"):
             package_dir = _package_dir(parts[0])
-            if package_dir is None or not (package_dir / parts[1]).is_dir():
+            # a package with only .action files still has a .msg module (their seven types)
+            folders = ("msg", "action") if parts[1] == "msg" else ("srv",)
+            if package_dir is None or not any((package_dir / f).is_dir() for f in folders):
                 return None
             kind = parts[1]
+        elif len(parts) in (2, 3) and parts[1] == "cfg":
+            package_dir = _package_dir(parts[0])
+            if package_dir is None or not (package_dir / "cfg").is_dir():
+                return None
+            from minros.dynamic_reconfigure.cfg_import import find_spec
+
+            return find_spec(fullname, parts, package_dir)  # dynamic_reconfigure's .cfg scripts
         else:
             return None
         spec = ModuleSpec(fullname, _NamespaceLoader(parts[0], kind),
@@ -203,6 +213,8 @@ class MsgImportFinder:
         return spec
 
 
+#: package folders that make a ROS package importable: definitions, actions, .cfg scripts
+_SERVED = ("msg", "srv", "action", "cfg")
 #: modules the finder never has to look at (the standard library's, the builtins)
 _NOT_ROS = frozenset(getattr(sys, "stdlib_module_names", ())) | frozenset(sys.builtin_module_names)
 _busy = threading.local()

@@ -30,6 +30,9 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
         "add_two_ints_server": "minros.workspace.rospy_tutorials.add_two_ints_server",
         "add_two_ints_client": "minros.workspace.rospy_tutorials.add_two_ints_client",
     },
+    "dynamic_reconfigure": {
+        "dynparam": "minros.dynamic_reconfigure.dynparam",
+    },
     "turtlesim": {
         "turtlesim_node": "minros.turtlesim.turtlesim_node",
         "turtle_teleop_key": "minros.turtlesim.turtle_teleop_key",
