@@ -20,6 +20,10 @@ class SimpleActionClient:
         self.simple_state = SimpleGoalState.DONE
         self.gh: ClientGoalHandle | None = None
         self.done_condition = threading.Condition()
+        # Held while a goal is sent and while its callbacks run: a fast server's first status
+        # can arrive before send_goal has stored the handle, and must wait for it rather than
+        # be dropped as "not tracking" (ROS 1's client then never calls active_cb).
+        self._tracking = threading.RLock()
         self.done_cb: Callable | None = None
         self.active_cb: Callable | None = None
         self.feedback_cb: Callable | None = None
@@ -31,12 +35,14 @@ class SimpleActionClient:
     def send_goal(self, goal: Any, done_cb: Callable | None = None, active_cb: Callable | None = None,
                   feedback_cb: Callable | None = None) -> None:
         """Send ``goal`` and forget the previous one (without cancelling it)."""
-        self.stop_tracking_goal()
-        self.done_cb = done_cb
-        self.active_cb = active_cb
-        self.feedback_cb = feedback_cb
-        self.simple_state = SimpleGoalState.PENDING
-        self.gh = self.action_client.send_goal(goal, self._handle_transition, self._handle_feedback)
+        with self._tracking:
+            self.stop_tracking_goal()
+            self.done_cb = done_cb
+            self.active_cb = active_cb
+            self.feedback_cb = feedback_cb
+            self.simple_state = SimpleGoalState.PENDING
+            self.gh = self.action_client.send_goal(goal, self._handle_transition,
+                                                   self._handle_feedback)
 
     def send_goal_and_wait(self, goal: Any, execute_timeout: Any = None,
                            preempt_timeout: Any = None) -> int:
@@ -109,6 +115,10 @@ class SimpleActionClient:
         self.gh = None
 
     def _handle_transition(self, gh: ClientGoalHandle) -> None:
+        with self._tracking:
+            self._transition(gh)
+
+    def _transition(self, gh: ClientGoalHandle) -> None:
         if gh != self.gh:
             minros.logerr("Got a transition callback on a goal handle that we're not tracking")
             return
@@ -140,6 +150,10 @@ class SimpleActionClient:
                       f"NS {minros.resolve_name(self.action_client.ns)}")
 
     def _handle_feedback(self, gh: ClientGoalHandle, feedback: Any) -> None:
+        with self._tracking:
+            self._feedback(gh, feedback)
+
+    def _feedback(self, gh: ClientGoalHandle, feedback: Any) -> None:
         if not self.gh:
             return  # feedback of a goal we stopped tracking, still in flight
         if gh != self.gh:

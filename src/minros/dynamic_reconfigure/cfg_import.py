@@ -47,7 +47,9 @@ class _ConfigLoader:
 
         path = find_cfg(self.package_dir, self.module_name)
         if path is None:
-            raise ModuleNotFoundError(
+            # ImportError, not ModuleNotFoundError: `from pkg.cfg import X` would replace the
+            # latter by a bare "cannot import name", losing where minros looked
+            raise ImportError(
                 f"No module named '{module.__name__}': package {self.package} has no "
                 f"cfg/{self.module_name[:-len('Config')]}.cfg (nor a .cfg generating "
                 f"{self.module_name})", name=module.__name__)

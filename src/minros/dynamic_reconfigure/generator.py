@@ -24,7 +24,7 @@ import sys
 import threading
 import types
 from pathlib import Path
-from typing import Any, Dict, List, Optional
+from typing import Any, Callable, Dict, List, Optional
 
 str_t = "str"
 bool_t = "bool"
@@ -232,8 +232,9 @@ class ParameterGenerator:
         if capture is None:
             raise SystemExit(_USAGE_EXIT)
         capture.append(self)
-        if getattr(_state, "verbose", False):
-            print(f"Generating reconfiguration files for {name} in {pkgname}", flush=True)
+        out = getattr(_state, "out", None)
+        if out is not None:
+            out(f"Generating reconfiguration files for {name} in {pkgname}")
 
 
 _state = threading.local()
@@ -246,10 +247,11 @@ def _capture() -> Optional[list]:
 # ---------------------------------------------------------------------------------------------
 # running a .cfg
 
-def run_cfg(path: Path, verbose: bool = False) -> ParameterGenerator:
+def run_cfg(path: Path, out: Optional[Callable[[str], None]] = None) -> ParameterGenerator:
     """Run the ``.cfg`` script at ``path``; the generator it called ``generate`` on.
 
-    Raises :class:`CfgError` (one line: ``file:line: what``) if the script fails.
+    ``out`` gets the line catkin prints for each generated configuration. Raises
+    :class:`CfgError` (one line: ``file:line: what``) if the script fails.
     """
     path = Path(path)
     try:
@@ -262,8 +264,8 @@ def run_cfg(path: Path, verbose: bool = False) -> ParameterGenerator:
         raise CfgError(f"{path}:{exc.lineno}: SyntaxError: {exc.msg}") from None
     namespace: Dict[str, Any] = {"__name__": "__main__", "__file__": str(path),
                                  "__builtins__": builtins}
-    previous = (_capture(), getattr(_state, "verbose", False))
-    _state.capture, _state.verbose = [], verbose
+    previous = (_capture(), getattr(_state, "out", None))
+    _state.capture, _state.out = [], out
     try:
         try:
             exec(code, namespace)
@@ -276,7 +278,7 @@ def run_cfg(path: Path, verbose: bool = False) -> ParameterGenerator:
                            f"{_one_line(exc)}") from None
         generated = _state.capture
     finally:
-        _state.capture, _state.verbose = previous
+        _state.capture, _state.out = previous
     if not generated:
         raise CfgError(f"{path}: the script never called gen.generate(PACKAGE, node_name, "
                        f"\"{path.stem}\")")

@@ -401,7 +401,7 @@ def _write_cfg_modules(manifest: Manifest, dist_packages: Path, out: Print) -> N
     modules = {}
     for path in sorted((manifest.path / "cfg").glob("*.cfg")):
         try:
-            gen = run_cfg(path, verbose=True)
+            gen = run_cfg(path, out=out)
         except CfgError as exc:
             raise WorkspaceError(str(exc)) from None
         modules[f"{gen.name}Config"] = path
