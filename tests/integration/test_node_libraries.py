@@ -1,6 +1,7 @@
 """actionlib and message_filters on minros alone, over real topics of a ``minros core``:
 many quick goals each get exactly one active and one done callback (no transition lost to a
-fast server), a finished goal leaves the status list after status_list_timeout, and
+fast server), a finished goal leaves the status list after status_list_timeout, a
+SimpleActionServer driven by goal and preempt callbacks, and
 synchronizers fed by message_filters.Subscriber pair the messages of two topics."""
 
 from __future__ import annotations
@@ -39,6 +40,39 @@ def on_status(msg):
 start = rospy.get_time()
 rospy.Subscriber("quick/status", GoalStatusArray, on_status)
 print("forgotten", gone.wait(10), 0.3 < rospy.get_time() - start < 3, flush=True)
+
+# goal and preempt callbacks instead of an execute callback
+polled = actionlib.SimpleActionServer("polled", TwoIntsAction, auto_start=False)
+preempts = []
+
+
+def on_goal():
+    goal = polled.accept_new_goal()
+    if goal.a:
+        polled.set_succeeded(TwoIntsResult(sum=goal.a * 10), "at once")
+
+
+def on_preempt():
+    preempts.append(polled.is_preempt_requested())
+    polled.set_preempted(TwoIntsResult(sum=-5), "stopped")
+
+
+polled.register_goal_callback(on_goal)
+polled.register_preempt_callback(on_preempt)
+polled.start()
+other = actionlib.SimpleActionClient("polled", TwoIntsAction)
+other.wait_for_server(rospy.Duration(20))
+other.send_goal(TwoIntsGoal(a=4))
+other.wait_for_result(rospy.Duration(10))
+first = (actionlib.GoalStatus.to_string(other.get_state()), other.get_result().sum)
+other.send_goal(TwoIntsGoal(a=0))
+deadline = rospy.get_time() + 10
+while other.get_state() != actionlib.GoalStatus.ACTIVE and rospy.get_time() < deadline:
+    rospy.sleep(0.01)
+other.cancel_goal()
+other.wait_for_result(rospy.Duration(10))
+print("polled", first, actionlib.GoalStatus.to_string(other.get_state()), other.get_result().sum,
+      other.get_goal_status_text(), preempts, flush=True)
 '''
 
 FILTERS = r'''
@@ -91,9 +125,10 @@ def _run(tmp_path: Path, port: int, home: Path, name: str, text: str, last: str)
 
 
 def test_many_quick_goals_and_status_list_timeout(tmp_path: Path, minros_core: int, ros_home: Path):
-    out = _run(tmp_path, minros_core, ros_home, "actions", ACTIONS, "forgotten")
+    out = _run(tmp_path, minros_core, ros_home, "actions", ACTIONS, "polled")
     lines = [line for line in out.splitlines() if not line.startswith("[")]
-    assert lines == ["server True", "goals 30 30 465", "forgotten True True"], out
+    assert lines == ["server True", "goals 30 30 465", "forgotten True True",
+                     "polled ('SUCCEEDED', 40) PREEMPTED -5 stopped [True]"], out
 
 
 def test_synchronizers_on_subscriber_filters(tmp_path: Path, minros_core: int, ros_home: Path):
