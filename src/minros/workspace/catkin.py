@@ -5,8 +5,10 @@ compile. What it must do is what a user relies on afterwards: a ``build/`` and a
 folder, ``devel/setup.{sh,bash,zsh}`` that put the workspace's packages on
 ROS_PACKAGE_PATH, ``devel/bin`` and minros's own interpreter folder on PATH and
 ``devel/lib/python3/dist-packages`` on PYTHONPATH, and importable ``<pkg>.msg`` / ``<pkg>.srv``
-modules for the workspace's message packages. Console output follows catkin's wording where a
-user sees it (``catkin_create_pkg``) and catkin_make's shape elsewhere.
+modules for the workspace's message packages (``.action`` files included), and
+``<pkg>.cfg.<Name>Config`` modules for their dynamic_reconfigure ``.cfg`` scripts. Console
+output follows catkin's wording where a user sees it (``catkin_create_pkg``) and
+catkin_make's shape elsewhere.
 """
 
 from __future__ import annotations
@@ -373,10 +375,45 @@ del _os, _init
 
 
 def _interface_counts(pkg: Path) -> Dict[str, int]:
-    return {kind: len(list((pkg / kind).glob(f"*.{kind}"))) for kind in ("msg", "srv", "action")}
+    return {kind: len(list((pkg / kind).glob(f"*.{kind}"))) for kind in ("msg", "srv", "action", "cfg")}
 
 
-def _write_message_stubs(manifest: Manifest, dist_packages: Path, src: Path) -> None:
+#: what genaction makes of ``Name.action``: these seven message types
+_ACTION_TYPES = ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result",
+                 "Feedback")
+
+
+def _check_definition(path: Path, build: Callable[[str], object], type_name: str) -> None:
+    try:
+        build(type_name)
+    except Exception as exc:  # a malformed definition: one line naming the file
+        text = str(exc).replace("\n", " ")
+        raise WorkspaceError(f"{path}: {text}") from None
+
+
+def _write_cfg_modules(manifest: Manifest, dist_packages: Path, out: Print) -> None:
+    """generate_dynamic_reconfigure_options: run each ``cfg/*.cfg`` (a broken one fails the
+    build with one line naming file and line) and write ``<pkg>.cfg.<Name>Config`` modules,
+    which rerun the script on import, so later edits need no rebuild."""
+    from minros.dynamic_reconfigure.cfg_import import write_stubs
+    from minros.dynamic_reconfigure.generator import CfgError, run_cfg
+
+    modules = {}
+    for path in sorted((manifest.path / "cfg").glob("*.cfg")):
+        try:
+            gen = run_cfg(path, out=out)
+        except CfgError as exc:
+            raise WorkspaceError(str(exc)) from None
+        modules[f"{gen.name}Config"] = path
+    init = dist_packages / manifest.name / "__init__.py"
+    if not init.exists():
+        init.parent.mkdir(parents=True, exist_ok=True)
+        init.write_text(f'"""{manifest.name}: written by minros catkin_make."""\n')
+    write_stubs(manifest.name, dist_packages, modules)
+
+
+def _write_message_stubs(manifest: Manifest, dist_packages: Path, src: Path,
+                         out: Print = _print) -> None:
     """Check the package's .msg/.srv files and write its ``<pkg>.msg``/``<pkg>.srv`` stubs.
 
     The stubs (helper A's writer) generate classes on first use from the package's files, found
@@ -391,11 +428,12 @@ def _write_message_stubs(manifest: Manifest, dist_packages: Path, src: Path) -> 
     try:
         for kind, getter in (("msg", msgs.get_message_class), ("srv", msgs.get_service_class)):
             for path in sorted((manifest.path / kind).glob(f"*.{kind}")):
-                try:
-                    getter(f"{name}/{path.stem}")
-                except Exception as exc:  # a malformed definition: one line naming the file
-                    text = str(exc).replace("\n", " ")
-                    raise WorkspaceError(f"{path}: {text}") from None
+                _check_definition(path, getter, f"{name}/{path.stem}")
+        for path in sorted((manifest.path / "action").glob("*.action")):
+            # add_action_files: the seven generated types must build, as genaction's output
+            out(f"Generating .msg files for action {name}/{path.stem} {path}")
+            for suffix in _ACTION_TYPES:
+                _check_definition(path, msgs.get_message_class, f"{name}/{path.stem}{suffix}")
         msgs.write_stub_package(name, dist_packages)
     finally:
         if previous is None:
@@ -444,9 +482,12 @@ def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _pr
         out(f"-- +++ processing catkin package: '{m.name}'")
         out(f"-- ==> add_subdirectory({m.path.relative_to(src)})")
         counts = _interface_counts(m.path)
-        if any(counts.values()):
-            out(f"-- {m.name}: {counts['msg']} messages, {counts['srv']} services")
-            _write_message_stubs(m, dist, src)
+        if counts["msg"] or counts["srv"] or counts["action"]:
+            messages = counts["msg"] + len(_ACTION_TYPES) * counts["action"]
+            out(f"-- {m.name}: {messages} messages, {counts['srv']} services")
+            _write_message_stubs(m, dist, src, out)
+        if counts["cfg"]:
+            _write_cfg_modules(m, dist, out)
         module_src = m.path / "src" / m.name
         if (module_src / "__init__.py").is_file():
             init = dist / m.name / "__init__.py"

@@ -30,6 +30,9 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
         "add_two_ints_server": "minros.nodes.rospy_tutorials.add_two_ints_server",
         "add_two_ints_client": "minros.nodes.rospy_tutorials.add_two_ints_client",
     },
+    "dynamic_reconfigure": {
+        "dynparam": "minros.dynamic_reconfigure.dynparam",
+    },
     "turtlesim": {
         "turtlesim_node": "minros.nodes.turtlesim.turtlesim_node",
         "turtle_teleop_key": "minros.nodes.turtlesim.turtle_teleop_key",

@@ -1,0 +1,15 @@
+"""actionlib stand-in: the action library served by minros.actionlib."""
+
+from actionlib import (  # noqa: F401,E402 - the submodules scripts import by name
+    action_client,
+    action_server,
+    exceptions,
+    goal_id_generator,
+    handle_tracker_deleter,
+    server_goal_handle,
+    simple_action_client,
+    simple_action_server,
+    status_tracker,
+)
+from minros.actionlib import *  # noqa: F401,F403
+from minros.actionlib import __all__ as __all__  # noqa: PLC0414

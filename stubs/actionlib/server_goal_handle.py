@@ -1,0 +1,3 @@
+"""actionlib.server_goal_handle: ServerGoalHandle (minros.actionlib)."""
+
+from minros.actionlib import ServerGoalHandle  # noqa: F401
