@@ -102,19 +102,19 @@ def test_rosrun_usage(tmp_path, pkg_path):
 
 
 def test_rosrun_builtin_missing_module_is_one_line(monkeypatch):
-    from minros.workspace import nodes
+    from minros.workspace import executables
 
-    monkeypatch.setitem(nodes.BUILTIN_NODES, "rospy_tutorials", {"ghost": "minros.no_such.module"})
-    with pytest.raises(nodes.ExecutableError) as err:
-        nodes.resolve_executable("rospy_tutorials", "ghost")
+    monkeypatch.setitem(executables.BUILTIN_NODES, "rospy_tutorials", {"ghost": "minros.no_such.module"})
+    with pytest.raises(executables.ExecutableError) as err:
+        executables.resolve_executable("rospy_tutorials", "ghost")
     assert err.value.lines == ["[rosrun] ghost of package rospy_tutorials is not available in this version of minros"]
 
 
 def test_rosrun_builtin_tutorial_resolves_to_module():
-    from minros.workspace import nodes
+    from minros.workspace import executables
 
-    assert nodes.resolve_executable("rospy_tutorials", "talker.py") == [
-        sys.executable, "-m", "minros.nodes.rospy_tutorials.talker"]
+    assert executables.resolve_executable("rospy_tutorials", "talker.py") == [
+        sys.executable, "-m", "minros.executables.rospy_tutorials.talker"]
 
 
 def test_rospack_find_and_list(tmp_path, pkg_path):
