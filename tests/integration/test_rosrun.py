@@ -114,7 +114,7 @@ def test_rosrun_builtin_tutorial_resolves_to_module():
     from minros.workspace import executables
 
     assert executables.resolve_executable("rospy_tutorials", "talker.py") == [
-        sys.executable, "-m", "minros.executables.rospy_tutorials.talker"]
+        sys.executable, "-m", "minros.nodes.rospy_tutorials.talker"]
 
 
 def test_rospack_find_and_list(tmp_path, pkg_path):
