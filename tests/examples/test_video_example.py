@@ -1,6 +1,6 @@
 """Seed "Opencv-Ros": the webcam publisher and the imshow subscriber, run unmodified.
 
-No webcam and no HighGUI here, so both run with tests/examples/video/fakecam on PYTHONPATH: its
+No webcam and no HighGUI here, so both run with tests/examples/fakecam on PYTHONPATH: its
 sitecustomize.py makes ``cv2.VideoCapture(0)`` produce synthetic frames and ``cv2.imshow`` save
 what it is given (see the module docstring there). The test then checks that the frames the
 subscriber showed are the synthetic camera frames plus the publisher's blue 'A'.

@@ -23,11 +23,13 @@ import cv2
 import numpy as np
 import pytest
 
-from support import IN_CI, PYTHON, Proc, free_port, ros_env, wait_for_master
+from support import EXAMPLES, IN_CI, PYTHON, Proc, free_port, ros_env, wait_for_master
 
 WEB = Path(__file__).resolve().parent.parent / "web"
 JS = WEB / "js"
-VIDEO = Path(__file__).resolve().parent.parent / "examples" / "video"
+VIDEO = EXAMPLES / "video"
+#: the test-only fake webcam shim (a synthetic camera for video_pub.py)
+FAKECAM = Path(__file__).resolve().parent.parent / "examples" / "fakecam"
 CHROMIUM = "/usr/bin/chromium"
 
 
@@ -260,7 +262,7 @@ def test_seed_video_subscriber_frames_appear_at_stream(graph, tmp_path):
     fake = tmp_path / "fakecam"
     fake.mkdir()
     pub = Proc([PYTHON, str(VIDEO / "video_pub.py")],
-               graph.env({"PYTHONPATH": str(VIDEO / "fakecam"), "FAKECAM_DIR": str(fake)}))
+               graph.env({"PYTHONPATH": str(FAKECAM), "FAKECAM_DIR": str(fake)}))
     sub = Proc([PYTHON, str(VIDEO / "video_sub.py")], graph.env())
     try:
         notice = sub.read_until("[imshow]", timeout=30)
