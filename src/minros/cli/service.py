@@ -8,7 +8,6 @@ read from the server's header through a probe connection (with a timeout).
 from __future__ import annotations
 
 import io
-import socket
 import sys
 from typing import Any, List
 
@@ -17,7 +16,9 @@ import yaml
 from minros import names
 from minros.tools.common import ToolError, dispatch, option_parser, resolve, run_tool
 from minros.tools.master import Master, MasterError
+from minros.tools.services import probe_service
 from minros.wire import tcpros
+from minros.wire.rosapi import ParameterInvalid
 
 NAME = "rosservice"
 PROBE_TIMEOUT = 5.0
@@ -44,25 +45,10 @@ def _error(text: str) -> ToolError:
 
 def get_service_headers(service: str, uri: str) -> dict:
     """Probe the server (``probe=1``) and return its connection header."""
-    from minros.client.services import parse_rosrpc_uri
-
     try:
-        host, port = parse_rosrpc_uri(uri)
-    except Exception:
+        return probe_service(uri, service, "/rosservice", PROBE_TIMEOUT)
+    except ParameterInvalid:
         raise _error(f"service [{service}] has an invalid RPC URI [{uri}]") from None
-    try:
-        with socket.create_connection((host, port), timeout=PROBE_TIMEOUT) as sock:
-            sock.sendall(tcpros.encode_header({"probe": "1", "md5sum": "*",
-                                               "callerid": "/rosservice", "service": service}))
-            data = b""
-            while True:
-                parsed = tcpros.read_header_block(data, 1 << 16)
-                if parsed is not None:
-                    return parsed[0]
-                chunk = sock.recv(65536)
-                if not chunk:
-                    raise OSError("connection closed")
-                data += chunk
     except (OSError, tcpros.HeaderError):
         raise _error(f"Unable to communicate with service [{service}], address [{uri}]") from None
 

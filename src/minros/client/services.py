@@ -29,7 +29,7 @@ import time
 import traceback
 import warnings
 import xmlrpc.client
-from typing import Any, Callable, Dict, Tuple
+from typing import Any, Callable, Dict
 
 from minros import names, node
 from minros.client.log import logerr, loginfo, logwarn, logwarn_throttle
@@ -42,7 +42,7 @@ from minros.exceptions import (
     TransportTerminated,
 )
 from minros.wire import sockets, tcpros
-from minros.wire.rosapi import ROSRPC
+from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
 
 # the node context (answers before init_node too)
 _caller_id = node.get_caller_id
@@ -81,24 +81,6 @@ _SMALL_PART = 4096
 _OK = b"\x01"
 
 _logger = logging.getLogger("rospy.service")
-
-
-class ParameterInvalid(ValueError):
-    """An argument failed validation (rospy.impl.validators.ParameterInvalid)."""
-
-
-def parse_rosrpc_uri(uri: str) -> Tuple[str, int]:
-    """``rosrpc://host:port[/...]`` -> ``(host, port)``; ParameterInvalid otherwise."""
-    if not uri.startswith(ROSRPC):
-        raise ParameterInvalid(f"Invalid protocol for ROS service URL: {uri}")
-    rest = uri[len(ROSRPC):]
-    rest = rest.split("/", 1)[0]
-    try:
-        host, port_text = rest.split(":")
-        port = int(port_text)
-    except ValueError:
-        raise ParameterInvalid(f"ROS service URL is invalid: {uri}") from None
-    return host, port
 
 
 # --------------------------------------------------------------------------- sending

@@ -23,14 +23,13 @@ the ``minros`` facade and ``minros.tools``.
 from __future__ import annotations
 
 import fnmatch
-import socket
-import struct
 import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Hashable, List, Optional, Set, Tuple
 
 import minros
+from minros.tools.services import probe_service
 from minros.web.rosapi import Graph
 
 #: seconds between two readings of the master's graph
@@ -70,46 +69,6 @@ def raw_service_class(type_name: str, md5sum: str) -> type:
     response = raw_class(type_name + "Response", md5sum, "")
     return type("RawService", (), {"_type": type_name, "_md5sum": md5sum,
                                    "_request_class": request, "_response_class": response})
-
-
-# -- the service probe (a connection header exchange, no request) --------------------------
-
-def encode_header(fields: Dict[str, str]) -> bytes:
-    """A TCPROS connection header: length-prefixed ``key=value`` fields after a total length."""
-    body = b"".join(struct.pack("<I", len(f)) + f
-                    for f in (f"{k}={v}".encode() for k, v in fields.items()))
-    return struct.pack("<I", len(body)) + body
-
-
-def decode_header(body: bytes) -> Dict[str, str]:
-    out: Dict[str, str] = {}
-    pos = 0
-    while pos + 4 <= len(body):
-        (size,) = struct.unpack_from("<I", body, pos)
-        pos += 4
-        key, _, value = body[pos:pos + size].decode("utf-8", "replace").partition("=")
-        out[key] = value
-        pos += size
-    return out
-
-
-def probe_service(uri: str, service: str, caller_id: str, timeout: float = PROBE_TIMEOUT) -> Dict[str, str]:
-    """The connection header a service server answers a ``probe=1`` header with."""
-    rest = uri[len("rosrpc://"):] if uri.startswith("rosrpc://") else uri
-    host, _, port = rest.rstrip("/").rpartition(":")
-    with socket.create_connection((host, int(port)), timeout=timeout) as sock:
-        sock.sendall(encode_header({"probe": "1", "md5sum": "*", "callerid": caller_id,
-                                    "service": service}))
-        data = b""
-        while len(data) < 4 or len(data) < 4 + struct.unpack_from("<I", data)[0]:
-            chunk = sock.recv(65536)
-            if not chunk:
-                raise OSError("service closed the connection during the handshake")
-            data += chunk
-            if len(data) > 1 << 20:
-                raise OSError("service header too large")
-        (size,) = struct.unpack_from("<I", data)
-        return decode_header(data[4:4 + size])
 
 
 # -- what taps hand out --------------------------------------------------------------------
@@ -404,7 +363,7 @@ class WebState:
         uri = self.service_uri(service)
         if uri is None:
             raise LookupError(f"Service {service} does not exist")
-        return probe_service(uri, service, self.caller_id)
+        return probe_service(uri, service, self.caller_id, PROBE_TIMEOUT)
 
     def service_type(self, service: str) -> str:
         """The type of ``service`` from its server's probe header (cached per provider)."""

@@ -13,7 +13,7 @@ and rospy answer to bad calls (both use the same decorator, ``apivalidate``). Pu
 from __future__ import annotations
 
 import functools
-from typing import Any, Callable, List, Sequence
+from typing import Any, Callable, List, Sequence, Tuple
 
 from minros.names import ANYTYPE, SEP, resolve_name
 
@@ -21,7 +21,7 @@ __all__ = [
     "ERROR", "FAILURE", "ROSRPC", "SUCCESS",
     "ParameterInvalid", "RemoteError", "Validator",
     "api", "empty_or_valid_name", "is_api", "is_topic", "non_empty_str", "not_none",
-    "triplet", "unwrap", "valid_name", "valid_type_name",
+    "parse_rosrpc_uri", "triplet", "unwrap", "valid_name", "valid_type_name",
 ]
 
 #: the call did what was asked
@@ -64,6 +64,19 @@ def unwrap(result: Any) -> Any:
 
 class ParameterInvalid(Exception):
     """An API argument failed validation (-> code -1 with this message)."""
+
+
+def parse_rosrpc_uri(uri: str) -> Tuple[str, int]:
+    """``rosrpc://host:port[/...]`` -> ``(host, port)``; ParameterInvalid otherwise (rospy's texts)."""
+    if not uri.startswith(ROSRPC):
+        raise ParameterInvalid(f"Invalid protocol for ROS service URL: {uri}")
+    rest = uri[len(ROSRPC):].split("/", 1)[0]
+    try:
+        host, port_text = rest.split(":")
+        port = int(port_text)
+    except ValueError:
+        raise ParameterInvalid(f"ROS service URL is invalid: {uri}") from None
+    return host, port
 
 
 #: ``validator(value, caller_id) -> canonical value``; raises ParameterInvalid
