@@ -257,3 +257,60 @@ def anonymous_name(id: str) -> str:  # noqa: A002 - the ROS API's parameter name
 
     name = f"{id}_{socket.gethostname()}_{os.getpid()}_{random.randint(0, sys.maxsize)}"
     return name.replace(".", "_").replace("-", "_").replace(":", "_")
+
+
+# ---------------------------------------------------------------------------------------------
+# package resource names (``pkg/Type``: message, service and node types), as genmsg.names and
+# roslib.names read them
+
+PRN_SEPARATOR = "/"
+_RESOURCE_NAME_LEGAL = re.compile(r"[A-Za-z][\w/]*")
+
+
+def package_resource_name(name: str) -> tuple:
+    """``'std_msgs/String'`` -> ``('std_msgs', 'String')``; ``'String'`` -> ``('', 'String')``.
+
+    Raises ``ValueError`` for more than one separator.
+    """
+    if PRN_SEPARATOR in name:
+        parts = tuple(name.split(PRN_SEPARATOR))
+        if len(parts) != 2:
+            raise ValueError(f"invalid name [{name}]")
+        return parts
+    return "", name
+
+
+def resource_name(res_pkg_name: str, name: str, my_pkg: str | None = None) -> str:
+    """``pkg/name``, or ``name`` alone when it is in ``my_pkg``."""
+    if res_pkg_name != my_pkg:
+        return res_pkg_name + PRN_SEPARATOR + name
+    return name
+
+
+def resource_name_base(name: str) -> str:
+    """``'pkg/Type'`` -> ``'Type'``."""
+    return name[name.rfind(PRN_SEPARATOR) + 1:]
+
+
+def resource_name_package(name: str) -> str | None:
+    """``'pkg/Type'`` -> ``'pkg'``; ``'Type'`` -> None."""
+    if PRN_SEPARATOR not in name:
+        return None
+    return name[:name.find(PRN_SEPARATOR)]
+
+
+def is_legal_resource_name(name: str | None) -> bool:
+    """``[A-Za-z][\\w/]*`` without ``//`` (a package resource name, e.g. ``std_msgs/String``)."""
+    if name is None:
+        return False
+    return _RESOURCE_NAME_LEGAL.fullmatch(name) is not None and "//" not in name
+
+
+def is_legal_resource_base_name(name: str | None) -> bool:
+    """``[A-Za-z]\\w*`` (a resource name without package, e.g. ``String``)."""
+    return is_legal_base_name(name)
+
+
+def normalize_package_context(package_context: str) -> str:
+    """``' pkg// '`` -> ``'pkg'``."""
+    return package_context.strip().rstrip(PRN_SEPARATOR)

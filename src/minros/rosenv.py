@@ -120,3 +120,83 @@ def get_host_name(env: Mapping[str, str] | None = None) -> str:
 
 def create_local_xmlrpc_uri(port: int, env: Mapping[str, str] | None = None) -> str:
     return f"http://{get_host_name(env)}:{port}/"
+
+
+def parse_http_host_and_port(url: str) -> tuple:
+    """``(host, port)`` of an ``http://`` URI (port 80 when absent); ``ValueError`` when the
+    scheme or host is missing (rosgraph.network's check of a master URI)."""
+    from urllib.parse import urlparse
+
+    if not url:
+        raise ValueError("not a valid URL")
+    parts = urlparse(url)
+    if not parts.scheme or not parts.hostname:
+        raise ValueError("not a valid URL")
+    return parts.hostname, parts.port or 80
+
+
+def _interface_addresses() -> tuple:
+    """(IPv4, IPv6) addresses of this machine's interfaces: ioctl SIOCGIFADDR per interface
+    and /proc/net/if_inet6 on Linux, else the addresses the host name resolves to."""
+    v4: list = []
+    v6: list = []
+    try:
+        import fcntl
+        import struct
+
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+            for _index, name in socket.if_nameindex():
+                request = struct.pack("256s", name.encode()[:15])
+                try:
+                    answer = fcntl.ioctl(sock.fileno(), 0x8915, request)  # SIOCGIFADDR
+                except OSError:
+                    continue  # no IPv4 address on this interface
+                v4.append(socket.inet_ntoa(answer[20:24]))
+    except (ImportError, OSError, AttributeError):
+        v4 = []
+    try:
+        with open("/proc/net/if_inet6") as f:
+            for line in f:
+                hexaddr = line.split()[0]
+                v6.append(socket.inet_ntop(socket.AF_INET6, bytes.fromhex(hexaddr)))
+    except (OSError, ValueError, IndexError):
+        pass
+    if not v4:
+        try:
+            v4 = sorted({a[4][0] for a in socket.getaddrinfo(socket.gethostname(), 0,
+                                                              socket.AF_INET, 0, socket.SOL_TCP)})
+        except OSError:
+            v4 = ["127.0.0.1"]
+    return v4, v6
+
+
+def get_local_addresses(env: Mapping[str, str] | None = None) -> list:
+    """This machine's addresses (IPv6 first when ROS_IPV6 is on); not affected by ROS_IP."""
+    v4, v6 = _interface_addresses()
+    return v6 + v4 if use_ipv6(env) else v4
+
+
+def get_local_address(env: Mapping[str, str] | None = None) -> str:
+    """The address override, else the one non-loopback address, else loopback."""
+    override = get_address_override(env)
+    if override:
+        return override
+    addrs = get_local_addresses(env)
+    if len(addrs) == 1:
+        return addrs[0]
+    for addr in addrs:
+        if not addr.startswith("127.") and addr != "::1":
+            return addr
+    return "::1" if use_ipv6(env) else "127.0.0.1"
+
+
+def is_local_address(hostname: str, env: Mapping[str, str] | None = None) -> bool:
+    """Whether ``hostname`` resolves to loopback or to one of this machine's addresses."""
+    family = 0 if use_ipv6(env) else socket.AF_INET
+    try:
+        ips = [a[4][0] for a in socket.getaddrinfo(hostname, 0, family, 0, socket.SOL_TCP)]
+    except (OSError, UnicodeError):
+        return False
+    if any(ip.startswith("127.") or ip == "::1" for ip in ips):
+        return True
+    return bool(set(ips) & ({"localhost"} | set(get_local_addresses(env))))

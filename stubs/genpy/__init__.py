@@ -1,19 +1,13 @@
-"""Stand-in for genpy: the names scripts and tools import from it, served by minros.msgs."""
+"""Stand-in for genpy: what scripts and genpy-generated message modules import from it,
+served by minros.msgs."""
 
 from __future__ import annotations
 
-from typing import Any
-
 from minros.exceptions import DeserializationError, MessageException, SerializationError
-from minros.msgs import Duration, Time, TVal
+from minros.msgs.message import Message, struct_I
+from minros.msgs.tval import Duration, Time, TVal
 
-__all__ = ["Message", "Time", "Duration", "TVal", "MessageException", "DeserializationError",
-           "SerializationError"]
+from . import message, rostime  # noqa: F401 - genpy's __init__ loads both
 
-
-def __getattr__(name: str) -> Any:
-    if name == "Message":  # loaded lazily, as minros.msgs does
-        from minros.msgs import Message
-
-        return Message
-    raise AttributeError(f"module 'genpy' has no attribute '{name}'")
+__all__ = ["Time", "Duration", "TVal", "Message", "SerializationError", "DeserializationError",
+           "MessageException", "struct_I"]

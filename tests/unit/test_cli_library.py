@@ -10,8 +10,8 @@ import pytest
 
 from compare import Outcome, differences, normalize
 from minros.exceptions import MessageException
-from minros.msgs import Duration, Time, get_message_class
-from minros.tools import echo, fill
+from minros.msgs import Duration, Time, fill, get_message_class
+from minros.tools import echo
 from minros.tools.decode import DecodeError, load_class
 
 PoseStamped = get_message_class("geometry_msgs/PoseStamped")

@@ -101,7 +101,7 @@ def get_service_class_by_name(master: Master, service: str) -> Any:
 
 
 def get_service_args(master: Master, service: str) -> str:
-    from minros.tools.fill import printable_message_args
+    from minros.msgs.fill import printable_message_args
 
     return printable_message_args(get_service_class_by_name(master, service)._request_class)
 
@@ -231,7 +231,7 @@ def _summary(args: Any) -> str:
 def call_service(master: Master, service: str, service_args: list, service_class: Any) -> tuple:
     from minros.client.services import ServiceProxy
     from minros.exceptions import MessageException, ServiceException
-    from minros.tools.fill import fill_message_args, printable_message_args, substitution_keys
+    from minros.msgs.fill import fill_message_args, printable_message_args, substitution_keys
 
     request = service_class._request_class()
     try:

@@ -826,7 +826,7 @@ def _cmd_delay(argv: List[str], prog: str) -> int:
 
 def _fill(msg_class: Any, pub_args: list) -> Any:
     from minros.exceptions import MessageException
-    from minros.tools.fill import fill_message_args, printable_message_args, substitution_keys
+    from minros.msgs.fill import fill_message_args, printable_message_args, substitution_keys
 
     msg = msg_class()
     try:

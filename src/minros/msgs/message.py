@@ -7,7 +7,7 @@ Generated classes (see :mod:`minros.msgs.codegen`) provide ``_serialize_parts(ap
 
 from __future__ import annotations
 
-import math
+import codecs
 import struct
 from typing import Any, Callable, Iterable, List
 
@@ -17,7 +17,39 @@ from .tval import Duration, Time, TVal
 
 __all__ = [
     "Message", "strify_message", "check_type", "DeserializationError", "SerializationError",
+    "struct_I", "isstring",
 ]
+
+#: the uint32 of every length prefix (genpy.struct_I: genpy-generated modules use it)
+struct_I = struct.Struct("<I")
+
+
+def isstring(s: Any) -> bool:
+    """genpy.message.isstring: whether ``s`` is a ``str``."""
+    return isinstance(s, str)
+
+
+class RosMsgUnicodeErrors:
+    """The ``'rosmsg'`` codec error handler genpy registers and its generated code decodes
+    strings with: bytes that are not UTF-8 become U+FFFD, and the first time this happens for a
+    message type (``msg_type``, which that code sets before decoding) an error is logged."""
+
+    def __init__(self) -> None:
+        self.msg_type: str | None = None
+        self._warned: set = set()
+
+    def __call__(self, err: UnicodeError) -> tuple:
+        if self.msg_type not in self._warned:
+            self._warned.add(self.msg_type)
+            import logging
+
+            what = f"message {self.msg_type}" if self.msg_type else "unknown message"
+            logging.getLogger("rosout").error(
+                "Characters replaced when decoding %s (will print only once): %s", what, err)
+        return codecs.replace_errors(err)
+
+
+codecs.register_error("rosmsg", RosMsgUnicodeErrors())
 
 #: Largest element count accepted for arrays whose elements occupy no bytes on the wire
 #: (e.g. ``std_msgs/Empty[]``): the count cannot be checked against the data, so bound it.
@@ -58,11 +90,12 @@ class Message:
         return self._slot_types
 
     def _check_types(self, exc: BaseException | None = None) -> None:
-        """Type-check every field; raise :class:`SerializationError` naming the bad one."""
-        for name, type_ in zip(self.__slots__, self._slot_types):
-            check_type(name, type_, getattr(self, name, None))
+        """Type-check every field; raise :class:`SerializationError` naming the bad one, else
+        (when given) one carrying ``exc``'s text, as genpy does."""
+        for name, type_ in zip(self.__slots__, self._get_types()):
+            check_type(name, type_, getattr(self, name))
         if exc is not None:
-            raise SerializationError(f"{self._type}: {exc}")
+            raise SerializationError(str(exc))
 
     def serialize(self, buff: Any) -> None:
         """Write the wire form of this message to ``buff`` (anything with ``.write``).
@@ -75,6 +108,10 @@ class Message:
             self._serialize_parts(buff.write)
         except _SERIALIZE_ERRORS as exc:
             raise _serialization_error(self, exc) from None
+        except NotImplementedError:
+            if type(self)._serialize_parts is not Message._serialize_parts:
+                raise
+            # genpy's base Message: a class without fields of its own writes nothing
 
     def serialize_to_bytes(self) -> bytes:
         """The wire form of this message as ``bytes``."""
@@ -93,13 +130,18 @@ class Message:
         """
         view = data
         if data.__class__ is not bytes:
-            if self._zero_copy:
-                # may hold a big array: read it in place, copy only the fields
-                view = data if data.__class__ is memoryview else memoryview(data)
-                if view.format != "B" or view.ndim != 1:
-                    view = view.cast("B")
-            else:
-                view = bytes(data)  # small: one copy, then the faster bytes operations
+            try:
+                if self._zero_copy:
+                    # may hold a big array: read it in place, copy only the fields
+                    view = data if data.__class__ is memoryview else memoryview(data)
+                    if view.format != "B" or view.ndim != 1:
+                        view = view.cast("B")
+                else:
+                    view = bytes(data)  # small: one copy, then the faster bytes operations
+            except TypeError:
+                if type(self)._deserialize_from is Message._deserialize_from:
+                    return self  # genpy's base Message reads nothing, whatever it is given
+                raise
         try:
             try:
                 end = self._deserialize_from(view, 0)
@@ -107,6 +149,10 @@ class Message:
                 # made without its constructor (cls.__new__): give it default fields first
                 self.__init__()
                 end = self._deserialize_from(view, 0)
+        except NotImplementedError:
+            if type(self)._deserialize_from is not Message._deserialize_from:
+                raise
+            return self  # genpy's base Message reads nothing
         except struct.error:
             raise DeserializationError(
                 f"{self._type}: message truncated ({len(view)} bytes do not hold a whole message)"
@@ -209,116 +255,97 @@ def _init_fields(msg: Message, args: tuple, kwds: dict) -> None:
 
 
 # ---------------------------------------------------------------------------------------------
-# type checking (diagnosis of serialization failures)
+# type checking (genpy.message.check_type: diagnosis of serialization failures)
 
-def check_type(field_name: str, field_type: str, value: Any) -> None:
-    """Raise :class:`SerializationError` if ``value`` cannot be written as ``field_type``."""
-    if field_type in _INT_WIDTHS:
-        bits, signed = _INT_WIDTHS[field_type]
-        if isinstance(value, bool) or not isinstance(value, int):
-            if not _is_numpy_integer(value):
-                raise SerializationError(
-                    f"field {field_name} must be an integer ({field_type}), not {type(value).__name__}")
-            value = int(value)
-        lower, upper = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
-        if not lower <= value <= upper:
-            raise SerializationError(
-                f"field {field_name} value {value} exceeds the range of {field_type} [{lower}, {upper}]")
-    elif field_type in ("float32", "float64"):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            if not _is_numpy_number(value):
-                raise SerializationError(
-                    f"field {field_name} must be a float ({field_type}), not {type(value).__name__}")
-        if field_type == "float32" and isinstance(value, (int, float)) and math.isfinite(value):
-            try:
-                struct.pack("<f", value)
-            except (OverflowError, struct.error):
-                raise SerializationError(
-                    f"field {field_name} value {value} is out of range for float32") from None
-    elif field_type == "bool":
-        if value not in (True, False, 0, 1):
-            raise SerializationError(f"field {field_name} is not a bool: {value!r}")
-    elif field_type == "string":
-        if isinstance(value, str):
-            try:
-                value.encode("utf-8")
-            except UnicodeEncodeError as exc:
-                raise SerializationError(f"field {field_name} cannot be encoded as UTF-8: {exc}") from None
-        elif not isinstance(value, (bytes, bytearray)):
-            raise SerializationError(f"field {field_name} must be a str, not {type(value).__name__}")
-    elif field_type == "time":
-        if not isinstance(value, Time):
-            raise SerializationError(f"field {field_name} must be a Time, not {type(value).__name__}")
-        _check_tval(field_name, value, 0, (1 << 32) - 1)
-    elif field_type == "duration":
-        if not isinstance(value, Duration):
-            raise SerializationError(f"field {field_name} must be a Duration, not {type(value).__name__}")
-        _check_tval(field_name, value, -(1 << 31), (1 << 31) - 1)
-    elif field_type.endswith("]"):
-        base, _, rest = field_type.partition("[")
-        length = int(rest[:-1]) if rest[:-1] else None
-        if base in ("uint8", "char") and _is_bytes_like(value):
-            size = len(memoryview(value).cast("B")) if not isinstance(value, (bytes, bytearray)) else len(value)
-            if length is not None and size != length:
-                raise SerializationError(
-                    f"field {field_name} must have exactly {length} bytes, not {size}")
-            return
-        if isinstance(value, (str, bytes, bytearray)) or not _is_sequence(value):
-            raise SerializationError(
-                f"field {field_name} must be a list or tuple ({field_type}), not {type(value).__name__}")
-        if length is not None and len(value) != length:
-            raise SerializationError(
-                f"field {field_name} must have exactly {length} elements, not {len(value)}")
-        for index, item in enumerate(value):
-            check_type(f"{field_name}[{index}]", base, item)
-    else:
-        if not isinstance(value, Message):
-            raise SerializationError(
-                f"field {field_name} must be a {field_type} message, not {type(value).__name__}")
-        if value._type != field_type and not (
-                field_type == "std_msgs/Header" and value._type == "roslib/Header"):
-            raise SerializationError(
-                f"field {field_name} must be a {field_type}, not a {value._type}")
-        for name, type_ in zip(value.__slots__, value._slot_types):
-            check_type(f"{field_name}.{name}", type_, getattr(value, name, None))
+#: numpy scalar types genpy accepts for a float field (besides float and int)
+_NUMPY_NUMBER_TYPES = {"float32", "float64", "int8", "int16", "int32", "int64", "uint8",
+                       "uint16", "uint32", "uint64"}
+_SIMPLE_TYPES = frozenset(_INT_WIDTHS) | {"float32", "float64", "bool"}
 
 
-def _check_tval(field_name: str, value: TVal, lower: int, upper: int) -> None:
-    for part in ("secs", "nsecs"):
-        item = getattr(value, part)
-        if not isinstance(item, int) or not lower <= item <= upper:
-            raise SerializationError(
-                f"field {field_name}.{part} value {item!r} does not fit the wire format")
-
-
-def _is_numpy_integer(value: Any) -> bool:
-    kind = getattr(getattr(value, "dtype", None), "kind", None)
-    return kind in ("i", "u") and getattr(value, "ndim", 1) == 0
-
-
-def _is_numpy_number(value: Any) -> bool:
-    kind = getattr(getattr(value, "dtype", None), "kind", None)
-    return kind in ("i", "u", "f") and getattr(value, "ndim", 1) == 0
-
-
-def _is_bytes_like(value: Any) -> bool:
-    if isinstance(value, (bytes, bytearray, memoryview)):
+def _is_float_value(value: Any) -> bool:
+    cls = type(value)
+    if cls is float or cls is int:
         return True
-    return hasattr(value, "__array_interface__") and getattr(value, "dtype", None) is not None \
-        and value.dtype.kind in ("u", "i") and value.dtype.itemsize == 1
+    return cls.__module__ == "numpy" and cls.__name__ in _NUMPY_NUMBER_TYPES
 
 
-def _is_sequence(value: Any) -> bool:
-    return isinstance(value, (list, tuple)) or hasattr(value, "__array_interface__")
+def check_type(field_name: str, field_type: str, field_val: Any) -> None:
+    """Raise :class:`SerializationError` if ``field_val`` cannot be written as ``field_type``.
+
+    genpy's rules and texts (its generated code calls this after a failed serialization to
+    name the bad field): integers must be ``int`` within the type's width, floats Python or
+    numpy numbers, strings ASCII ``str`` or ``bytes``, ``uint8[]``/``char[]`` may be ``bytes``
+    or ``str``, other arrays lists or tuples, embedded messages of the declared type.
+    """
+    if field_type in _SIMPLE_TYPES:
+        if field_type in _INT_WIDTHS:
+            bits, signed = _INT_WIDTHS[field_type]
+            if signed:
+                if type(field_val) is not int:
+                    raise SerializationError(f"field {field_name} must be an integer type")
+                if not -(1 << (bits - 1)) <= field_val < (1 << (bits - 1)):
+                    raise SerializationError(
+                        f"field {field_name} exceeds specified width [{field_type}]")
+            else:
+                if type(field_val) is not int or field_val < 0:
+                    raise SerializationError(f"field {field_name} must be unsigned integer type")
+                if field_val >= (1 << bits):
+                    raise SerializationError(
+                        f"field {field_name} exceeds specified width [{field_type}]")
+        elif field_type == "bool":
+            if field_val not in (True, False, 0, 1):
+                raise SerializationError(f"field {field_name} is not a bool")
+        elif not _is_float_value(field_val):
+            raise SerializationError(f"field {field_name} must be float type")
+    elif field_type == "string":
+        if type(field_val) is str:
+            if not field_val.isascii():
+                raise SerializationError(f"field {field_name} is a non-ascii string")
+        elif type(field_val) is not bytes:
+            raise SerializationError(
+                f"field {field_name} must be of type bytes or an ascii string")
+    elif field_type == "time":
+        if not isinstance(field_val, Time):
+            raise SerializationError(f"field {field_name} must be of type Time")
+    elif field_type == "duration":
+        if not isinstance(field_val, Duration):
+            raise SerializationError(f"field {field_name} must be of type Duration")
+    elif field_type.endswith("]"):
+        base_type = field_type[:field_type.index("[")]
+        if type(field_val) in (bytes, str):
+            if base_type not in ("char", "uint8"):
+                raise SerializationError(f"field {field_name} must be a list or tuple type. "
+                                         "Only uint8[] can be a string")
+            return
+        if type(field_val) not in (list, tuple):
+            raise SerializationError(f"field {field_name} must be a list or tuple type")
+        for item in field_val:
+            check_type(field_name + "[]", base_type, item)
+    elif isinstance(field_val, Message):
+        if field_val._type in ("std_msgs/Header", "roslib/Header"):
+            if field_type not in ("Header", "std_msgs/Header", "roslib/Header"):
+                raise SerializationError(
+                    f"field {field_name} must be a Header instead of a {field_val._type}")
+        elif field_val._type != field_type:
+            raise SerializationError(
+                f"field {field_name} must be of type {field_type} instead of {field_val._type}")
+        for name, type_ in zip(field_val.__slots__, field_val._get_types()):
+            check_type(f"{field_name}.{name}", type_, getattr(field_val, name))
+    else:
+        raise SerializationError(f"field {field_name} must be of type [{field_type}]")
 
 
 def _serialization_error(msg: Message, exc: BaseException) -> SerializationError:
-    """Find the field that made serialization fail and say so."""
+    """What genpy's generated code raises when writing fails: check_type's diagnosis of the
+    first bad field, else the underlying error's text."""
     try:
         msg._check_types()
     except SerializationError as found:
-        return SerializationError(f"{msg._type}: {found}")
-    return SerializationError(f"{msg._type}: cannot serialize: {type(exc).__name__}: {exc}")
+        return found
+    if isinstance(exc, SerializationError):
+        return exc
+    return SerializationError(f"{type(exc)}: '{exc}' when writing '{msg._type}'")
 
 
 # ---------------------------------------------------------------------------------------------

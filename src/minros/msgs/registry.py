@@ -332,6 +332,33 @@ def get_service_class(type_name: str) -> type:
     return REGISTRY.get_service_class(type_name)
 
 
+def import_class(type_name: str, kind: str = "msg") -> Any:
+    """genpy's lookup: the class ``Type`` of module ``<pkg>.msg`` (``.srv`` for ``kind='srv'``)
+    or None when there is none, so a genpy-generated package on sys.path is found as in ROS,
+    and minros's own classes through its stand-in packages. ``'time'``/``'duration'`` give
+    Time/Duration; ``'Header'`` means std_msgs/Header; a name without a package is a
+    ``ValueError``. A malformed definition raises :class:`MsgSpecError` naming its file.
+    """
+    import importlib
+
+    from .tval import Duration, Time
+
+    if kind == "msg" and type_name == "time":
+        return Time
+    if kind == "msg" and type_name == "duration":
+        return Duration
+    package, _, base = type_name.rpartition("/")
+    if not package:
+        if base != "Header":
+            raise ValueError(f"message type is missing package name: {type_name}")
+        package = "std_msgs"
+    try:
+        module = importlib.import_module(f"{package}.{kind}")
+    except ImportError:
+        return None
+    return getattr(module, base, None)
+
+
 def numpy_msg(cls: type) -> type:
     """The variant of message class ``cls`` whose numeric arrays deserialize as numpy views."""
     return (getattr(cls, "_context", None) or REGISTRY).get_numpy_class(cls)

@@ -14,7 +14,7 @@ from typing import Any, Callable
 
 from minros.exceptions import DeserializationError, SerializationError
 
-from .message import MAX_EMPTY_ELEMENTS, Message, _init_fields
+from .message import MAX_EMPTY_ELEMENTS, Message, _init_fields, struct_I
 from .tval import Duration, Time
 
 #: genpy's constructor rules (all fields positionally, or any by keyword)
@@ -23,7 +23,7 @@ init_fields = _init_fields
 #: ``new(Cls)`` makes an instance without running ``__init__`` (deserialization fills it).
 new = object.__new__
 #: the uint32 used for every length and count prefix
-S_I = Struct("<I")
+S_I = struct_I
 
 _ITEM_SIZE = {"b": 1, "B": 1, "?": 1, "h": 2, "H": 2, "i": 4, "I": 4, "q": 8, "Q": 8,
               "f": 4, "d": 8}

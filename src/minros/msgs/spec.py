@@ -89,16 +89,22 @@ def split_array(type_: str) -> Tuple[str, bool, int | None]:
 class Field:
     """One field of a message: its name and resolved type."""
 
-    __slots__ = ("name", "type", "base_type", "is_array", "array_len", "is_builtin")
+    __slots__ = ("name", "type", "base_type", "is_array", "array_len", "is_builtin", "is_header")
 
     def __init__(self, name: str, type_: str) -> None:
         self.name = name
         self.type = type_
         self.base_type, self.is_array, self.array_len = split_array(type_)
         self.is_builtin = is_builtin(self.base_type)
+        self.is_header = type_ in (HEADER, HEADER_FULL_NAME, "roslib/Header")
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Field) and (self.name, self.type) == (other.name, other.type)
+
+    __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:
-        return f"Field({self.type} {self.name})"
+        return f"[{self.name}, {self.type}, {self.base_type}, {self.is_array}, {self.array_len}]"
 
 
 class Constant:
@@ -112,8 +118,21 @@ class Constant:
         self.value = value
         self.val_text = val_text
 
+    @property
+    def val(self) -> object:
+        """genmsg's name for :attr:`value`."""
+        return self.value
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Constant) and \
+            (self.type, self.name, self.value) == (other.type, other.name, other.value)
+
+    __hash__ = None  # type: ignore[assignment]
+
     def __repr__(self) -> str:
-        return f"Constant({self.type} {self.name}={self.val_text})"
+        return f"{self.type} {self.name}={self.value}"
+
+    __str__ = __repr__
 
 
 class MsgSpec:

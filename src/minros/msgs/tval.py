@@ -243,3 +243,9 @@ class Duration(TVal):
         if not isinstance(other, Duration):
             return False
         return self.secs == other.secs and self.nsecs == other.nsecs
+
+
+# genpy's Time and Duration list their fields in ``__slots__`` and code written for genpy
+# iterates them (YAML/JSON converters); here the slots live on TVal, so the subclasses name
+# them as a plain class attribute after creation (it no longer affects the layout).
+Time.__slots__ = Duration.__slots__ = ["secs", "nsecs"]  # type: ignore[misc]

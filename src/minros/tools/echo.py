@@ -98,11 +98,10 @@ def field_type(msg_class: Any, path: str) -> str | None:
         if i + 1 < len(fields):
             value = getattr(cls(), name)
             if isinstance(value, list):
-                from minros.tools.fill import _element_class, parse_type
+                from minros.msgs.fill import _element_class, parse_type
 
-                try:
-                    cls = _element_class(cls(), name, parse_type(type_name)[0])
-                except LookupError:
+                cls = _element_class(cls(), name, parse_type(type_name)[0])
+                if cls is None:
                     return None
             else:
                 cls = type(value)
