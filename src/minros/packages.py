@@ -13,7 +13,7 @@ import os
 import re
 import threading
 from pathlib import Path
-from typing import Dict, List, Optional
+from typing import Any, Dict, List, Optional
 
 #: Folders under which minros keeps the packages it ships, in lookup order.
 BUILTIN_SHARE_DIRS: List[Path] = [Path(__file__).resolve().parent / "msgs" / "share"]
@@ -88,3 +88,58 @@ def is_builtin(package_dir: Path) -> bool:
     """Whether ``package_dir`` is one of the packages minros ships."""
     resolved = Path(package_dir).resolve()
     return any(root in resolved.parents for root in BUILTIN_SHARE_DIRS)
+
+
+# ---------------------------------------------------------------------------------------------
+# roslib's package API on rospkg (manifests, dependencies, the rosbuild python path)
+
+def rospack() -> Any:
+    """A ``rospkg.RosPack`` over the same roots minros searches (ROS_PACKAGE_PATH, then the
+    bundled packages): rospkg reads manifests and dependency lists as ROS's tools do."""
+    import rospkg
+
+    return rospkg.RosPack(ros_paths=[str(p) for p in _search_roots()])
+
+
+_bootstrapped: List[str] = []
+
+
+def load_manifest(package_name: str) -> List[str]:
+    """roslib.load_manifest: check that ``package_name`` exists (``rospkg.ResourceNotFound``
+    naming the search path when it does not) and, for a rosbuild package (``manifest.xml``),
+    return the folders to put on sys.path (its and its dependencies' ``src``/``lib`` or python
+    exports), as catkin-era ROS does. A catkin package needs none."""
+    if package_name in _bootstrapped:
+        return []
+    pack = rospack()
+    manifest = pack.get_manifest(package_name)
+    if manifest.is_catkin:
+        _bootstrapped.append(package_name)
+        return []
+    paths: List[str] = []
+    for name in pack.get_depends(package_name, implicit=True) + [package_name]:
+        folder = pack.get_path(name)
+        exports = pack.get_manifest(name).get_export("python", "path")
+        if exports:
+            paths += [e.replace("${prefix}", folder) for x in exports for e in x.split(":")]
+        else:
+            paths += [d for d in (os.path.join(folder, "src"), os.path.join(folder, "lib"))
+                      if os.path.isdir(d)]
+        _bootstrapped.append(name)
+    return paths
+
+
+def find_resource(package: str, resource_name: str, filter_fn: Any = None) -> List[str]:
+    """Files called ``resource_name`` below package ``package`` (roslib.packages.find_resource),
+    optionally kept only where ``filter_fn(path)`` is true; none for a missing package."""
+    folder = find_package(package)
+    if folder is None:
+        return []
+    found = []
+    for dirpath, dirnames, filenames in os.walk(folder, followlinks=True):
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith("."))
+        if resource_name in filenames:
+            path = os.path.join(dirpath, resource_name)
+            if filter_fn is None or filter_fn(path):
+                found.append(path)
+    return found

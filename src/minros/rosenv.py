@@ -52,6 +52,14 @@ def ros_log_dir(env: Optional[Mapping[str, str]] = None) -> Path:
     return ros_home(env) / "log"
 
 
+def test_results_dir(env: Optional[Mapping[str, str]] = None) -> Path:
+    """ROS_TEST_RESULTS_DIR, else ``$ROS_HOME/test_results`` (where rostest writes JUnit XML)."""
+    env = os.environ if env is None else env
+    if env.get("ROS_TEST_RESULTS_DIR"):
+        return Path(env["ROS_TEST_RESULTS_DIR"])
+    return ros_home(env) / "test_results"
+
+
 def renew_latest_log_dir(run_dir: Path) -> None:
     """Point ``<log dir>/latest`` at ``run_dir`` (a run's directory), as roscore and roslaunch
     do. A ``latest`` that is a real file or directory is left alone; failures print rosgraph's

@@ -11,7 +11,7 @@ import sys
 import xmlrpc.client
 from typing import Any, Dict, List, Tuple
 
-from minros import rosenv
+from minros import names, rosenv
 from minros.wire.xmlrpc import ServerProxy
 
 DEFAULT_MASTER_URI = rosenv.DEFAULT_MASTER_URI
@@ -54,15 +54,43 @@ def call_node(uri: str, method: str, *args: Any, timeout: float = TOOL_TIMEOUT) 
         proxy.close()
 
 
+#: rosgraph.masterapi's names for the same classes
+ROSMasterException = MasterException
+Error = MasterError
+Failure = MasterFailure
+
+
 class Master:
-    """Calls master methods with ``caller_id`` prepended; results unwrapped as rosgraph does."""
+    """Calls master methods with ``caller_id`` prepended; results unwrapped as rosgraph does.
+
+    This is rosgraph.Master: ``Master('/rostopic').getParam('/x')``; a relative caller id is
+    put in the ROS namespace. Every call is bounded by ``timeout`` seconds.
+    """
 
     def __init__(self, caller_id: str, master_uri: str | None = None,
                  timeout: float = TOOL_TIMEOUT) -> None:
-        self.caller_id = caller_id
+        caller_id = names.make_caller_id(caller_id)
+        self.caller_id = caller_id[:-1] if caller_id.endswith("/") else caller_id
         self.uri = master_uri or get_master_uri()
         self.timeout = timeout
         self._proxy: ServerProxy | None = None
+
+    @property
+    def master_uri(self) -> str:
+        return self.uri
+
+    @property
+    def handle(self) -> ServerProxy:
+        """The XML-RPC proxy of the master (rosgraph's name)."""
+        return self._get_proxy()
+
+    def is_online(self) -> bool:
+        """Whether the master answers ``getPid``."""
+        try:
+            self.getPid()
+            return True
+        except Exception:  # noqa: BLE001 - any failure means "not online", as in rosgraph
+            return False
 
     def _get_proxy(self) -> ServerProxy:
         if self._proxy is None:
@@ -95,7 +123,7 @@ class Master:
         raise MasterFailure(str(msg))
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("_"):
+        if name.startswith("_") or name in ("uri", "timeout", "caller_id"):
             raise AttributeError(name)
         return lambda *args: self.call(name, *args)
 
@@ -122,3 +150,8 @@ class Master:
             except MasterException:
                 cache[node] = None
         return cache[node]
+
+
+def is_online(master_uri: str | None = None) -> bool:
+    """Whether the master at ``master_uri`` (default: the environment's) answers."""
+    return Master("rosgraph", master_uri=master_uri).is_online()

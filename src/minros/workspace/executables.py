@@ -172,10 +172,7 @@ def resolve_executable(pkg: str, executable: str) -> List[str]:
             raise ExecutableError([f"[rosrun] Couldn't find executable named {absname}"], 3,
                                   f"couldn't find executable named {absname}")
         return command_for(absname)
-    candidates: List[Path] = []
-    for root in _libexec_dirs(pkg) + [pkg_dir]:
-        candidates += [p for p in _search(root, executable, root == pkg_dir) if _is_executable_file(p)]
-    unique = list(dict.fromkeys(candidates))
+    unique = _executables_in(pkg, pkg_dir, executable)
     if not unique:
         lines = [f"[rosrun] Couldn't find executable named {executable} below {pkg_dir}"]
         others = _search(pkg_dir, executable, skip_build=False)
@@ -191,6 +188,24 @@ def resolve_executable(pkg: str, executable: str) -> List[str]:
             f"non-unique executable {executable} in package {pkg}: " + ", ".join(map(str, unique)),
             candidates=unique)
     return command_for(unique[0])
+
+
+def _executables_in(pkg: str, pkg_dir: Path, executable: str) -> List[Path]:
+    """Executable files called ``executable`` in ``<prefix>/lib/<pkg>`` folders, then below
+    the package folder (``build/`` skipped), each once."""
+    candidates: List[Path] = []
+    for root in _libexec_dirs(pkg) + [pkg_dir]:
+        candidates += [p for p in _search(root, executable, root == pkg_dir) if _is_executable_file(p)]
+    return list(dict.fromkeys(candidates))
+
+
+def find_executables(pkg: str, executable: str) -> List[Path]:
+    """The files rosrun would choose among for ``pkg executable`` (roslib.packages.find_node):
+    none for a package that is missing or a program minros ships as a module."""
+    pkg_dir = packages.find_package(pkg)
+    if pkg_dir is None:
+        return []
+    return _executables_in(pkg, pkg_dir, executable)
 
 
 def child_environment(env: Dict[str, str] | None = None) -> Dict[str, str]:

@@ -1,0 +1,13 @@
+"""rosgraph.masterapi: Master and its errors (minros.tools.master)."""
+
+from minros.rosenv import parse_http_host_and_port  # noqa: F401
+from minros.tools.master import (  # noqa: F401
+    Error,
+    Failure,
+    Master,
+    MasterError,
+    MasterException,
+    MasterFailure,
+    ROSMasterException,
+    is_online,
+)

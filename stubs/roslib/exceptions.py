@@ -1,0 +1,5 @@
+"""roslib.exceptions."""
+
+
+class ROSLibException(Exception):
+    """Base of roslib's errors."""

@@ -1,0 +1,9 @@
+"""roslib.network: rosgraph.network's helpers."""
+
+from rosgraph.network import *  # noqa: F401, F403
+from rosgraph.network import (  # noqa: F401
+    decode_ros_handshake_header,
+    encode_ros_handshake_header,
+    read_ros_handshake_header,
+    write_ros_handshake_header,
+)
