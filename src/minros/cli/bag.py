@@ -377,3 +377,7 @@ def play_node_main() -> int:
         return play_cmd(sys.argv[1:], "rosbag")
     except SystemExit as exc:
         return int(exc.code or 0)
+
+
+if __name__ == "__main__":  # rosrun rosbag rosbag / <node pkg="rosbag" type="rosbag">
+    sys.exit(main(sys.argv[1:]))

@@ -12,7 +12,7 @@ import re
 import socket
 import sys
 import time
-from typing import Dict, List, Tuple
+from typing import Any, Callable, Dict, List, Tuple
 from urllib.parse import urlparse
 
 from minros import names
@@ -480,3 +480,56 @@ COMMANDS = {"list": _cmd_list, "info": _cmd_info, "ping": _cmd_ping, "kill": _cm
 
 def main(argv: List[str], prog: str = "rosnode") -> int:
     return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE, usage_status=64))
+
+
+# ---------------------------------------------------------------------------------------------
+# the Python API of ROS's rosnode module (the stand-in re-exports it)
+
+
+class ROSNodeException(Exception):
+    """A rosnode call failed."""
+
+
+class ROSNodeIOException(ROSNodeException):
+    """The master could not be reached."""
+
+
+def _library(fn: Callable[[], Any]) -> Any:
+    from minros.tools.common import library_call
+
+    return library_call(fn, ROSNodeException, ROSNodeIOException)
+
+
+def rosnode_get_node_names(namespace: str | None = None) -> List[str]:
+    return _library(lambda: get_node_names(Master(ID), namespace))
+
+
+def rosnode_ping(node_name: str, max_count: int | None = None, verbose: bool = False) -> bool:
+    """Ping ``node_name`` through its getPid; True when it answered."""
+    return _library(lambda: ping(_Graph(), node_name, max_count, verbose))
+
+
+def rosnode_ping_all(verbose: bool = False) -> Tuple[List[str], List[str]]:
+    return _library(lambda: ping_all(_Graph(), verbose))
+
+
+def rosnode_kill_nodes(node_names: List[str]) -> Tuple[List[str], List[str]]:
+    """Ask each node to shut down: ``(killed, unknown)``."""
+    return _library(lambda: kill_nodes(_Graph(), list(node_names)))
+
+
+def rosnode_get_api_uri(master: Any, caller_id: str, skip_cache: bool = False) -> str | None:
+    return _library(lambda: _Graph().node_uri(caller_id, skip_cache))
+
+
+def rosnode_info(node_name: str) -> None:
+    print(_library(lambda: info_description(Master(ID), node_name)))
+
+
+def rosnodemain(argv: List[str] | None = None) -> None:
+    """The rosnode command (``argv`` as sys.argv, program name first)."""
+    sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
+
+
+if __name__ == "__main__":  # rosrun rosnode rosnode
+    sys.exit(main(sys.argv[1:]))

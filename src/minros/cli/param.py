@@ -11,7 +11,7 @@ import optparse
 import os
 import sys
 import xmlrpc.client
-from typing import Any, List, Tuple
+from typing import Any, Callable, List, Tuple
 
 import yaml
 
@@ -357,3 +357,92 @@ COMMANDS = {"get": _cmd_get, "set": _cmd_set, "load": _cmd_load, "dump": _cmd_du
 
 def main(argv: List[str], prog: str = "rosparam") -> int:
     return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE))
+
+
+# ---------------------------------------------------------------------------------------------
+# the Python API of ROS's rosparam module (the stand-in re-exports it): the same code as the
+# commands, raising RosParamException instead of exiting
+
+
+class RosParamException(Exception):
+    """A rosparam call failed."""
+
+
+class RosParamIOException(RosParamException):
+    """The master could not be reached."""
+
+
+def _library(fn: Callable[[], Any]) -> Any:
+    from minros.tools.common import library_call
+
+    return library_call(fn, RosParamException, RosParamIOException)
+
+
+def load_file(filename: str, default_namespace: str | None = None,
+              verbose: bool = False) -> List[Tuple[Any, str]]:
+    """The YAML documents of ``filename`` as ``[(values, namespace), ...]`` (``_ns`` keys
+    honoured); nothing is set yet."""
+    def run() -> List[Tuple[Any, str]]:
+        ns = resolve(NAME, default_namespace or "")
+        try:
+            with open(filename) as f:
+                text = f.read()
+        except OSError as exc:
+            raise ToolError(f"file [{filename}] does not exist: {exc.strerror}") from None
+        return load_documents(text, ns, verbose)
+
+    return _library(run)
+
+
+def upload_params(ns: str, values: Any, verbose: bool = False) -> None:
+    """Set ``values`` under namespace ``ns`` (dictionaries merged key by key)."""
+    _library(lambda: set_param_raw(_master(), resolve(NAME, ns), values, verbose))
+
+
+def get_param(param: str) -> Any:
+    """The value of ``param`` (a namespace gives a dictionary)."""
+    return _library(lambda: _master().getParam(resolve(NAME, param)))
+
+
+def set_param(param: str, value: str, verbose: bool = False) -> None:
+    """Set ``param`` from ``value`` given as YAML text, as ``rosparam set`` does."""
+    _library(lambda: set_param_raw(_master(), resolve(NAME, param), yaml_load(value), verbose))
+
+
+def delete_param(param: str, verbose: bool = False) -> None:
+    def run() -> None:
+        name = resolve(NAME, param)
+        _master().deleteParam(name)
+        if verbose:
+            print(f"deleted parameter [{name}]")
+
+    _library(run)
+
+
+def list_params_api(ns: str) -> List[str]:
+    return _library(lambda: list_params(_master(), resolve(NAME, ns)))
+
+
+def dump_params(filename: str, param: str, verbose: bool = False) -> None:
+    """Write the parameters under ``param`` to ``filename`` as YAML (``rosparam dump``)."""
+    def run() -> None:
+        ns = resolve(NAME, param)
+        tree = _master().getParam(ns)
+        if verbose:
+            print_params(tree, ns)
+        try:
+            with open(filename, "w") as f:
+                f.write(dump_yaml(tree))
+        except OSError as exc:
+            raise ToolError(f"cannot write [{filename}]: {exc.strerror}") from None
+
+    _library(run)
+
+
+def yamlmain(argv: List[str] | None = None) -> None:
+    """The rosparam command (``argv`` as sys.argv, program name first)."""
+    sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
+
+
+if __name__ == "__main__":  # rosrun rosparam rosparam / <node pkg="rosparam" type="rosparam">
+    sys.exit(main(sys.argv[1:]))

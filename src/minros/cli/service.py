@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import io
 import sys
-from typing import Any, List
+from typing import Any, Callable, List
 
 import yaml
 
@@ -331,3 +331,70 @@ def main(argv: List[str], prog: str = "rosservice") -> int:
         print(USAGE)
         return 64
     return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE, usage_status=64), io_status=2)
+
+
+# ---------------------------------------------------------------------------------------------
+# the Python API of ROS's rosservice module (the stand-in re-exports it): the same code as the
+# commands, raising rosservice's exceptions instead of exiting
+
+
+class ROSServiceException(Exception):
+    """A rosservice call failed."""
+
+
+class ROSServiceIOException(ROSServiceException):
+    """The master or the service could not be reached."""
+
+
+def _library(fn: Callable[[], Any]) -> Any:
+    from minros.tools.common import library_call
+
+    return library_call(fn, ROSServiceException, ROSServiceIOException)
+
+
+def _api(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``fn(master, service, ...)`` as rosservice's ``fn(service, ...)``: the name resolved
+    as the command resolves it, a master of its own."""
+    def call(service: str, *args: Any, **kwds: Any) -> Any:
+        return _library(lambda: fn(_master(), resolve(NAME, service), *args, **kwds))
+
+    call.__name__ = fn.__name__
+    call.__doc__ = fn.__doc__
+    return call
+
+
+rosservice_get_service_type = _api(get_service_type)
+rosservice_get_service_uri = _api(get_service_uri)
+rosservice_get_service_node = _api(get_service_node)
+rosservice_get_service_class_by_name = _api(get_service_class_by_name)
+rosservice_get_service_args = _api(get_service_args)
+
+
+def rosservice_get_service_headers(service_name: str, service_uri: str) -> dict:
+    return _library(lambda: get_service_headers(service_name, service_uri))
+
+
+def rosservice_get_service_list(node: str | None = None, namespace: str | None = None,
+                                include_nodes: bool = False) -> list:
+    return _library(lambda: get_service_list(_master(), node, namespace, include_nodes))
+
+
+def rosservice_call_service(service_name: str, service_args: list,
+                            service_class: Any = None) -> tuple:
+    """``(request, response)`` of calling ``service_name`` with YAML-parsed ``service_args``."""
+    def run() -> tuple:
+        master = _master()
+        service = resolve(NAME, service_name)
+        cls = service_class or get_service_class_by_name(master, service)
+        return call_service(master, service, service_args, cls)
+
+    return _library(run)
+
+
+def rosservicemain(argv: List[str] | None = None) -> None:
+    """The rosservice command (``argv`` as sys.argv, program name first)."""
+    sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
+
+
+if __name__ == "__main__":  # rosrun rosservice rosservice
+    sys.exit(main(sys.argv[1:]))

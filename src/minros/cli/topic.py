@@ -1062,3 +1062,110 @@ def main(argv: List[str], prog: str = "rostopic") -> int:
         print(USAGE)
         return 64
     return run_tool(lambda: dispatch(argv, prog, COMMANDS, USAGE, usage_status=64))
+
+
+# ---------------------------------------------------------------------------------------------
+# the Python API of ROS's rostopic module (the stand-in re-exports it): the same code as the
+# commands, with rostopic's exceptions instead of exit statuses
+
+
+class ROSTopicException(Exception):
+    """A rostopic call failed (unknown topic, type not installed, ...)."""
+
+
+class ROSTopicIOException(ROSTopicException):
+    """The master (or a node) could not be reached."""
+
+
+def _library(fn: Callable[[], Any]) -> Any:
+    from minros.tools.common import library_call
+
+    return library_call(fn, ROSTopicException, ROSTopicIOException)
+
+
+def msgevalgen(pattern: str) -> Callable[[Any], Any] | None:
+    """A function message -> the field ``pattern`` names (``/pose/position/x``), or None."""
+    from minros.tools.echo import make_field_getter
+
+    return make_field_getter(pattern) if pattern else None
+
+
+def get_topic_type(topic: str, blocking: bool = False) -> Tuple[str | None, str | None, Any]:
+    """``(type, topic, field evaluator)`` of a topic or of a field of one (``/odom/pose``);
+    ``(None, None, None)`` when nobody publishes it, unless ``blocking`` waits for it."""
+    def run() -> Tuple[str | None, str | None, Any]:
+        master = _master()
+        resolved = resolve(NAME, topic)
+        type_name, real, field = topic_type(master, resolved)
+        if type_name is None and blocking:
+            type_name, real, field = wait_topic_type(master, resolved)
+        if type_name is None:
+            return None, None, None
+        return type_name, real, msgevalgen(field)
+
+    return _library(run)
+
+
+def get_topic_class(topic: str, blocking: bool = False) -> Tuple[Any, str | None, Any]:
+    """``(message class, topic, field evaluator)``, as :func:`get_topic_type`."""
+    type_name, real, evaluator = get_topic_type(topic, blocking)
+    if type_name is None:
+        return None, None, None
+    cls = _message_class(type_name)
+    if cls is None:
+        raise ROSTopicException(f"Cannot load message class for [{type_name}]. "
+                                "Are your messages built?")
+    return cls, real, evaluator
+
+
+def get_info_text(topic: str) -> str:
+    """What ``rostopic info TOPIC`` prints."""
+    return _library(lambda: info_text(_master(), resolve(NAME, topic)))
+
+
+class ROSTopicHz:
+    """Publishing-rate statistics fed by a subscriber callback (rostopic's ROSTopicHz):
+    ``rospy.Subscriber(topic, rospy.AnyMsg, hz.callback_hz, callback_args=topic)``."""
+
+    def __init__(self, window_size: int, filter_expr: Callable | None = None,
+                 use_wtime: bool = False) -> None:
+        self.window_size = window_size
+        self.filter_expr = filter_expr
+        self.use_wtime = use_wtime
+        self._stats: Dict[str | None, HzStats] = {}
+        self._lock = threading.Lock()
+
+    def _for(self, topic: str | None) -> HzStats:
+        with self._lock:
+            stats = self._stats.get(topic)
+            if stats is None:
+                stats = self._stats[topic] = HzStats(self.window_size)
+            return stats
+
+    def callback_hz(self, m: Any, topic: str | None = None) -> None:
+        if self.filter_expr is not None and not self.filter_expr(m):
+            return
+        self._for(topic).tick(time.time() if self.use_wtime else _now().to_sec())
+
+    def get_hz(self, topic: str | None = None) -> Tuple[float, float, float, float, int] | None:
+        """``(rate, min delta, max delta, std dev, window)`` since the last call, or None."""
+        return self._for(topic).get()
+
+    def print_hz(self, topics: Tuple[str | None, ...] = (None,)) -> None:
+        for topic in topics:
+            result = self.get_hz(topic)
+            if result is None:
+                print("no new messages")
+                continue
+            rate, mn, mx, std, n = result
+            print(f"average rate: {rate:.3f}\n\tmin: {mn:.3f}s max: {mx:.3f}s "
+                  f"std dev: {std:.5f}s window: {n}")
+
+
+def rostopicmain(argv: List[str] | None = None) -> None:
+    """The rostopic command (``argv`` as sys.argv, program name first)."""
+    sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
+
+
+if __name__ == "__main__":  # rosrun rostopic rostopic / <node pkg="rostopic" type="rostopic">
+    sys.exit(main(sys.argv[1:]))

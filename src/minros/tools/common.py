@@ -6,7 +6,7 @@ import argparse
 import optparse
 import os
 import sys
-from typing import Callable, Dict, List
+from typing import Any, Callable, Dict, List
 
 from minros import names
 
@@ -102,3 +102,20 @@ def run_tool(fn: Callable[[], int], io_message: str = "Unable to communicate wit
         except OSError:
             pass
         return 0
+
+
+def library_call(fn: Callable[[], Any], error: type, io_error: type,
+                 io_message: str = "Unable to communicate with master!") -> Any:
+    """Run a tool's function for a Python caller: the tool's expected failures become the
+    exceptions its Python API documents (``error``; ``io_error`` when the master cannot be
+    reached) instead of an exit status."""
+    from minros.tools.master import MasterError, MasterFailure, MasterIOError
+
+    try:
+        return fn()
+    except ToolError as exc:
+        raise error(exc.text) from None
+    except MasterIOError:
+        raise io_error(io_message) from None
+    except (MasterError, MasterFailure) as exc:
+        raise error(str(exc)) from None

@@ -63,11 +63,18 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
         "turtle_tf_broadcaster.py": "minros.nodes.turtle_tf.turtle_tf_broadcaster",
         "turtle_tf_listener.py": "minros.nodes.turtle_tf.turtle_tf_listener",
     },
-    # the record and play programs that `rosbag record|play` run in ROS 1
+    # the record and play programs that `rosbag record|play` run in ROS 1, and the tool itself
     "rosbag": {
         "record": "minros.cli.bag_record",
         "play": "minros.cli.bag_play",
+        "rosbag": "minros.cli.bag",
     },
+    # the command-line tools, which ROS also installs as programs of their packages
+    # (`<node pkg="rostopic" type="rostopic" args="pub ...">`)
+    "rostopic": {"rostopic": "minros.cli.topic"},
+    "rosnode": {"rosnode": "minros.cli.node"},
+    "rosparam": {"rosparam": "minros.cli.param"},
+    "rosservice": {"rosservice": "minros.cli.service"},
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...
