@@ -27,6 +27,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "ws": ("minros.cli.ws", "catkin workspaces: init, create_pkg, make"),
     "web": ("minros.cli.web", "rosbridge, rosapi, Foxglove and video for browsers, on one port"),
     "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
+    "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -46,6 +47,7 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "catkin_create_pkg": ("ws", ["create_pkg"]),
     "catkin_make": ("ws", ["make"]),
     "rosbag": ("bag", []),
+    "rostest": ("test", []),
 }
 
 
@@ -122,6 +124,7 @@ catkin_init_workspace = _alias("catkin_init_workspace")
 catkin_create_pkg = _alias("catkin_create_pkg")
 catkin_make = _alias("catkin_make")
 rosbag = _alias("rosbag")
+rostest = _alias("rostest")
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -468,6 +468,23 @@ class LaunchRunner:
         self.out("shutting down processing monitor...")
         self.out("... shutting down processing monitor complete")
 
+    # -- for rostest: the launch without its monitor loop in the caller's thread
+    def start(self) -> None:
+        """Start the master (when needed), set the parameters and start the nodes; then
+        :meth:`monitor` in a thread of the caller's and :meth:`stop` at the end."""
+        self._start_master()
+        self._setup_run_id()
+        self._load_parameters()
+        self._start_nodes()
+
+    def monitor(self) -> None:
+        """Watch the processes (respawn, required) until :attr:`shutdown` is set."""
+        self._monitor()
+
+    def stop(self) -> None:
+        self.shutdown.set()
+        self._stop_all()
+
     # -- entry point
     def run(self, install_signal_handlers: bool = True) -> int:
         previous = {}
