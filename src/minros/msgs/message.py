@@ -122,8 +122,9 @@ class Message:
         except _SERIALIZE_ERRORS as exc:
             raise _serialization_error(self, exc) from None
 
-    def deserialize(self, data: Any) -> Message:
-        """Fill this message from ``data`` (bytes, bytearray, memoryview); returns self.
+    def deserialize(self, data: Any) -> Message | None:
+        """Fill this message from ``data`` (bytes, bytearray, memoryview); returns self (None
+        for genpy's base Message, which has nothing to read).
 
         The data must hold exactly one message: truncated data, lengths pointing past the end
         and trailing bytes raise :class:`DeserializationError`.
@@ -140,7 +141,7 @@ class Message:
                     view = bytes(data)  # small: one copy, then the faster bytes operations
             except TypeError:
                 if type(self)._deserialize_from is Message._deserialize_from:
-                    return self  # genpy's base Message reads nothing, whatever it is given
+                    return None  # genpy's base Message reads nothing, whatever it is given
                 raise
         try:
             try:
@@ -152,7 +153,7 @@ class Message:
         except NotImplementedError:
             if type(self)._deserialize_from is not Message._deserialize_from:
                 raise
-            return self  # genpy's base Message reads nothing
+            return None  # genpy's base Message reads nothing
         except struct.error:
             raise DeserializationError(
                 f"{self._type}: message truncated ({len(view)} bytes do not hold a whole message)"
@@ -345,7 +346,11 @@ def _serialization_error(msg: Message, exc: BaseException) -> SerializationError
         return found
     if isinstance(exc, SerializationError):
         return exc
-    return SerializationError(f"{type(exc)}: '{exc}' when writing '{msg._type}'")
+    try:
+        shown = str(msg)
+    except Exception:  # noqa: BLE001 - a field too broken to print
+        shown = msg._type
+    return SerializationError(f"{type(exc)}: '{exc}' when writing '{shown}'")
 
 
 # ---------------------------------------------------------------------------------------------
