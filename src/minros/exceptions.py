@@ -27,8 +27,8 @@ class ROSTimeMovedBackwardsException(ROSInterruptException):
     """Simulated time jumped backwards while a node was sleeping."""
 
     def __init__(self, time: float) -> None:
-        self.time = time
-        super().__init__(None)
+        self.time = time  # how far back, in seconds
+        super().__init__("ROS time moved backwards")
 
 
 class ROSInternalException(Exception):

@@ -153,7 +153,9 @@ def script_resolve_name(script_name: str, name: str) -> str:
 def scoped_name(caller_id: str, name: str) -> str:
     """``name`` relative to the namespace of the global ``caller_id`` (not validated)."""
     if not is_global(caller_id):
-        raise ValueError("caller_id must be global")
+        from minros.exceptions import ROSException
+
+        raise ROSException("caller_id must be global")
     return canonicalize_name(name)[len(namespace(caller_id)):]
 
 

@@ -5,6 +5,9 @@ from __future__ import annotations
 from typing import Any
 
 import minros
+
+# rospy imports std_msgs.msg (for Header): scripts that `import rospy, std_msgs` use it
+import std_msgs.msg  # noqa: E402, F401
 from minros import __all__ as __all__  # noqa: PLC0414 - rospy's public names are minros's
 
 # the submodules scripts reach through the package (rospy.timer.TimerEvent, rospy.exceptions...)

@@ -268,6 +268,11 @@ class _PubConnection:
         return (f"TCPROS connection on port {self.local[1]} to [{self.remote[0]}:{self.remote[1]}"
                 f" on socket {self.fileno}]")
 
+    @property
+    def endpoint_id(self) -> str:
+        """rospy's name for the subscriber's caller id."""
+        return self.callerid
+
     # -- sending ---------------------------------------------------------------------------
 
     def write(self, frame: Any) -> None:
@@ -592,6 +597,13 @@ class _PublisherImpl:
         return [self.resolved_name, self.message_data_sent,
                 [[c.id, c.stat_bytes, c.stat_msgs, not c.done] for c in self.connections]]
 
+    def has_connection(self, endpoint_id: str) -> bool:
+        """rospy's query: is the subscriber node ``endpoint_id`` (its caller id) connected?"""
+        return any(c.callerid == endpoint_id and not c.done for c in self.connections)
+
+    def has_connections(self) -> bool:
+        return any(not c.done for c in self.connections)
+
     def get_stats_info(self) -> list:
         return [[c.id, c.callerid, "o", "TCPROS", self.resolved_name, True, c.info()]
                 for c in self.connections]
@@ -635,6 +647,16 @@ class _SubConnection:
     def info(self) -> str:
         return (f"TCPROS connection on port {self.local[1]} to [{self.remote[0]}:{self.remote[1]}"
                 f" on socket {self.fileno}]")
+
+    @property
+    def endpoint_id(self) -> str:
+        """rospy's name for the publisher's XML-RPC URI."""
+        return self.pub_uri
+
+    @property
+    def callerid_pub(self) -> str:
+        """The publisher's caller id, from its connection header ('unknown' before it)."""
+        return self.header.get("callerid", "unknown")
 
     def close(self) -> None:
         self.done = True
@@ -809,7 +831,8 @@ class _SubscriberImpl:
         self.queue_size: int | None = None
         self.buff_size = DEFAULT_BUFF_SIZE
         self.tcp_nodelay = False
-        self.connections: Dict[str, _SubConnection] = {}
+        #: publisher XML-RPC URI -> our connection to it
+        self.by_uri: Dict[str, _SubConnection] = {}
         self.publisher_uris: List[str] = []
         self.update_gen = 0
         self.lock = threading.RLock()
@@ -825,18 +848,18 @@ class _SubscriberImpl:
             self.update_gen += 1
             fresh = []
             for uri in uris:
-                if uri not in self.connections:
+                if uri not in self.by_uri:
                     conn = _SubConnection(self, uri)
                     conn.gen = self.update_gen
-                    self.connections[uri] = conn
+                    self.by_uri[uri] = conn
                     fresh.append(conn)
         for conn in fresh:
             conn.thread.start()
 
     def _connection_ended(self, conn: _SubConnection) -> None:
         with self.lock:
-            if self.connections.get(conn.pub_uri) is conn:
-                del self.connections[conn.pub_uri]
+            if self.by_uri.get(conn.pub_uri) is conn:
+                del self.by_uri[conn.pub_uri]
             again = (not self.closed and not conn.done and conn.pub_uri in self.publisher_uris
                      and self.update_gen != conn.gen and not self.node.is_shutdown_requested())
         if again:  # the publisher was announced again while this connection was ending
@@ -845,7 +868,7 @@ class _SubscriberImpl:
     def add_callback(self, cb: Callable, cb_args: Any) -> None:
         with self.lock:
             self.callbacks = self.callbacks + [(cb, cb_args)]
-            latched = [c.latch for c in self.connections.values() if c.latch is not None]
+            latched = [c.latch for c in self.by_uri.values() if c.latch is not None]
         for msg in latched:
             self._invoke(msg, cb, cb_args)
 
@@ -882,20 +905,30 @@ class _SubscriberImpl:
     def get_stats(self) -> list:
         return [self.resolved_name,
                 [[c.id, c.stat_bytes, c.stat_msgs, -1, c.connected]
-                 for c in list(self.connections.values())]]
+                 for c in list(self.by_uri.values())]]
 
     def get_stats_info(self) -> list:
         return [[c.id, c.pub_uri, "i", "TCPROS", self.resolved_name, True, c.info()]
-                for c in list(self.connections.values()) if c.connected]
+                for c in list(self.by_uri.values()) if c.connected]
 
     def get_num_connections(self) -> int:
-        return sum(1 for c in list(self.connections.values()) if c.connected)
+        return sum(1 for c in list(self.by_uri.values()) if c.connected)
+
+    @property
+    def connections(self) -> List[_SubConnection]:
+        """The connections, one per publisher (rospy's list: code reads ``callerid_pub``)."""
+        return list(self.by_uri.values())
+
+    def has_connection(self, endpoint_id: str) -> bool:
+        """Whether we are connected to the publisher whose XML-RPC URI is ``endpoint_id``."""
+        conn = self.by_uri.get(endpoint_id)
+        return conn is not None and conn.connected
 
     def close(self) -> None:
         with self.lock:
             self.closed = True
-            conns = list(self.connections.values())
-            self.connections = {}
+            conns = list(self.by_uri.values())
+            self.by_uri = {}
             self.callbacks = []
         for conn in conns:
             conn.close()
@@ -1077,6 +1110,8 @@ class Subscriber(Topic):
 
 def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) -> Any:
     """Subscribe to ``topic`` and return its next message (rospy.wait_for_message)."""
+    if timeout is not None and hasattr(timeout, "to_sec"):
+        timeout = timeout.to_sec()  # rospy accepts a Duration
     received: list = []
     event = threading.Event()
 
