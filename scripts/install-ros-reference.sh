@@ -18,7 +18,8 @@ PKGS="ros-core python3-rosmaster python3-roslaunch rosout
   python3-cv-bridge python3-numpy libroscpp-dev g++ pkg-config python3-catkin-pkg
   python3-tf2-ros python3-tf python3-tf2-geometry-msgs tf2-tools tf-tools
   python3-actionlib python3-message-filters python3-diagnostic-updater
-  python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev"
+  python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
+  python3-roslib python3-rosgraph python3-rostest python3-rosunit"
 # Tools the tests drive besides ROS: a virtual display for turtlesim's window, zsh for
 # devel/setup.zsh; python3-venv and python3-tk so that minros's own venv can be built on the
 # same interpreter as the reference (scripts/test.sh), turtlesim's Tk window included;
@@ -30,6 +31,8 @@ WEB_TEST_TOOLS="chromium nodejs npm"
 if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msgs.msg, tf2_msgs.msg' 2>/dev/null \
    && /usr/bin/python3 -c 'import rosbag, roslz4' 2>/dev/null && [ -x /usr/lib/rosbag/record ] \
    && /usr/bin/python3 -c 'import actionlib, message_filters, diagnostic_updater, dynamic_reconfigure.client' 2>/dev/null \
+   && /usr/bin/python3 -c 'import roslib, rosgraph, rostest, rosunit, genmsg, sensor_msgs.point_cloud2' 2>/dev/null \
+   && [ -x /usr/lib/genpy/genmsg_py.py ] \
    && [ -f /usr/share/dynamic_reconfigure/package.xml ] \
    && command -v rostopic >/dev/null && command -v catkin_create_pkg >/dev/null \
    && pkg-config --exists roscpp std_msgs && command -v Xvfb >/dev/null && command -v zsh >/dev/null \
