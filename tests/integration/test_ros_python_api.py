@@ -134,3 +134,46 @@ def test_tool_apis_answer_as_debians_on_the_same_graph(chatter_graph) -> None:
                             capture_output=True, text=True, timeout=60)
     assert theirs.returncode == 0, theirs.stderr
     assert result == json.loads(theirs.stdout.strip().splitlines()[-1])
+
+
+ROSLAUNCH_SCRIPT = r'''
+import sys, time
+import roslaunch, rosnode
+
+uuid = roslaunch.rlutil.get_or_generate_uuid(None, False)
+roslaunch.configure_logging(uuid)
+parent = roslaunch.parent.ROSLaunchParent(uuid, [sys.argv[1]])
+parent.start()
+launch = roslaunch.scriptapi.ROSLaunch()
+launch.start()
+process = launch.launch(roslaunch.core.Node("rospy_tutorials", "listener", name="script_listener"))
+deadline = time.time() + 20
+while time.time() < deadline:
+    nodes = rosnode.get_node_names()
+    if "/script_talker" in nodes and "/script_listener" in nodes:
+        break
+    time.sleep(0.1)
+print(sorted(n for n in nodes if n.startswith("/script_")), process.is_alive())
+process.stop()
+launch.stop()
+parent.shutdown()
+print(process.is_alive())
+'''
+
+
+def test_roslaunch_scripting_api(minros_core: int, ros_home: Path, tmp_path: Path) -> None:
+    launch = tmp_path / "talker.launch"
+    launch.write_text('<launch><node pkg="rospy_tutorials" type="talker" name="script_talker"/>'
+                      '</launch>')
+    env = ros_env(minros_core, ros_home)
+    run = subprocess.run([PYTHON, "-c", ROSLAUNCH_SCRIPT, str(launch)], env=env,
+                         capture_output=True, text=True, timeout=90)
+    assert run.returncode == 0, run.stderr
+    # the launcher's own lines (process[...] started, killing on exit) come in between
+    lines = [line for line in run.stdout.splitlines() if line in (
+        "['/script_listener', '/script_talker'] True", "False")]
+    assert lines == ["['/script_listener', '/script_talker'] True", "False"], run.stdout
+    master = ServerProxy(f"http://localhost:{minros_core}/")
+    wait_until(lambda: not any(n.startswith("/script_") for section in
+                               master.getSystemState("/test")[2] for _t, ns in section for n in ns),
+               timeout=20, what="the launched nodes unregistered")
