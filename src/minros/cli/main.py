@@ -28,6 +28,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "web": ("minros.cli.web", "rosbridge, rosapi, Foxglove and video for browsers, on one port"),
     "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
     "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
+    "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -48,6 +49,7 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "catkin_make": ("ws", ["make"]),
     "rosbag": ("bag", []),
     "rostest": ("test", []),
+    "rosconsole": ("console", []),
 }
 
 
@@ -125,6 +127,7 @@ catkin_create_pkg = _alias("catkin_create_pkg")
 catkin_make = _alias("catkin_make")
 rosbag = _alias("rosbag")
 rostest = _alias("rostest")
+rosconsole = _alias("rosconsole")
 
 if __name__ == "__main__":
     sys.exit(main())
