@@ -14,7 +14,7 @@ import threading
 from typing import Any, Dict, List
 
 from minros import node
-from minros.client import rosout_log, rostime
+from minros.client import rosout_log, rostime, statistics
 from minros.client.topics import Subscriber
 
 __all__ = ["init_node"]
@@ -64,6 +64,7 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
         except Exception:
             use_sim_time = False
     rostime.start_node_time(use_sim_time)
+    statistics.install()  # subscriptions read /enable_statistics when they are made
     if use_sim_time:
         from rosgraph_msgs.msg import Clock
 

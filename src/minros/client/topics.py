@@ -767,7 +767,7 @@ class _SubConnection:
         header = self.header
         latching = header.get("latching", "0") == "1"
         data_class = impl.data_class
-        deliver = impl.deliver
+        deliver = impl.deliver if impl.statistics is None else impl.statistics.wrap(self, impl.deliver)
         frames = self.pending
         recv_into = self.sock.recv_into
         received_frames = reader.received_frames
@@ -838,6 +838,8 @@ class _SubscriberImpl:
         self.lock = threading.RLock()
         self.ref_count = 0
         self.closed = False
+        #: topic statistics (/enable_statistics), or None
+        self.statistics: Any = None
 
     def publisher_update(self, uris: List[str]) -> None:
         """The master's current publisher list: connect to the new ones."""
@@ -932,6 +934,8 @@ class _SubscriberImpl:
             self.callbacks = []
         for conn in conns:
             conn.close()
+        if self.statistics is not None:
+            self.statistics.shutdown()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -940,6 +944,9 @@ class _SubscriberImpl:
 #: guards the reference counts of the publication/subscription objects (a leaf: the master
 #: is called outside it, so a slow master does not block other threads' Publisher() calls)
 _impl_lock = threading.Lock()
+#: makes a new subscription's topic statistics (or None); set by init_node (client/statistics)
+#: so that the receive loop wraps its deliver only when statistics are on
+statistics_factory: Callable[[Any], Any] | None = None
 
 
 def _acquire(kind: str, name: str, data_class: Any) -> Any:
@@ -966,7 +973,9 @@ def _acquire(kind: str, name: str, data_class: Any) -> Any:
                 me.add_publication(impl, announce=False)
             else:
                 me.add_subscription(impl, announce=False)
-    if fresh:  # the master round trip happens outside the lock
+    if fresh:  # the master round trips happen outside the lock
+        if kind == "sub" and statistics_factory is not None:
+            impl.statistics = statistics_factory(impl)  # before any connection starts
         me.announce(kind, impl)
     return impl
 
