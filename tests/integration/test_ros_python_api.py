@@ -177,3 +177,33 @@ def test_roslaunch_scripting_api(minros_core: int, ros_home: Path, tmp_path: Pat
     wait_until(lambda: not any(n.startswith("/script_") for section in
                                master.getSystemState("/test")[2] for _t, ns in section for n in ns),
                timeout=20, what="the launched nodes unregistered")
+
+
+OBJECT_MODEL = r'''
+import time, rospy
+from std_msgs.msg import String
+rospy.init_node("model", anonymous=False)
+pub = rospy.Publisher("/model_topic", String, queue_size=1)
+sub = rospy.Subscriber("/model_topic", String, lambda m: None)
+deadline = time.time() + 20
+while time.time() < deadline and not (pub.get_num_connections() and sub.get_num_connections()):
+    time.sleep(0.05)
+conn = sub.impl.connections[0]
+print(pub.impl.has_connection("/model"), pub.impl.has_connection("/other"), conn.callerid_pub,
+      sub.impl.has_connection(conn.endpoint_id), len(sub.impl.connections))
+'''
+
+
+def test_rospy_object_model_read_by_libraries(minros_core: int, ros_home: Path) -> None:
+    """actionlib's client reads pub.impl.has_connection(callerid) and walks sub.impl.connections
+    for callerid_pub: both mean what they mean in rospy (checked with Debian's rospy too)."""
+    env = ros_env(minros_core, ros_home)
+    ours = subprocess.run([PYTHON, "-c", OBJECT_MODEL], env=env, capture_output=True, text=True,
+                          timeout=60)
+    assert ours.returncode == 0, ours.stderr
+    assert ours.stdout.split() == ["True", "False", "/model", "True", "1"]
+    require_reference()
+    theirs = subprocess.run([REFERENCE_PYTHON, "-c", OBJECT_MODEL], env=reference_env(env),
+                            capture_output=True, text=True, timeout=60)
+    assert theirs.returncode == 0, theirs.stderr
+    assert theirs.stdout.split() == ours.stdout.split()

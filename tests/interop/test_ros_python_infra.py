@@ -122,9 +122,20 @@ def _bad_input(req):
     }
 
 
+def _rospy(req):
+    import rospy, std_msgs
+    return {
+        "moved_backwards": _outcome(lambda: str(rospy.ROSTimeMovedBackwardsException(1.5))),
+        "scoped_name": _outcome(lambda: rospy.names.scoped_name("name", "/name")),
+        "scoped_ok": _outcome(lambda: rospy.names.scoped_name("/ns/node", "/ns/a/b")),
+        "on_shutdown": _outcome(lambda: rospy.on_shutdown(1)),
+        "std_msgs_loaded": _outcome(lambda: std_msgs.msg.Bool._type),
+    }
+
+
 def answer(req):
     return {"fill": _fill, "check_type": _check_type, "names": _names, "genmsg": _genmsg,
-            "bad_input": _bad_input}[req["op"]](req)
+            "bad_input": _bad_input, "rospy": _rospy}[req["op"]](req)
 '''
 
 
@@ -407,3 +418,11 @@ def test_message_base_semantics() -> None:
 
     assert genpy.Message().serialize(io.BytesIO()) is None
     genpy.Message().deserialize("")
+
+
+def test_rospy_behaviours_equal_debians(oracle: Oracle) -> None:
+    """The rospy differences the issue lists: exception text, scoped_name's exception,
+    on_shutdown's check, std_msgs.msg loaded by import rospy."""
+    ours, theirs = oracle.both(op="rospy")
+    assert ours == theirs
+    assert ours["scoped_name"]["exc"] == "ROSException"
