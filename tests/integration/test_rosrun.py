@@ -190,3 +190,24 @@ def test_rosrun_non_unique_executable_asks_which(tmp_path, pkg_path):
     assert lines[3].startswith("#? exe ") and lines[4] == "argv ['x']"  # the second: scripts/deep/node.py
     aborted = _run(["rosrun", "demo_pkg", "node.py"], env, input="")
     assert aborted.returncode == 1
+
+
+def test_every_shipped_program_runs_under_its_ros_package_name() -> None:
+    """roslaunch and rosrun start each executable minros ships as ROS installs it (the tools
+    too: rostopic, rosbag, rosmsg, rosconsole, ...): every table entry is a module that runs
+    as a program and answers -h."""
+    import importlib.util
+
+    from minros.workspace import executables
+
+    missing = [f"{pkg}/{exe}: {module}" for pkg, table in executables.BUILTIN_NODES.items()
+               for exe, module in table.items() if importlib.util.find_spec(module) is None]
+    assert missing == []
+    for pkg, exe in (("rostopic", "rostopic"), ("rosnode", "rosnode"), ("rosparam", "rosparam"),
+                     ("rosservice", "rosservice"), ("rosmsg", "rosmsg"), ("rosbag", "rosbag"),
+                     ("rosconsole", "rosconsole"), ("rostest", "rostest")):
+        argv = executables.resolve_executable(pkg, exe)
+        assert argv[1:3] == ["-m", executables.BUILTIN_NODES[pkg][exe]]
+        run = subprocess.run(argv + ["-h"], capture_output=True, text=True, timeout=60)
+        assert pkg in (run.stdout + run.stderr).lower(), (pkg, run.stdout, run.stderr)
+        assert "Traceback" not in run.stderr, run.stderr

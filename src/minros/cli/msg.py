@@ -196,3 +196,7 @@ def _describe(show: Callable[[str], str], type_name: str, kind: str, command: st
         else:
             print(f"Unable to load msg [{type_name}]: {exc}", file=sys.stderr)
         return None
+
+
+if __name__ == "__main__":  # rosrun rosmsg rosmsg
+    sys.exit(main(sys.argv[1:], prog="rosmsg"))

@@ -15,3 +15,9 @@ from minros.cli import msg as _msg
 def main(argv: List[str], prog: str = "minros srv") -> int:
     """Run ``minros srv``; the implementation is shared with ``minros msg``."""
     return _msg.main(argv, prog=prog, kind="srv")
+
+
+if __name__ == "__main__":  # rosrun rosmsg rossrv
+    import sys
+
+    sys.exit(main(sys.argv[1:], prog="rossrv"))

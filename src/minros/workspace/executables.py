@@ -75,6 +75,9 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosnode": {"rosnode": "minros.cli.node"},
     "rosparam": {"rosparam": "minros.cli.param"},
     "rosservice": {"rosservice": "minros.cli.service"},
+    "rosmsg": {"rosmsg": "minros.cli.msg", "rossrv": "minros.cli.srv"},
+    "rosconsole": {"rosconsole": "minros.cli.console"},
+    "rostest": {"rostest": "minros.cli.rostest"},
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...
