@@ -20,7 +20,17 @@ Scenarios
   String into an object and encode it again (no middleware, no checks, no queues);
 * small-message flood: std_msgs/String "x"*20 published as fast as possible for N seconds,
   messages per second *received*;
-* 640x480 and 1920x1080 bgr8 sensor_msgs/Image floods, frames per second received.
+* 640x480 and 1920x1080 bgr8 sensor_msgs/Image floods, frames per second received;
+* idle node memory: RSS of a node that did nothing but init_node;
+* service calls of std_srvs/SetBool, persistent and with a new connection (and master
+  lookup) per call, median round trip;
+* fan-out: one publisher flooding 8 subscriber processes (small messages, 640x480 images),
+  messages per second delivered in all;
+* a subscriber's CPU (% of one core) while it receives a 1920x1080 bgr8 topic at 30 Hz;
+* bring-up: 100 nodes, each publishing 10 topics and subscribing to the next node's 10, started
+  at once: seconds until every connection is made (minros and rospy);
+* `rostopic hz` and `rostopic echo` (minros's and Debian's) on a 10 kHz std_msgs/String topic
+  from the same publisher: % of one core the tool uses.
 
 This same file is also the worker: ``--role ...`` runs one side of a scenario, in whichever
 Python runs it (the venv's for minros and raw, /usr/bin/python3 for rospy), and prints one JSON
@@ -31,6 +41,7 @@ line. ``--minros-python`` picks another interpreter for minros and raw, e.g. a v
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import shutil
@@ -162,7 +173,7 @@ def role_flood_pub(args) -> None:
     cls, msg = _make(args.kind)
     rospy.init_node("bench_flood_pub", anonymous=True)
     pub = rospy.Publisher("/bench_flood", cls, queue_size=_queue(args.queue))
-    _wait_connections(pub)
+    _wait_connections(pub, args.subs)
     time.sleep(0.3)
     sent = 0
     end = time.monotonic() + args.seconds
@@ -197,6 +208,121 @@ def role_flood_sub(args) -> None:
     n = len(stamps)
     rate = (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0
     print(json.dumps({"received": n, "rate": rate}), flush=True)
+    rospy.signal_shutdown("done")
+
+
+# services, fan-out, a subscriber's CPU, many nodes coming up
+
+def _median_report(times: list, **extra) -> None:
+    print(json.dumps({"median_us": statistics.median(times) * 1e6, **extra}), flush=True)
+
+
+def role_srv_server(args) -> None:
+    import rospy
+    from std_srvs.srv import SetBool, SetBoolResponse
+
+    rospy.init_node("bench_srv", anonymous=True)
+    rospy.Service("/bench_srv", SetBool, lambda req: SetBoolResponse(req.data, "ok"))
+    print(json.dumps({"ready": True}), flush=True)
+    rospy.spin()
+
+
+def role_srv_client(args) -> None:
+    """Calls of std_srvs/SetBool, each timed; persistent or a new connection (and master
+    lookup) per call, as rospy.ServiceProxy does either way."""
+    import rospy
+    from std_srvs.srv import SetBool
+
+    rospy.wait_for_service("/bench_srv", timeout=20)
+    proxy = rospy.ServiceProxy("/bench_srv", SetBool, persistent=args.persistent)
+    times = []
+    for i in range(args.count + 50):
+        t = time.perf_counter()
+        proxy(True)
+        if i >= 50:
+            times.append(time.perf_counter() - t)
+    _median_report(times)
+
+
+def role_rate_pub(args) -> None:
+    """Publishes at ``--hz`` for ``--seconds``, paced by the clock (not a flood)."""
+    import warnings
+
+    import rospy
+
+    warnings.simplefilter("ignore", SyntaxWarning)
+    cls, msg = _make(args.kind)
+    rospy.init_node("bench_rate_pub", anonymous=True)
+    pub = rospy.Publisher("/bench_rate", cls, queue_size=10)
+    _wait_connections(pub, args.subs)
+    time.sleep(0.5)
+    period = 1.0 / args.hz
+    print(json.dumps({"started": True}), flush=True)
+    start = time.perf_counter()
+    n = 0
+    while True:
+        now = time.perf_counter()
+        if now - start >= args.seconds:
+            break
+        target = start + n * period
+        if now < target:
+            time.sleep(min(target - now, 0.001) if target - now > 0.0015 else 0)
+            continue
+        pub.publish(msg)
+        n += 1
+    print(json.dumps({"sent": n}), flush=True)
+    time.sleep(1.0)
+    rospy.signal_shutdown("done")
+
+
+def role_cpu_sub(args) -> None:
+    """Counts messages on /bench_rate and reports the CPU this process spent per second of flow."""
+    import rospy
+
+    cls, _ = _make(args.kind)
+    seen = {"n": 0, "cpu0": 0.0, "t0": 0.0, "cpu1": 0.0, "t1": 0.0}
+
+    def on_msg(_msg) -> None:
+        if seen["n"] == 0:
+            seen["cpu0"], seen["t0"] = time.process_time(), time.perf_counter()
+        seen["n"] += 1
+        seen["cpu1"], seen["t1"] = time.process_time(), time.perf_counter()
+
+    rospy.init_node("bench_cpu_sub", anonymous=True)
+    rospy.Subscriber("/bench_rate", cls, on_msg, queue_size=10, buff_size=1 << 24)
+    print(json.dumps({"ready": True}), flush=True)
+    last = -1
+    while True:
+        time.sleep(0.5)
+        if seen["n"] and seen["n"] == last:
+            break
+        last = seen["n"]
+    span = seen["t1"] - seen["t0"]
+    print(json.dumps({"received": seen["n"],
+                      "cpu_percent": 100.0 * (seen["cpu1"] - seen["cpu0"]) / span if span else None}),
+          flush=True)
+    rospy.signal_shutdown("done")
+
+
+def role_ring_node(args) -> None:
+    """Node ``index`` of a ring: publishes ``--topics`` topics and subscribes to those of the
+    next node; says when every one of its connections is made, then waits to be stopped."""
+    import warnings
+
+    import rospy
+    from std_msgs.msg import Empty
+
+    warnings.simplefilter("ignore", SyntaxWarning)
+    rospy.init_node(f"ring{args.index}")
+    nxt = (args.index + 1) % args.nodes
+    pubs = [rospy.Publisher(f"/ring{args.index}/t{k}", Empty, queue_size=1) for k in range(args.topics)]
+    subs = [rospy.Subscriber(f"/ring{nxt}/t{k}", Empty) for k in range(args.topics)]
+    while not all(p.get_num_connections() for p in pubs) or not all(s.get_num_connections() for s in subs):
+        if rospy.is_shutdown():
+            return
+        time.sleep(0.02)
+    print(json.dumps({"connected": time.time()}), flush=True)
+    sys.stdin.read()  # until the driver closes our stdin
     rospy.signal_shutdown("done")
 
 
@@ -366,7 +492,9 @@ ROLES = {
     "echo": role_echo, "ping": role_ping, "flood-pub": role_flood_pub, "flood-sub": role_flood_sub,
     "raw-echo": role_raw_echo, "raw-ping": role_raw_ping, "raw-flood-pub": role_raw_flood_pub,
     "raw-flood-sub": role_raw_flood_sub, "raw-pubsub-echo": role_raw_pubsub_echo,
-    "raw-pubsub-ping": role_raw_pubsub_ping,
+    "raw-pubsub-ping": role_raw_pubsub_ping, "srv-server": role_srv_server,
+    "srv-client": role_srv_client, "rate-pub": role_rate_pub, "cpu-sub": role_cpu_sub,
+    "ring-node": role_ring_node,
 }
 
 # --------------------------------------------------------------------------------- roscpp
@@ -375,6 +503,8 @@ ROSCPP_SOURCE = r'''
 #include <ros/ros.h>
 #include <std_msgs/String.h>
 #include <sensor_msgs/Image.h>
+#include <std_srvs/SetBool.h>
+#include <ctime>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -399,6 +529,17 @@ static void onPong(const std_msgs::String::ConstPtr&) {
   pub.publish(pingMsg);
 }
 template <class M> static void onFlood(const typename M::ConstPtr&) { stamps.push_back(Clock::now()); }
+static bool onSetBool(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+  res.success = req.data; res.message = "ok"; return true;
+}
+static double cpuSeconds() { return (double)std::clock() / CLOCKS_PER_SEC; }
+static double cpu0 = 0, cpu1 = 0;
+static Clock::time_point first, last;
+static long received = 0;
+static void onImage(const sensor_msgs::Image::ConstPtr&) {
+  if (received++ == 0) { cpu0 = cpuSeconds(); first = Clock::now(); }
+  cpu1 = cpuSeconds(); last = Clock::now();
+}
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "bench_cpp", ros::init_options::AnonymousName | ros::init_options::NoSigintHandler);
@@ -442,6 +583,46 @@ int main(int argc, char** argv) {
     size_t k = stamps.size();
     double span = k > 1 ? std::chrono::duration<double>(stamps.back() - stamps.front()).count() : 0;
     printf("{\"received\": %zu, \"rate\": %f}\n", k, span > 0 ? (k - 1) / span : 0.0);
+  } else if (role == "srv-server") {
+    ros::ServiceServer srv = nh.advertiseService("/bench_srv", onSetBool);
+    printf("{\"ready\": true}\n"); fflush(stdout);
+    ros::spin();
+  } else if (role == "srv-client") {
+    ros::service::waitForService("/bench_srv", 20000);
+    ros::ServiceClient client = nh.serviceClient<std_srvs::SetBool>("/bench_srv", kind == "persistent");
+    std_srvs::SetBool call; call.request.data = true;
+    for (int i = 0; i < count + 50; ++i) {
+      Clock::time_point t = Clock::now();
+      if (!client.call(call)) { printf("{\"error\": \"call failed\"}\n"); return 1; }
+      if (i >= 50) times.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t).count());
+    }
+    std::sort(times.begin(), times.end());
+    printf("{\"median_us\": %f}\n", times[times.size() / 2]);
+  } else if (role == "cpu-sub") {
+    ros::Subscriber s = nh.subscribe<sensor_msgs::Image>("/bench_rate", 10, onImage);
+    printf("{\"ready\": true}\n"); fflush(stdout);
+    ros::AsyncSpinner spinner(1); spinner.start();
+    long seen = -1;
+    while (true) {
+      ros::WallDuration(0.5).sleep();
+      if (received && received == seen) break;
+      seen = received;
+    }
+    double span = std::chrono::duration<double>(last - first).count();
+    printf("{\"received\": %ld, \"cpu_percent\": %f}\n", received, span > 0 ? 100.0 * (cpu1 - cpu0) / span : 0.0);
+  } else if (role == "rate-pub") {
+    sensor_msgs::Image img; int h = kind == "vga" ? 480 : 1080, w = kind == "vga" ? 640 : 1920;
+    img.height = h; img.width = w; img.encoding = "bgr8"; img.step = w * 3; img.data.assign(h * w * 3, 0);
+    pub = nh.advertise<sensor_msgs::Image>("/bench_rate", queue);
+    while (pub.getNumSubscribers() == 0) ros::Duration(0.005).sleep();
+    ros::Duration(0.5).sleep();
+    printf("{\"started\": true}\n"); fflush(stdout);
+    ros::WallRate rate(count);
+    Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    long sent = 0;
+    while (Clock::now() < end) { pub.publish(img); ++sent; rate.sleep(); }
+    printf("{\"sent\": %ld}\n", sent); fflush(stdout);
+    ros::WallDuration(1.0).sleep();
   } else {  // flood-pub
     std_msgs::String small; small.data = std::string(20, 'x');
     sensor_msgs::Image img;
@@ -451,7 +632,7 @@ int main(int argc, char** argv) {
     }
     if (kind == "small") pub = nh.advertise<std_msgs::String>("/bench_flood", queue);
     else pub = nh.advertise<sensor_msgs::Image>("/bench_flood", queue);
-    while (pub.getNumSubscribers() == 0) ros::Duration(0.005).sleep();
+    while ((int)pub.getNumSubscribers() < std::max(count, 1)) ros::Duration(0.005).sleep();
     ros::Duration(0.3).sleep();
     long sent = 0;
     Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
@@ -470,12 +651,14 @@ int main(int argc, char** argv) {
 
 def build_roscpp(cache: str):
     """Compile the C++ worker (once); None when g++/roscpp are unavailable."""
-    binary = os.path.join(cache, "bench_roscpp")
+    digest = hashlib.sha1(ROSCPP_SOURCE.encode()).hexdigest()[:12]
+    binary = os.path.join(cache, f"bench_roscpp_{digest}")
     if os.path.exists(binary):
         return binary
     if not shutil.which("g++") or not shutil.which("pkg-config"):
         return None
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "roscpp", "std_msgs", "sensor_msgs"],
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "roscpp", "std_msgs", "sensor_msgs",
+                            "std_srvs"],
                            capture_output=True, text=True)
     if flags.returncode != 0:
         return None
@@ -492,6 +675,13 @@ def build_roscpp(cache: str):
 
 
 # --------------------------------------------------------------------------------- driver
+
+
+def _cpu_seconds(pid: int) -> float:
+    """user + system CPU seconds a running process has used (from /proc)."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rpartition(")")[2].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def _free_port() -> int:
@@ -616,6 +806,139 @@ class Runner:
                           first_measures=True)
         return r.get("rate")
 
+    def service(self, who: str, persistent: bool):
+        if who in ("py-min", "raw", "raw-1"):
+            return None
+        count = str(max(self.args.count // 4, 100))
+        if who == "roscpp":
+            r = self.pair(who, self.command(who, "", ["srv-server", "x", "0", "0", "0"]),
+                          self.command(who, "", ["srv-client", "persistent" if persistent else "plain",
+                                                 "0", "0", count]))
+        else:
+            r = self.pair(who, self.command(who, "srv-server", []),
+                          self.command(who, "srv-client", [*(["--persistent"] if persistent else []),
+                                                           "--count", count]))
+        return r.get("median_us")
+
+    def _start_ready(self, who: str, command: tuple) -> subprocess.Popen:
+        proc = subprocess.Popen(command[0], env=command[1], stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL, stdin=subprocess.PIPE, text=True)
+        line = proc.stdout.readline()
+        if "ready" not in line:
+            proc.kill()
+            raise RuntimeError(f"{who}: worker failed to start: {line!r}")
+        return proc
+
+    @staticmethod
+    def _stop(procs: list) -> None:
+        for proc in procs:
+            if proc.poll() is None:
+                proc.terminate()
+        for proc in procs:
+            try:
+                proc.wait(5)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+
+    def fanout(self, who: str, kind: str, subs: int = 8):
+        """One publisher flooding ``subs`` subscriber processes: messages/s delivered in all."""
+        if who in ("py-min", "raw", "raw-1"):
+            return None
+        seconds = str(self.args.seconds)
+        if who == "roscpp":
+            sub_cmd = self.command(who, "", ["flood-sub", kind, "10", seconds, "0"])
+            pub_cmd = self.command(who, "", ["flood-pub", kind, "10", seconds, str(subs)])
+        else:
+            sub_cmd = self.command(who, "flood-sub", ["--kind", kind])
+            pub_cmd = self.command(who, "flood-pub", ["--kind", kind, "--queue", "10",
+                                                      "--seconds", seconds, "--subs", str(subs)])
+        procs = []
+        try:
+            for _ in range(subs):
+                procs.append(self._start_ready(who, sub_cmd))
+            subprocess.run(pub_cmd[0], env=pub_cmd[1], stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL, timeout=120)
+            total = 0.0
+            for proc in procs:
+                out, _ = proc.communicate(timeout=60)
+                for raw in out.splitlines():
+                    if raw.startswith("{"):
+                        total += json.loads(raw).get("rate", 0.0)
+            return total
+        finally:
+            self._stop(procs)
+
+    def subscriber_cpu(self, who: str):
+        """% of one core a subscriber spends receiving a 1920x1080 bgr8 image topic at 30 Hz."""
+        if who in ("py-min", "raw", "raw-1"):
+            return None
+        seconds = str(max(self.args.seconds, 3.0))
+        if who == "roscpp":
+            first = self.command(who, "", ["cpu-sub", "hd", "10", seconds, "0"])
+            second = self.command(who, "", ["rate-pub", "hd", "10", seconds, "30"])
+        else:
+            first = self.command(who, "cpu-sub", ["--kind", "hd"])
+            second = self.command(who, "rate-pub", ["--kind", "hd", "--hz", "30", "--seconds", seconds])
+        return self.pair(who, first, second, first_measures=True).get("cpu_percent")
+
+    def bringup(self, who: str, nodes: int = 100, topics: int = 10):
+        """Seconds from starting ``nodes`` nodes (``topics`` publishers and subscribers each, in a
+        ring) until every one of their connections is made."""
+        if who not in ("minros", "rospy"):
+            return None
+        procs = []
+        start = time.time()
+        try:
+            for i in range(nodes):
+                cmd = self.command(who, "ring-node", ["--index", str(i), "--nodes", str(nodes),
+                                                      "--topics", str(topics)])
+                procs.append(subprocess.Popen(cmd[0], env=cmd[1], stdout=subprocess.PIPE,
+                                              stderr=subprocess.DEVNULL, stdin=subprocess.PIPE,
+                                              text=True))
+            done = []
+            for proc in procs:
+                line = proc.stdout.readline()
+                if not line.startswith("{"):
+                    raise RuntimeError(f"{who}: a ring node failed")
+                done.append(json.loads(line)["connected"])
+            return max(done) - start
+        finally:
+            for proc in procs:
+                try:
+                    proc.stdin.close()
+                except OSError:
+                    pass
+            self._stop(procs)
+
+    def tool_cpu(self, who: str, verb: str):
+        """% of one core ``rostopic hz|echo`` spends on a 10 kHz std_msgs/String topic (the same
+        minros publisher for every tool)."""
+        if who not in ("minros", "rospy"):
+            return None
+        if who == "minros":
+            tool = [self.args.minros_python, "-m", "minros", "topic", verb, "/bench_rate"]
+        else:
+            tool = [REFERENCE_PYTHON, "/usr/bin/rostopic", verb, "/bench_rate"]
+        seconds = max(self.args.seconds, 3.0)
+        procs = []
+        try:
+            procs.append(subprocess.Popen(tool, env=self.env(who == "rospy"), stdout=subprocess.DEVNULL,
+                                          stderr=subprocess.DEVNULL))
+            pub_cmd = self.command("minros", "rate-pub", ["--kind", "small", "--hz", "10000",
+                                                         "--seconds", str(seconds + 1.0)])
+            pub = subprocess.Popen(pub_cmd[0], env=pub_cmd[1], stdout=subprocess.PIPE,
+                                   stderr=subprocess.DEVNULL, text=True)
+            procs.append(pub)
+            if "started" not in pub.stdout.readline():
+                raise RuntimeError("the 10 kHz publisher did not start")
+            time.sleep(1.0)  # the tool's start-up is not what this measures
+            before, t0 = _cpu_seconds(procs[0].pid), time.perf_counter()
+            time.sleep(seconds - 1.0)
+            after, t1 = _cpu_seconds(procs[0].pid), time.perf_counter()
+            return 100.0 * (after - before) / (t1 - t0)
+        finally:
+            self._stop(procs)
+
     def idle_memory(self, who: str):
         if who in ("py-min", "raw", "raw-1", "roscpp"):
             return None
@@ -642,6 +965,15 @@ SCENARIOS = [
     ("640x480 bgr8 images (frames/s)", "vga", lambda r, w: r.flood(w, "vga"), "high"),
     ("1920x1080 bgr8 images (frames/s)", "hd", lambda r, w: r.flood(w, "hd"), "high"),
     ("idle node memory (MB RSS)", "mem", lambda r, w: r.idle_memory(w), "low"),
+    ("service call, persistent (µs)", "srv", lambda r, w: r.service(w, True), "low"),
+    ("service call, new connection each (µs)", "srvnew", lambda r, w: r.service(w, False), "low"),
+    ("1 publisher -> 8 subscribers, small (msg/s delivered)", "fan", lambda r, w: r.fanout(w, "small"), "high"),
+    ("1 publisher -> 8 subscribers, 640x480 (frames/s delivered)", "fanvga",
+     lambda r, w: r.fanout(w, "vga"), "high"),
+    ("subscriber CPU, 1920x1080 at 30 Hz (% of a core)", "subcpu", lambda r, w: r.subscriber_cpu(w), "low"),
+    ("100 nodes x 10 topics: all connected (s)", "bringup", lambda r, w: r.bringup(w), "low"),
+    ("rostopic hz, 10 kHz topic (% of a core)", "hz", lambda r, w: r.tool_cpu(w, "hz"), "low"),
+    ("rostopic echo, 10 kHz topic (% of a core)", "echo", lambda r, w: r.tool_cpu(w, "echo"), "low"),
 ]
 
 
@@ -664,6 +996,12 @@ def main(argv=None) -> int:
     parser.add_argument("--kind", default="small", help=argparse.SUPPRESS)
     parser.add_argument("--port", type=int, default=0, help=argparse.SUPPRESS)
     parser.add_argument("--messages", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--persistent", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--subs", type=int, default=1, help=argparse.SUPPRESS)
+    parser.add_argument("--hz", type=float, default=30.0, help=argparse.SUPPRESS)
+    parser.add_argument("--index", type=int, default=0, help=argparse.SUPPRESS)
+    parser.add_argument("--nodes", type=int, default=100, help=argparse.SUPPRESS)
+    parser.add_argument("--topics", type=int, default=10, help=argparse.SUPPRESS)
     parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (median shown)")
     parser.add_argument("--seconds", type=float, default=2.0, help="duration of each flood")
     parser.add_argument("--count", type=int, default=2000, help="round trips per latency run")

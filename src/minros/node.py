@@ -385,17 +385,19 @@ class Node:
         threading.Thread(target=self._monitor_master, name="minros-master-probe", daemon=True).start()
 
     def master(self) -> ServerProxy:
-        """This thread's proxy to the master (kept alive between calls)."""
+        """This thread's proxy to the master, kept alive between calls (a new one when the
+        master URI changed, which it may before init_node fixes it)."""
+        uri = self.master_uri
         proxy = getattr(self._local, "master", None)
-        if proxy is None:
-            proxy = ServerProxy(self.master_uri, timeout=XMLRPC_TIMEOUT)
+        if proxy is None or proxy.uri != uri:
+            proxy = ServerProxy(uri, timeout=XMLRPC_TIMEOUT)
             self._local.master = proxy
         return proxy
 
     def master_call(self, method: str, *args: Any) -> list:
-        """``master.method(caller_id, *args)``: the raw triplet."""
-        if not self._started:
-            return self.master_call_once(method, *args)
+        """``master.method(caller_id, *args)``: the raw triplet; works before init_node. The
+        connection is kept alive (a lookupService per service call, a getParam per parameter
+        read, must not each pay for a new TCP connection); OSError when the master is down."""
         try:
             return getattr(self.master(), method)(self.caller_id, *args)
         except Exception:
@@ -403,8 +405,7 @@ class Node:
             raise
 
     def master_call_once(self, method: str, *args: Any) -> list:
-        """``master.method(caller_id, *args)`` on a fresh connection, closed afterwards; works
-        before init_node; OSError when the master is unreachable."""
+        """``master.method(caller_id, *args)`` on a fresh connection, closed afterwards."""
         proxy = ServerProxy(self.master_uri, timeout=XMLRPC_TIMEOUT)
         try:
             return getattr(proxy, method)(self.caller_id, *args)

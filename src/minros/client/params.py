@@ -39,7 +39,7 @@ _mappings = node.get_mappings
 _resolve = node.resolve_name
 _is_shutdown = node.is_shutdown
 _wait_for_shutdown = node.wait_for_shutdown
-_call_master = node.master_call_once
+_call_master = node.master_call
 
 
 # --------------------------------------------------------------------------- the cache

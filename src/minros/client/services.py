@@ -47,7 +47,7 @@ from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
 # the node context (answers before init_node too)
 _caller_id = node.get_caller_id
 _is_shutdown = node.is_shutdown
-_call_master = node.master_call_once
+_call_master = node.master_call
 _resolve = node.resolve_name
 _wait_for_shutdown = node.wait_for_shutdown
 
