@@ -9,6 +9,9 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+#: a ROS package the rostest tests run: its test_*.py are rostest's test nodes, not pytest's
+collect_ignore_glob = ["integration/rostest_pkgs/*"]
+
 from support import (  # noqa: E402
     PYTHON,
     REFERENCE_PYTHON,

@@ -40,7 +40,12 @@ READER = '''
 import json, rospy
 from rosgraph_msgs.msg import TopicStatistics
 rospy.init_node("stat_reader", anonymous=True)
-m = rospy.wait_for_message("/statistics", TopicStatistics, timeout=20)
+# the first window of a connection ends at its first message (rospy's rule too): read on to a
+# window that had time to fill
+for _ in range(10):
+    m = rospy.wait_for_message("/statistics", TopicStatistics, timeout=20)
+    if (m.window_stop - m.window_start).to_sec() >= 0.5:
+        break
 print(json.dumps({"topic": m.topic, "node_sub": m.node_sub, "node_pub": m.node_pub,
                   "delivered": m.delivered_msgs, "traffic": m.traffic,
                   "window": (m.window_stop - m.window_start).to_sec(),
