@@ -30,7 +30,7 @@ import sys
 import threading
 from typing import Any, Callable, Dict, Iterable, List, Tuple
 
-from minros import rosenv
+from minros import logfiles, rosenv
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
 from minros.names import resolve_name as _resolve_name
 from minros.wire import xmlrpc
@@ -823,13 +823,14 @@ class Master:
 
 
 def configure_log_file(path: str) -> bool:
-    """Write the master's log to ``path`` (rosmaster's master.log); False if it cannot."""
+    """Write the master's log to ``path`` (rosmaster's master.log), rotated as rospy rotates
+    it (50 MB, 4 old files) with lines truncated (a caller_id is the client's to choose);
+    False if it cannot."""
     try:
         os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-        handler = logging.FileHandler(path, encoding="utf-8")
+        handler = logfiles.rotating_handler(path, "[%(name)s][%(levelname)s] %(asctime)s: %(message)s")
     except OSError:
         return False
-    handler.setFormatter(logging.Formatter("[%(name)s][%(levelname)s] %(asctime)s: %(message)s"))
     _log.addHandler(handler)
     _log.setLevel(logging.INFO)
     return True
