@@ -77,3 +77,38 @@ def test_rotate_copy_truncate_keeps_the_writer_appending(tmp_path):
     finally:
         writer.close()
     assert not logfiles.rotate_copy_truncate(tmp_path / "missing.log")
+
+
+def test_roslaunch_rotates_the_console_logs_of_its_processes(tmp_path, monkeypatch):
+    import sys
+    import time
+
+    from minros.launch.runner import LaunchProcess
+
+    monkeypatch.setattr(logfiles, "NODE_LOG_MAX_BYTES", 10000)
+    monkeypatch.setattr(logfiles, "NODE_LOG_BACKUPS", 2)
+    # three rounds of 15 kB, each waiting for the test to rotate before the next one
+    chatty = ("import os, sys, time\n"
+              "for r in range(3):\n"
+              "    for i in range(300): print('round', r, 'line', i, 'x' * 30, flush=True)\n"
+              "    print('end of round', r, flush=True)\n"
+              "    while not os.path.exists(sys.argv[1] + str(r)): time.sleep(0.01)\n")
+    go = tmp_path / "go"
+    proc = LaunchProcess("chatty", [sys.executable, "-c", chatty, str(go)], {}, str(tmp_path),
+                         log_dir=tmp_path / "log", screen=False)
+    stdout = tmp_path / "log" / "chatty-stdout.log"
+    proc.start()
+    try:
+        for r in range(3):
+            deadline = time.monotonic() + 10
+            while f"end of round {r}" not in stdout.read_text() and time.monotonic() < deadline:
+                time.sleep(0.01)
+            proc.rotate_logs()  # what roslaunch's monitor does once a second
+            assert stdout.stat().st_size == 0
+            (tmp_path / f"go{r}").touch()
+    finally:
+        proc.stop(1, 1, print)
+    names = sorted(p.name for p in stdout.parent.glob("chatty-stdout.log*"))
+    assert names == ["chatty-stdout.log", "chatty-stdout.log.1", "chatty-stdout.log.2"]
+    assert (stdout.parent / "chatty-stdout.log.1").read_text().endswith("end of round 2\n")
+    assert (stdout.parent / "chatty-stdout.log.2").read_text().startswith("round 1 line 0 ")
