@@ -31,7 +31,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence
 
 from minros import rosenv
 
-__all__ = ["Admission", "BUSY", "IDLE", "Limits", "READING", "Refused"]
+__all__ = ["Admission", "BUSY", "Connection", "IDLE", "Limits", "READING", "Refused"]
 
 #: a connection waiting for its next request
 IDLE = 0
@@ -297,3 +297,41 @@ class Admission:
                 self._reported.clear()
         self._reported[peer] = now
         return True
+
+
+class Connection:
+    """One admitted connection's part in the policy, for the code that serves it: it says what
+    the connection is doing and charges the bytes it holds; ``evict(keys)`` closes the
+    connections the policy names to make room (the server's)."""
+
+    __slots__ = ("admission", "key", "_evict")
+
+    def __init__(self, admission: Admission, key: Any, evict: Callable[[List[Any]], Any]) -> None:
+        self.admission = admission
+        self.key = key
+        self._evict = evict
+
+    @property
+    def limits(self) -> Limits:
+        return self.admission.limits
+
+    def idle(self) -> None:
+        self.admission.set_state(self.key, IDLE)
+
+    def reading(self) -> None:
+        self.admission.set_state(self.key, READING)
+
+    def busy(self) -> None:
+        self.admission.set_state(self.key, BUSY)
+
+    def charge(self, size: int) -> None:
+        """``size`` more bytes held; Refused when they do not fit (see Admission.charge)."""
+        victims = self.admission.charge(self.key, size)
+        if victims:
+            self._evict(victims)
+
+    def release(self) -> None:
+        self.admission.release(self.key)
+
+    def evicted(self) -> bool:
+        return self.admission.evicted(self.key)
