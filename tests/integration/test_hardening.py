@@ -182,3 +182,42 @@ while not rospy.is_shutdown():
     pub.publish(String("hello"))
     rate.sleep()
 '''
+
+
+def test_minros_web_full_of_silent_connections_still_serves(minros_core, ros_home):
+    """The same rules in ``minros web``: past its 512 connections the oldest ones that have not
+    sent their request are closed, so a browser connecting now is served."""
+    import json
+
+    from websockets.sync.client import connect
+
+    web_port = free_port()
+    web = Proc([PYTHON, "-m", "minros", "web", "--port", str(web_port)],
+               ros_env(minros_core, ros_home))
+    silent = []
+    try:
+        web.read_until("ws://", 30)
+        for _ in range(600):
+            silent.append(socket.create_connection(("127.0.0.1", web_port), timeout=5))
+        start = time.perf_counter()
+        with connect(f"ws://127.0.0.1:{web_port}", open_timeout=5) as ws:
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/topics", "id": "t"}))
+            reply = json.loads(ws.recv(timeout=10))
+        print(f"\nminros web with 600 silent connections: answered in "
+              f"{(time.perf_counter() - start) * 1e3:.1f} ms")
+        assert reply["op"] == "service_response" and reply["result"] is True
+        closed = 0
+        deadline = time.monotonic() + 2.0  # well before websockets' 10 s handshake timeout
+        for s in silent[:88]:  # the oldest ones made room
+            s.settimeout(max(0.01, deadline - time.monotonic()))
+            try:
+                closed += s.recv(1) == b""
+            except socket.timeout:
+                pass  # still open
+            except OSError:  # reset
+                closed += 1
+        assert closed >= 80
+    finally:
+        for s in silent:
+            s.close()
+        web.stop()
