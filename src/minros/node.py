@@ -35,7 +35,7 @@ from minros import names, rosenv
 from minros.exceptions import ROSException, ROSInitException, ServiceException
 from minros.wire import admission, sockets, tcpros
 from minros.wire.rosapi import ParameterInvalid, api, is_topic
-from minros.wire.xmlrpc import ServerProxy, XmlRpcServer, after_reply
+from minros.wire.xmlrpc import ProtocolError, ServerProxy, XmlRpcServer, after_reply
 
 __all__ = [
     "DEFAULT_MASTER_URI",
@@ -734,6 +734,10 @@ class Node:
                     self._warned_master = True
                     text = (f"Unable to immediately register with master node [{self.master_uri}]: "
                             "master may not be running yet. Will keep trying.")
+                    if isinstance(exc, ProtocolError) and exc.errcode == 403:
+                        # not "may not be running": it runs and refuses us (ROS_ALLOWED_HOSTS)
+                        text = (f"The master [{self.master_uri}] refuses this node: {exc.errmsg}. "
+                                "Will keep trying.")
                     if first:
                         _rosout.error(text)
                     else:

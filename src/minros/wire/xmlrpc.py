@@ -724,6 +724,9 @@ class ServerProxy:
             raise ProtocolError(self.uri, 413, "response too large", headers)
         if status != 200:
             self._drop()
+            if headers.get("content-type", "").startswith("text/plain") and len(data) < 1024:
+                # a refusal's one line says why (minros's servers name the setting to change)
+                reason = data.decode("utf-8", "replace").strip() or reason
             raise ProtocolError(self.uri, status, reason, headers)
         _check_markup(data)
         result, _ = xmlrpc.client.loads(data, use_builtin_types=False)
