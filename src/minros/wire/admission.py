@@ -198,14 +198,18 @@ class Admission:
     # -- memory ----------------------------------------------------------------------------
 
     def charge(self, key: Any, size: int) -> List[Any]:
-        """``size`` more bytes of ``key``'s request are in memory. Returns the connections to
-        close to make room (older unfinished requests); raises Refused when the request does
-        not fit, even so, or when its peer holds its whole share."""
+        """``size`` more bytes of ``key``'s request are in memory (an idle connection is then
+        reading a request, from now). Returns the connections to close to make room (older
+        unfinished requests); raises Refused when the request does not fit, even so, or when
+        its peer holds its whole share."""
         limits = self.limits
         with self._lock:
             ticket = self._tickets.get(key)
             if ticket is None or ticket.evicted:
                 raise Refused("connection closed to make room for others")
+            if ticket.state == IDLE:
+                ticket.state = READING
+                ticket.since = self.clock()
             victims: List[Any] = []
             peer = ticket.peer
             if (limits.peer_budget < limits.budget

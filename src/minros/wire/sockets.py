@@ -171,9 +171,7 @@ class FrameSource:
                 reader.eof()  # FrameError (a TransportException) when cut mid-frame
                 return None
             if guard is not None:
-                if self._started is None:
-                    guard.reading()
-                guard.charge(n)
+                guard.charge(n)  # the policy counts a request as reading from its first bytes
             frames = reader.received_frames(n)
             if frames or self._started is None:
                 self._started = time.monotonic() if reader.pending() else None

@@ -167,11 +167,11 @@ class RequestHead:
 def parse_request_head(block: bytes, max_body: int) -> RequestHead:
     """Check the head of a request (request line and headers, without the blank line that
     ends it) and return what the server needs of it; _HttpError with the status otherwise."""
-    lines = block.split(b"\n")
-    line = lines[0]
+    lines = block.decode("latin-1").split("\n")  # latin-1: one character per byte
+    line = lines[0].rstrip("\r")
     if len(line) > MAX_HEADER_LINE:
         raise _HttpError(414, "request line too long")
-    parts = line.decode("latin-1").split()
+    parts = line.split()
     if len(parts) != 3:
         raise _HttpError(400, f"bad request line {line[:80]!r}")
     verb, path, version = parts
@@ -183,15 +183,15 @@ def parse_request_head(block: bytes, max_body: int) -> RequestHead:
     for hline in lines[1:]:
         if len(hline) > MAX_HEADER_LINE:
             raise _HttpError(431, "header line too long")
-        key, sep, value = hline.decode("latin-1").partition(":")
+        key, sep, value = hline.partition(":")
         if not sep:
             raise _HttpError(400, "malformed header line")
         headers[key.strip().lower()] = value.strip()
     if verb != "POST":
         raise _HttpError(501, f"Unsupported method ({verb!r})")
-    if path.split("?", 1)[0] not in _RPC_PATHS:
+    if path != "/" and path != "/RPC2" and path.split("?", 1)[0] not in _RPC_PATHS:
         raise _HttpError(404, path)
-    if "chunked" in headers.get("transfer-encoding", "").lower():
+    if "transfer-encoding" in headers and "chunked" in headers["transfer-encoding"].lower():
         raise _HttpError(411, "chunked requests are not supported; send Content-Length")
     length_text = headers.get("content-length")
     if length_text is None:
@@ -209,7 +209,7 @@ def parse_request_head(block: bytes, max_body: int) -> RequestHead:
         keep_alive = "keep-alive" in connection
     else:
         keep_alive = "close" not in connection
-    expect = headers.get("expect", "").lower() == "100-continue" and version != "HTTP/1.0"
+    expect = "expect" in headers and headers["expect"].lower() == "100-continue" and version != "HTTP/1.0"
     return RequestHead(version, length, keep_alive, expect)
 
 
@@ -266,8 +266,7 @@ class RequestReader:
             if len(buf) > MAX_HEAD:
                 raise _HttpError(431, "request head too long")
             return None
-        block = bytes(buf[:end]).replace(b"\r\n", b"\n")
-        self._head = parse_request_head(block, self.max_body)
+        self._head = parse_request_head(bytes(buf[:end]), self.max_body)
         self._body = buf[stop:]
         self._buf = bytearray()
         self._scanned = 0
@@ -515,12 +514,10 @@ class XmlRpcServer:
                       ) -> Tuple[RequestHead, bytearray]:
         """Read one request under the policy's deadlines and memory budget."""
         limits = self.limits
-        adm = self.admission
         idle_until = time.monotonic() + limits.idle_timeout
         while not reader.started():
             self._receive(conn, key, reader, idle_until, None)
-        adm.set_state(key, admission.READING)
-        start = time.monotonic()
+        start = time.monotonic()  # the policy took the first bytes' charge as the start too
         deadline = start + limits.head_timeout
         while (head := reader.head()) is None:
             self._receive(conn, key, reader, deadline, "request head")
@@ -548,9 +545,11 @@ class XmlRpcServer:
             if what is None:
                 raise _Closed() from None
             raise _HttpError(408, f"{what} not received within the deadline") from None
-        if not data or self._stopping.is_set() or self.admission.evicted(key):
+        if not data:  # the peer left, or the server closed the connection (shutdown, eviction)
             raise _Closed()
-        self._evict(self.admission.charge(key, len(data)))
+        victims = self.admission.charge(key, len(data))  # Refused once evicted
+        if victims:
+            self._evict(victims)
         reader.received(data)
 
 
