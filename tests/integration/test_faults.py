@@ -138,22 +138,18 @@ def report(fault: str, sent: List[int], got: List[int], **extra: object) -> List
     return missing
 
 
-def graph_env(port: int, home: Path) -> dict:
-    return ros_env(port, home)
-
-
 def start_core(port: int, home: Path) -> Proc:
-    core = Proc([PYTHON, "-m", "minros", "core", "-p", str(port)], graph_env(port, home))
+    core = Proc([PYTHON, "-m", "minros", "core", "-p", str(port)], ros_env(port, home))
     wait_for_master(port)
     return core
 
 
 def talker(port: int, home: Path, hz: float = 50, queue: str = "10", size: int = 10) -> Counted:
-    return Counted([PYTHON, "-c", COUNT_TALKER, str(hz), queue, str(size)], graph_env(port, home))
+    return Counted([PYTHON, "-c", COUNT_TALKER, str(hz), queue, str(size)], ros_env(port, home))
 
 
 def listener(port: int, home: Path) -> Counted:
-    node = Counted([PYTHON, "-c", COUNT_LISTENER], graph_env(port, home))
+    node = Counted([PYTHON, "-c", COUNT_LISTENER], ros_env(port, home))
     node.wait_for("listening")
     return node
 
@@ -250,7 +246,7 @@ def test_publisher_sigkilled_mid_frame(ros_home):
     try:
         sub = listener(port, ros_home)
         raw = Counted([PYTHON, "-c", RAW_PUBLISHER, f"http://127.0.0.1:{port}/"],
-                      graph_env(port, ros_home))
+                      ros_env(port, ros_home))
         nodes += [sub, raw]
         raw.wait_for("mid-frame")
         sub.wait_count("got", 5)
@@ -356,7 +352,7 @@ except rospy.ServiceException as exc:
 def test_a_service_server_that_never_answers(ros_home):
     port = free_port()
     core = start_core(port, ros_home)
-    env = graph_env(port, ros_home)
+    env = ros_env(port, ros_home)
     nodes: List[Counted] = []
     try:
         sub = listener(port, ros_home)
@@ -425,13 +421,13 @@ def test_roslaunch_sigkilled_leaves_no_orphans(ros_home, tmp_path):
     core = start_core(port, ros_home)
     launch_file = tmp_path / "pair.launch"
     launch_file.write_text(LAUNCH)
-    launch = Counted([str(BIN / "roslaunch"), str(launch_file)], graph_env(port, ros_home))
+    launch = Counted([str(BIN / "roslaunch"), str(launch_file)], ros_env(port, ros_home))
     counter = None
     try:
         launch.wait_for("I heard", 30)
         pids = [int(p) for p in re.findall(r"started with pid \[(\d+)\]", launch.text)]
         assert len(pids) == 2
-        counter = Counted([PYTHON, "-c", CHATTER_COUNTER], graph_env(port, ros_home))
+        counter = Counted([PYTHON, "-c", CHATTER_COUNTER], ros_env(port, ros_home))
         counter.wait_count("got", 5)
         os.kill(launch.proc.pid, signal.SIGKILL)  # roslaunch alone, no chance to clean up
         wait_until(lambda: not any(_alive(p) for p in pids), 10, what="its nodes gone")
@@ -451,7 +447,7 @@ def test_roslaunch_sigkilled_leaves_no_orphans(ros_home, tmp_path):
 
 def test_ctrl_c_of_everything(ros_home, tmp_path):
     port = free_port()
-    env = graph_env(port, ros_home)
+    env = ros_env(port, ros_home)
     core = start_core(port, ros_home)
     launch_file = tmp_path / "pair.launch"
     launch_file.write_text(LAUNCH)
