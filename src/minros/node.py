@@ -599,8 +599,9 @@ class Node:
 
         ``handler(sock, header, conn)`` runs in the connection's thread for inbound connections
         whose header names this service; it owns the socket from then on, and tells ``conn``
-        (the connection's admission) when it waits for, reads or serves a request. ServiceException if this
-        node already serves ``resolved_name`` (checked under the registry lock: no two winners).
+        (the connection's admission) when it waits for, reads or serves a request.
+        ServiceException if this node already serves ``resolved_name`` (checked under the
+        registry lock: no two winners).
         """
         with self._registry_lock:
             if resolved_name in self.services:

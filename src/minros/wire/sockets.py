@@ -170,11 +170,11 @@ class FrameSource:
             if not n:
                 reader.eof()  # FrameError (a TransportException) when cut mid-frame
                 return None
+            frames = reader.received_frames(n)
             if guard is not None:
                 guard.charge(n)  # the policy counts a request as reading from its first bytes
-            frames = reader.received_frames(n)
-            if frames or self._started is None:
-                self._started = time.monotonic() if reader.pending() else None
+                if frames or self._started is None:
+                    self._started = time.monotonic() if reader.pending() else None
             self.pending.extend(frames)
         return self.pending.popleft()
 
@@ -187,6 +187,7 @@ class FrameSource:
             deadline = self._started + self.guard.limits.transfer_time(self.reader.announced() or 0)
             what = "the request did not arrive"
         if deadline is None:
+            self.sock.settimeout(self._poll)
             return
         remaining = deadline - time.monotonic()
         if remaining <= 0:
