@@ -30,7 +30,7 @@ import sys
 import threading
 from typing import Any, Callable, Dict, Iterable, List, Tuple
 
-from minros import rosenv
+from minros import logfiles, rosenv
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
 from minros.names import resolve_name as _resolve_name
 from minros.wire import xmlrpc
@@ -783,6 +783,7 @@ class Master:
                  hostname: str | None = None) -> None:
         """``host``: address to bind (default: ROS's rule from ROS_IP/ROS_HOSTNAME);
         ``hostname``: name advertised in the master URI (default: ROS_HOSTNAME/ROS_IP/host name)."""
+        allowed = rosenv.allowed_hosts()  # first: ValueError naming a malformed entry
         self.hostname = hostname
         if host is None and hostname is not None:
             host = rosenv.get_bind_address(hostname)
@@ -792,7 +793,8 @@ class Master:
         self.handler._on_shutdown = lambda reason: xmlrpc.after_reply(self._stopped.set)
         bind = rosenv.get_bind_address() if host is None else host
         self.server = xmlrpc.XmlRpcServer(self.handler, bind, port,
-                                          ipv6=":" in bind or rosenv.use_ipv6())
+                                          ipv6=":" in bind or rosenv.use_ipv6(), allowed=allowed,
+                                          on_refused=_report_refusal, what="the master")
         self._stopped = threading.Event()
         self.uri = ""
 
@@ -822,14 +824,25 @@ class Master:
         self.pool.stop()
 
 
+def _report_refusal(peer: str, reason: str) -> None:
+    """A peer outside ROS_ALLOWED_HOSTS: one line on the console and in master.log (at most
+    one a minute per peer, by the admission policy)."""
+    _log.warning("%s", reason)
+    try:
+        sys.stderr.write(f"[WARN] {reason}\n")
+    except (OSError, ValueError):
+        pass
+
+
 def configure_log_file(path: str) -> bool:
-    """Write the master's log to ``path`` (rosmaster's master.log); False if it cannot."""
+    """Write the master's log to ``path`` (rosmaster's master.log), rotated as rospy rotates
+    it (50 MB, 4 old files) with lines truncated (a caller_id is the client's to choose);
+    False if it cannot."""
     try:
         os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-        handler = logging.FileHandler(path, encoding="utf-8")
+        handler = logfiles.rotating_handler(path, "[%(name)s][%(levelname)s] %(asctime)s: %(message)s")
     except OSError:
         return False
-    handler.setFormatter(logging.Formatter("[%(name)s][%(levelname)s] %(asctime)s: %(message)s"))
     _log.addHandler(handler)
     _log.setLevel(logging.INFO)
     return True
@@ -865,7 +878,11 @@ def main(argv: List[str] | None = None, prog: str = "minros master") -> int:
             parser.error(f"unrecognized arg: {extra}")
     if not 0 < args.port < 65536:
         parser.error(f"invalid port {args.port}")
-    master = Master(args.port, workers=max(1, args.numworkers), callback_timeout=args.timeout)
+    try:
+        master = Master(args.port, workers=max(1, args.numworkers), callback_timeout=args.timeout)
+    except ValueError as exc:
+        print(f"{prog}: {exc}", file=sys.stderr)
+        return 1
     try:
         master.start()
     except OSError as exc:

@@ -33,9 +33,9 @@ from typing import Any, Callable, Dict, List, Protocol, Sequence, Tuple
 
 from minros import names, rosenv
 from minros.exceptions import ROSException, ROSInitException, ServiceException
-from minros.wire import sockets, tcpros
+from minros.wire import admission, sockets, tcpros
 from minros.wire.rosapi import ParameterInvalid, api, is_topic
-from minros.wire.xmlrpc import ServerProxy, XmlRpcServer, after_reply
+from minros.wire.xmlrpc import ProtocolError, ServerProxy, XmlRpcServer, after_reply
 
 __all__ = [
     "DEFAULT_MASTER_URI",
@@ -74,8 +74,12 @@ __all__ = [
 DEFAULT_MASTER_URI = rosenv.DEFAULT_MASTER_URI
 #: how often the master is probed to notice that it restarted
 MASTER_PROBE_INTERVAL = 1.0
-#: time allowed to read an inbound connection header
+#: time allowed to read an inbound connection header, however slowly it trickles in
 HEADER_TIMEOUT = 10.0
+#: the admission policy of the TCPROS server (wire/admission.py): handshakes and service
+#: connections; a service request may be large (roscpp allows 1 GB), hence the budget
+TCPROS_LIMITS = admission.Limits(max_connections=1024, head_timeout=HEADER_TIMEOUT,
+                                 budget=1 << 30)
 #: timeout of XML-RPC calls to the master and to other nodes
 XMLRPC_TIMEOUT = 10.0
 #: a registration the master did not answer is retried this often
@@ -111,8 +115,9 @@ class Subscription(Protocol):
     def close(self) -> None: ...
 
 
-#: ``handler(sock, header)``: serves one inbound service connection, owns the socket
-ServiceHandler = Callable[[socket.socket, Dict[str, str]], Any]
+#: ``handler(sock, header, conn)``: serves one inbound service connection, owns the socket;
+#: ``conn`` (an admission.Connection) is its part in the TCPROS server's admission policy
+ServiceHandler = Callable[[socket.socket, Dict[str, str], admission.Connection], Any]
 #: ``handler(key, value) -> bool``: a paramUpdate; True when the value was cached
 ParamUpdateHandler = Callable[[str, Any], bool]
 
@@ -154,6 +159,10 @@ class Node:
         self._tcpros_port = 0
         self._tcpros_sock: socket.socket | None = None
         self._tcpros_lock = threading.Lock()
+        self._allowed: Any = None  # ROS_ALLOWED_HOSTS, read by start()
+        self._tcpros_admission = admission.Admission(TCPROS_LIMITS)
+        self._inbound: Dict[int, socket.socket] = {}  # admission key -> inbound socket
+        self._inbound_lock = threading.Lock()
         self._local = threading.local()  # one master proxy per thread
         self._reg_lock = threading.Lock()
         self._master_pid: int | None = None
@@ -374,7 +383,15 @@ class Node:
     def start(self) -> None:
         """Start the slave API, register everything with the master, watch the master."""
         self.host = self.host_name()
-        self._xmlrpc = XmlRpcServer(SlaveApi(self), host=self.bind_address(), port=self._xmlrpc_port)
+        try:
+            self._allowed = rosenv.allowed_hosts()
+        except ValueError as exc:
+            raise ROSInitException(str(exc)) from None
+        self._tcpros_admission = admission.Admission(
+            TCPROS_LIMITS, self._allowed, what=f"node [{self.caller_id}]")
+        self._xmlrpc = XmlRpcServer(SlaveApi(self), host=self.bind_address(), port=self._xmlrpc_port,
+                                    allowed=self._allowed, on_refused=self._refused,
+                                    what=f"node [{self.caller_id}]")
         self._xmlrpc.start()
         self.uri = f"http://{self.host}:{self._xmlrpc.port}/"
         _logger.info("ROS Slave URI: [%s]", self.uri)
@@ -427,7 +444,13 @@ class Node:
                                  name="minros-tcpros-server", daemon=True).start()
             return self.host, self._tcpros_sock.getsockname()[1]
 
+    @staticmethod
+    def _refused(peer: str, reason: str) -> None:
+        """A peer outside ROS_ALLOWED_HOSTS (one line per peer a minute, by the policy)."""
+        _rosout.warning("%s", reason)
+
     def _accept_loop(self, server: socket.socket) -> None:
+        adm = self._tcpros_admission
         while not self._closed.is_set():
             try:
                 sock, addr = server.accept()
@@ -436,37 +459,86 @@ class Node:
                     return
                 self._closed.wait(0.01)  # e.g. out of file descriptors: back off
                 continue
-            threading.Thread(target=self._handle_inbound, args=(sock, addr),
-                             name="minros-tcpros-inbound", daemon=True).start()
-
-    def _handle_inbound(self, sock: socket.socket, addr: Any) -> None:
-        """Read the connection header and hand the socket to the topic or service."""
-        try:
-            sock.settimeout(HEADER_TIMEOUT)
-            header = sockets.read_header(sock)
-            sock.settimeout(None)
-        except (OSError, tcpros.HeaderError) as exc:
-            if not self.is_shutdown_requested():
-                _rosout.warning("Inbound TCP/IP connection failed: %s", exc)
-            sockets.close(sock)
-            return
-        try:
-            error = self._dispatch_inbound(sock, addr, header)
-        except Exception as exc:
-            error = f"internal error: {exc}"
-            _logger.error("inbound connection failed: %s", traceback.format_exc())
-        if error is not None:
-            if self.is_shutdown_requested():
-                error = "node shutting down"
-            else:  # rospy's wording, header dict included
-                _rosout.warning("Could not process inbound connection: %s%s", error, header)
+            key = adm.new_key()
             try:
-                sock.sendall(tcpros.encode_error_header(error))
-            except OSError:
-                pass
-            sockets.close(sock)
+                victims = adm.admit(key, addr[0], sock.getsockname()[0])
+            except admission.Refused as refused:
+                if refused.report:
+                    self._refused(addr[0], str(refused))
+                sock.settimeout(1.0)
+                try:  # the peer reads it where it expects the answer to its header
+                    sock.sendall(tcpros.encode_error_header(str(refused)))
+                except OSError:
+                    pass
+                sockets.close(sock)
+                continue
+            except OSError:  # the peer left already
+                sockets.close(sock)
+                continue
+            self._evict_inbound(victims)
+            with self._inbound_lock:
+                self._inbound[key] = sock
+            try:
+                threading.Thread(target=self._handle_inbound, args=(sock, addr, key),
+                                 name="minros-tcpros-inbound", daemon=True).start()
+            except RuntimeError:  # cannot start a thread: drop this peer
+                self._forget_inbound(key)
+                sockets.close(sock)
 
-    def _dispatch_inbound(self, sock: socket.socket, addr: Any, header: Dict[str, str]) -> str | None:
+    def _evict_inbound(self, keys: List[Any]) -> None:
+        """Close inbound connections the admission policy chose to make room."""
+        for key in keys:
+            with self._inbound_lock:
+                sock = self._inbound.get(key)
+            if sock is not None:
+                try:
+                    sock.shutdown(socket.SHUT_RDWR)  # its thread sees the end and cleans up
+                except OSError:
+                    pass
+
+    def _forget_inbound(self, key: Any) -> None:
+        with self._inbound_lock:
+            self._inbound.pop(key, None)
+        self._tcpros_admission.leave(key)
+
+    def _handle_inbound(self, sock: socket.socket, addr: Any, key: Any) -> None:
+        """Read the connection header and hand the socket to the topic or service."""
+        conn = admission.Connection(self._tcpros_admission, key, self._evict_inbound)
+        try:
+            conn.reading()
+            try:
+                header = sockets.read_header(
+                    sock, deadline=time.monotonic() + conn.limits.head_timeout,
+                    charge=conn.charge)
+                sock.settimeout(None)
+            except (OSError, tcpros.HeaderError, admission.Refused) as exc:
+                if not self.is_shutdown_requested() and not conn.evicted():
+                    _rosout.warning("Inbound TCP/IP connection failed: %s", exc)
+                sockets.close(sock)
+                return
+            conn.release()
+            conn.busy()
+            try:
+                error = self._dispatch_inbound(sock, addr, header, conn)
+            except Exception as exc:
+                error = f"internal error: {exc}"
+                _logger.error("inbound connection failed: %s", traceback.format_exc())
+            if error is not None:
+                if self.is_shutdown_requested():
+                    error = "node shutting down"
+                else:  # rospy's wording, header dict included
+                    _rosout.warning("Could not process inbound connection: %s%s", error, header)
+                try:
+                    sock.sendall(tcpros.encode_error_header(error))
+                except OSError:
+                    pass
+                sockets.close(sock)
+        finally:
+            # a topic connection lives on with its publication; a service one has ended
+            self._forget_inbound(key)
+
+    def _dispatch_inbound(self, sock: socket.socket, addr: Any, header: Dict[str, str],
+                          conn: admission.Connection) -> str | None:
         """Hand a connection to what its header names; the error text when it cannot be."""
         if "topic" in header:
             if self.is_shutdown_requested():
@@ -481,7 +553,7 @@ class Node:
             handler = self.services.get(header["service"])
             if handler is None:
                 return f"[{self.caller_id}] is not a provider of [{header['service']}]"
-            handler(sock, header)
+            handler(sock, header, conn)
             return None
         return "no topic or service name detected"
 
@@ -525,9 +597,11 @@ class Node:
     def register_service(self, resolved_name: str, handler: ServiceHandler) -> None:
         """Serve ``resolved_name`` on the TCPROS server and register it with the master.
 
-        ``handler(sock, header)`` runs in the connection's thread for inbound connections whose
-        header names this service; it owns the socket from then on. ServiceException if this
-        node already serves ``resolved_name`` (checked under the registry lock: no two winners).
+        ``handler(sock, header, conn)`` runs in the connection's thread for inbound connections
+        whose header names this service; it owns the socket from then on, and tells ``conn``
+        (the connection's admission) when it waits for, reads or serves a request.
+        ServiceException if this node already serves ``resolved_name`` (checked under the
+        registry lock: no two winners).
         """
         with self._registry_lock:
             if resolved_name in self.services:
@@ -661,6 +735,10 @@ class Node:
                     self._warned_master = True
                     text = (f"Unable to immediately register with master node [{self.master_uri}]: "
                             "master may not be running yet. Will keep trying.")
+                    if isinstance(exc, ProtocolError) and exc.errcode == 403:
+                        # not "may not be running": it runs and refuses us (ROS_ALLOWED_HOSTS)
+                        text = (f"The master [{self.master_uri}] refuses this node: {exc.errmsg}. "
+                                "Will keep trying.")
                     if first:
                         _rosout.error(text)
                     else:

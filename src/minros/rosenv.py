@@ -1,5 +1,6 @@
-"""The ROS environment rules in one place: master URI, ROS_HOME, the log directory, and the
-addresses a node binds to and advertises (ROS_IP, ROS_HOSTNAME, ROS_IPV6).
+"""The ROS environment rules in one place: master URI, ROS_HOME, the log directory, the
+addresses a node binds to and advertises (ROS_IP, ROS_HOSTNAME, ROS_IPV6), and the peers its
+servers accept (ROS_ALLOWED_HOSTS, minros's own: ROS 1 has no access control).
 
 Every tool and node reads these the same way, as rosgraph.rosenv does: ``__master:=`` beats
 ``ROS_MASTER_URI`` (default ``http://localhost:11311/``); ``ROS_HOME`` defaults to ``~/.ros``;
@@ -9,11 +10,13 @@ directory named by its run_id and ``latest`` links to the newest one.
 
 from __future__ import annotations
 
+import ipaddress
 import os
+import re
 import socket
 import sys
 from pathlib import Path
-from typing import Iterable, Mapping, Optional, Sequence
+from typing import Iterable, Mapping, Optional, Sequence, Tuple, Union
 
 DEFAULT_MASTER_PORT = 11311
 DEFAULT_MASTER_URI = f"http://localhost:{DEFAULT_MASTER_PORT}/"
@@ -208,3 +211,64 @@ def is_local_address(hostname: str, env: Mapping[str, str] | None = None) -> boo
     if any(ip.startswith("127.") or ip == "::1" for ip in ips):
         return True
     return bool(set(ips) & ({"localhost"} | set(get_local_addresses(env))))
+
+# ---------------------------------------------------------------------------------------------
+# the peers a master's or a node's servers accept (ROS_ALLOWED_HOSTS)
+
+#: the environment variable of the allow-list (the name ROS 2's first localhost-only proposal
+#: used; ROS 1 has no access control at all)
+ALLOWED_HOSTS_VAR = "ROS_ALLOWED_HOSTS"
+
+Network = Union[ipaddress.IPv4Network, ipaddress.IPv6Network]
+_LOOPBACK = (ipaddress.ip_network("127.0.0.0/8"), ipaddress.ip_network("::1/128"))
+
+
+def parse_allowed_hosts(text: str) -> Tuple[Network, ...]:
+    """The networks of an allow-list: entries separated by commas, semicolons or spaces, each
+    an address (``10.0.0.5``, ``fe80::1``), a network (``10.0.0.0/24``) or a host name (its
+    addresses, resolved now). ValueError naming the first entry that is none of these."""
+    networks = []
+    for entry in re.split(r"[\s,;]+", text.strip()):
+        if not entry:
+            continue
+        try:
+            networks.append(ipaddress.ip_network(entry, strict=False))
+            continue
+        except ValueError:
+            pass
+        try:
+            infos = socket.getaddrinfo(entry, None, proto=socket.IPPROTO_TCP)
+        except (OSError, UnicodeError):
+            raise ValueError(f"{ALLOWED_HOSTS_VAR}: [{entry}] is neither an address, a network "
+                             "(10.0.0.0/24) nor a host name this machine can resolve") from None
+        for info in infos:
+            networks.append(ipaddress.ip_network(info[4][0].split("%", 1)[0]))
+    return tuple(networks)
+
+
+def allowed_hosts(env: Mapping[str, str] | None = None) -> Optional[Tuple[Network, ...]]:
+    """ROS_ALLOWED_HOSTS as networks, or None when it is unset or empty: then every peer is
+    accepted, as in ROS. ValueError for an entry that is not an address, network or host."""
+    env = os.environ if env is None else env
+    text = env.get(ALLOWED_HOSTS_VAR, "").strip()
+    if not text:
+        return None
+    return parse_allowed_hosts(text)
+
+
+def host_allowed(peer: str, allowed: Optional[Sequence[Network]], local: str | None = None) -> bool:
+    """Whether a connection from address ``peer`` may be served. Everyone when ``allowed`` is
+    None; otherwise loopback, this host itself (``peer`` equal to ``local``, the address the
+    connection arrived at) and the members of ``allowed``."""
+    if allowed is None:
+        return True
+    try:
+        address = ipaddress.ip_address(peer.split("%", 1)[0])
+    except ValueError:
+        return False
+    mapped = getattr(address, "ipv4_mapped", None)  # ::ffff:10.0.0.1 on a dual-stack socket
+    if mapped is not None:
+        address = mapped
+    if local is not None and peer == local:
+        return True
+    return any(address in net for net in (*_LOOPBACK, *allowed))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from minros.nodes.rosout import RotatingLog, format_line
+from minros.nodes.rosout import format_line
 from minros.rosenv import ros_log_dir as log_dir
 
 
@@ -20,17 +20,6 @@ def test_line_format_matches_cpp_rosout():
     assert " FATAL " in format_line(_msg(level=16))
     assert " 3 " in format_line(_msg(level=3))  # unknown levels print their number
     assert "[topics: ]" in format_line(_msg(topics=()))
-
-
-def test_rotation(tmp_path):
-    log = RotatingLog(tmp_path / "rosout.log", max_size=100, backups=2)
-    for i in range(10):
-        log.write(f"line {i:02d} " + "x" * 40 + "\n")
-    log.close()
-    assert (tmp_path / "rosout.log.1").exists() and (tmp_path / "rosout.log.2").exists()
-    assert not (tmp_path / "rosout.log.3").exists()
-    assert "line 09" in (tmp_path / "rosout.log").read_text()
-    assert (tmp_path / "rosout.log").stat().st_size <= 100
 
 
 def test_log_dir_rules(tmp_path):

@@ -9,7 +9,9 @@ import xmlrpc.client
 
 import pytest
 
+from minros import rosenv
 from minros.wire import xmlrpc as mx
+from minros.wire.admission import Limits
 
 
 class Handler:
@@ -212,7 +214,8 @@ def test_many_silent_clients_do_not_block_others(server):
 
 
 def test_connection_bound_reclaims_idle_connections():
-    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", idle_timeout=30, max_connections=2).start()
+    limits = Limits(max_connections=2, peer_share=1.0, idle_timeout=30)
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", limits=limits).start()
     try:
         silent = [socket.create_connection(("127.0.0.1", srv.port), timeout=5) for _ in range(2)]
         wait = time.monotonic() + 3
@@ -254,24 +257,6 @@ def test_concurrent_clients(server):
     assert not errors
 
 
-def test_bodies_in_memory_are_bounded_in_total():
-    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", max_body=1000, body_budget=1000, idle_timeout=0.1)
-    assert srv._reserve(900)
-    start = time.monotonic()
-    assert not srv._reserve(200)  # would exceed the budget: refused after a short wait
-    assert time.monotonic() - start >= 0.09
-    srv._release(900)
-    assert srv._reserve(200)
-    srv._release(200)
-    # and the server still answers requests through the budget
-    srv.start()
-    try:
-        assert mx.ServerProxy(f"http://127.0.0.1:{srv.port}/").add(1, 2) == 3
-        assert srv._budget_used == 0
-    finally:
-        srv.shutdown()
-
-
 def test_expect_100_continue(server):
     body = xmlrpc.client.dumps((1, 2), "add").encode()
     with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
@@ -300,3 +285,193 @@ def test_client_reports_bad_content_length_as_protocol_error():
     finally:
         thread.join(5)
         listener.close()
+
+
+# --------------------------------------------------------------------------- the request reader
+
+
+def test_request_reader_parses_heads_bodies_and_pipelined_requests():
+    body = xmlrpc.client.dumps((1, 2), "add").encode()
+    one = b"POST /RPC2 HTTP/1.1\r\nContent-Length: %d\r\n\r\n%s" % (len(body), body)
+    reader = mx.RequestReader()
+    reader.received(b"\r\n\r\n")  # stray blank lines between requests do not start one
+    assert not reader.started() and reader.head() is None
+    stream = one + b"POST / HTTP/1.0\nContent-Length: 3\n\nabc"  # bare LF and HTTP/1.0
+    for i in range(len(stream)):  # byte by byte: the same requests come out
+        reader.received(stream[i:i + 1])
+        if reader.body() is not None:
+            break
+    head = reader.head()
+    assert head.length == len(body) and head.keep_alive and reader.body() == body
+    assert reader.next_request() == 0
+    reader.received(stream[len(one):])
+    head = reader.head()
+    assert head.version == "HTTP/1.0" and not head.keep_alive and reader.body() == b"abc"
+    reader.next_request()
+    reader.received(one + one[:10])  # one whole request and the start of the next
+    assert reader.body() == body and reader.next_request() == 10
+
+
+@pytest.mark.parametrize("data, status", [
+    (b"GET / HTTP/1.1\r\n\r\n", 501),
+    (b"POST /x HTTP/1.1\r\nContent-Length: 0\r\n\r\n", 404),
+    (b"POST / HTTP/2.0\r\n\r\n", 505),
+    (b"POST / HTTP/1.1\r\n\r\n", 411),
+    (b"POST / HTTP/1.1\r\nContent-Length: -1\r\n\r\n", 400),
+    (b"POST / HTTP/1.1\r\nContent-Length: 2000\r\n\r\n", 413),
+    (b"POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n", 411),
+    (b"POST / HTTP/1.1\r\nno colon\r\n\r\n", 400),
+    (b"POST " + b"x" * 9000, 414),
+    (b"POST / HTTP/1.1\r\n" + b"X: y\r\n" * 101 + b"\r\n", 431),
+    (b"POST / HTTP/1.1\r\n" + b"X: " + b"y" * 9000 + b"\r\n\r\n", 431),
+    (b"POST / HTTP/1.1\r\n" + (b"X: " + b"y" * 8000 + b"\r\n") * 110, 431),
+])
+def test_request_reader_refuses_bad_heads(data, status):
+    reader = mx.RequestReader(max_body=1000)
+    reader.received(data)
+    with pytest.raises(mx._HttpError) as err:
+        reader.head()
+    assert err.value.status == status
+
+
+def test_request_reader_keeps_only_what_arrived():
+    reader = mx.RequestReader()
+    reader.received(b"POST / HTTP/1.1\r\nContent-Length: 67108864\r\n\r\nab")
+    assert reader.head().length == 64 << 20
+    assert reader.body() is None and len(reader._body) == 2  # nothing allocated for the rest
+
+
+# --------------------------------------------------------------------------- hostile clients
+
+
+def _held_open(port: int, data: bytes, count: int) -> list:
+    conns = []
+    for _ in range(count):
+        s = socket.create_connection(("127.0.0.1", port), timeout=5)
+        s.sendall(data)
+        conns.append(s)
+    return conns
+
+
+def _answer_times(port: int, calls: int) -> list:
+    times = []
+    for i in range(calls):
+        start = time.perf_counter()
+        assert mx.ServerProxy(f"http://127.0.0.1:{port}/", timeout=2.0).add(i, 1) == i + 1
+        times.append(time.perf_counter() - start)
+    return times
+
+
+def test_announced_bodies_hold_no_memory_and_block_nobody():
+    """Defect 1 of issue 18: four requests announcing 64 MiB and sending nothing stalled every
+    other call, because the announced length was booked against the shared budget."""
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1").start()
+    hostile = _held_open(srv.port, b"POST / HTTP/1.1\r\nContent-Length: 67108864\r\n\r\nx", 4)
+    try:
+        assert len(_answer_times(srv.port, 5)) == 5
+        assert srv.admission.held() < 4096  # only the bytes that arrived are charged
+    finally:
+        for s in hostile:
+            s.close()
+        srv.shutdown()
+
+
+def test_a_trickled_head_cannot_extend_its_deadline():
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", limits=Limits(head_timeout=0.5)).start()
+    try:
+        s = socket.create_connection(("127.0.0.1", srv.port), timeout=5)
+        start = time.monotonic()
+        s.settimeout(0.1)
+        reply = b""
+        for byte in b"POST / HTTP/1.1\r\nContent-Length: 5\r\nX-Slow: " + b"y" * 100:
+            try:
+                s.send(bytes([byte]))
+                reply = s.recv(4096)
+                break
+            except socket.timeout:
+                continue
+            except OSError:
+                break
+        assert reply.startswith(b"HTTP/1.1 408 Request Timeout")
+        assert b"request head not received within the deadline" in reply
+        assert 0.4 < time.monotonic() - start < 3.0
+        s.close()
+    finally:
+        srv.shutdown()
+
+
+def test_a_trickled_body_cannot_extend_its_deadline():
+    limits = Limits(head_timeout=0.3, min_rate=1000.0)  # 300 bytes: 0.3 + 0.3 s
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", limits=limits).start()
+    try:
+        s = socket.create_connection(("127.0.0.1", srv.port), timeout=5)
+        start = time.monotonic()
+        s.sendall(b"POST / HTTP/1.1\r\nContent-Length: 300\r\n\r\n")
+        s.settimeout(0.05)
+        reply = b""
+        while not reply and time.monotonic() - start < 5:
+            try:
+                s.send(b"<")
+                reply = s.recv(4096)
+            except socket.timeout:
+                continue
+        assert b"408 Request Timeout" in reply and b"request body" in reply
+        assert 0.5 < time.monotonic() - start < 3.0
+        s.close()
+    finally:
+        srv.shutdown()
+
+
+def test_a_full_server_of_trickling_clients_still_answers():
+    """Defect 2 of issue 18 in small: at the cap the server closed only connections waiting for
+    their first request line, so clients trickling their headers held it full."""
+    limits = Limits(max_connections=20, peer_share=1.0)
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", limits=limits).start()
+    tricklers = _held_open(srv.port, b"POST / HTTP/1.1\r\nX-Slow: ", 25)
+    try:
+        for s in tricklers:
+            s.send(b"y")
+        assert len(_answer_times(srv.port, 5)) == 5
+        assert srv.connection_count() <= 20 and srv.admission.evictions >= 5
+    finally:
+        for s in tricklers:
+            s.close()
+        srv.shutdown()
+
+
+def test_slow_bodies_filling_the_budget_are_closed_for_newer_requests():
+    limits = Limits(budget=1500, peer_share=1.0)
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", max_body=1500, limits=limits).start()
+    try:
+        slow = _held_open(srv.port, b"POST / HTTP/1.1\r\nContent-Length: 1500\r\n\r\n"
+                          + b"<" * 1400, 1)[0]
+        wait = time.monotonic() + 3
+        while srv.admission.held() < 1400 and time.monotonic() < wait:
+            time.sleep(0.01)
+        assert srv.admission.held() >= 1400
+        assert _answer_times(srv.port, 3)  # each needs ~300 bytes: the slow one makes room
+        assert slow.recv(100) == b""  # closed
+        assert srv.admission.held() == 0
+        slow.close()
+    finally:
+        srv.shutdown()
+
+
+def test_peers_outside_the_allow_list_are_refused_with_one_reported_line():
+    refused = []
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", allowed=rosenv.parse_allowed_hosts("10.9.9.0/24"),
+                          on_refused=lambda peer, reason: refused.append(reason),
+                          what="the master")
+    for _ in range(3):
+        ours, theirs = socket.socketpair()
+        with ours, theirs:
+            srv._admit(ours, ("192.168.5.5", 4000))  # as if accepted from that address
+            reply = theirs.recv(4096)
+        assert reply.startswith(b"HTTP/1.1 403 Forbidden")
+        assert b"connection from 192.168.5.5 refused: not in ROS_ALLOWED_HOSTS of the master" in reply
+    assert refused == ["connection from 192.168.5.5 refused: not in ROS_ALLOWED_HOSTS of the master"]
+    srv.start()  # loopback peers are always served
+    try:
+        assert mx.ServerProxy(uri(srv)).add(1, 2) == 3
+    finally:
+        srv.shutdown()

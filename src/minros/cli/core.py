@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import List
 from urllib.parse import urlparse
 
+from minros import logfiles
 from minros.rosenv import renew_latest_log_dir
 
 #: minros implements the Noetic protocols; tools that ask for the distro get a real one.
@@ -137,6 +138,14 @@ class RosoutProcess:
             out.close()
         self.started_at = time.monotonic()
         return self.popen.pid
+
+    def rotate_log(self) -> None:
+        """rosout's console log rotates as a node log does (its lines may quote peers)."""
+        try:
+            logfiles.rotate_copy_truncate(os.path.join(self.log_dir, "rosout-1-stdout.log"),
+                                          logfiles.NODE_LOG_MAX_BYTES, logfiles.NODE_LOG_BACKUPS)
+        except OSError:
+            pass
 
     def died(self) -> bool:
         return self.popen is not None and self.popen.poll() is not None
@@ -270,6 +279,8 @@ def main(argv: List[str], prog: str = "minros core") -> int:
     try:
         while not stop.is_set() and core.ok():
             stop.wait(0.5)
+            if rosout is not None:
+                rosout.rotate_log()
             if rosout is not None and rosout.died() and not stop.is_set() and core.ok():
                 # respawn="true" in roscore.xml; back off if it keeps dying at start
                 if time.monotonic() - rosout.started_at < 5.0:

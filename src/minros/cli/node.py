@@ -229,7 +229,8 @@ def ping(graph: _Graph, node: str, max_count: int | None = None, verbose: bool =
                         uri = fresh
                         continue
                     print(f"ERROR: connection refused to [{uri}]", file=sys.stderr)
-                elif isinstance(exc, socket.gaierror):
+                elif isinstance(exc, socket.gaierror) and exc.errno == socket.EAI_NONAME:
+                    # only "no such name": rosnode says "failed" when DNS cannot be asked
                     print(f"ERROR: Unknown host [{urlparse(uri).hostname}] for node [{node}]",
                           file=sys.stderr)
                 else:

@@ -18,14 +18,13 @@ from __future__ import annotations
 import hashlib
 import inspect
 import logging
-import logging.handlers
 import os
 import sys
 import threading
 import time
 from typing import Any, Dict, Tuple
 
-from minros import node
+from minros import logfiles, node
 from minros.client import rostime
 from minros.rosenv import ros_log_dir
 
@@ -204,20 +203,20 @@ def node_log_filename(caller_id: str, mappings: Dict[str, str] | None = None,
 
 
 def start_file_logging(caller_id: str) -> None:
-    """rospy's logging config: every logger at INFO and above also goes to the node's file."""
+    """rospy's logging config: every logger at INFO and above also goes to the node's file
+    (rotated at 50 MB keeping 4, lines truncated: they may quote what a peer sent)."""
     filename = node_log_filename(caller_id, node.get_mappings())
     root = logging.getLogger()
     if any(getattr(h, "_minros_node_log", False) for h in root.handlers):
         return
     try:
         os.makedirs(os.path.dirname(filename), exist_ok=True)
-        handler = logging.handlers.RotatingFileHandler(filename, "a", 50000000, 4)
+        handler = logfiles.rotating_handler(filename, FILE_FORMAT)  # rospy's 50 MB x 4
     except OSError as exc:
         # a node without a writable log directory still runs, as in rospy
         sys.stderr.write(f"WARNING: cannot create log file [{filename}]: {exc}\n")
         return
     handler.setLevel(logging.DEBUG)
-    handler.setFormatter(logging.Formatter(FILE_FORMAT))
     handler._minros_node_log = True  # type: ignore[attr-defined]
     root.addHandler(handler)
     if root.level == logging.WARNING:  # Python's default: rospy's config says INFO

@@ -41,7 +41,7 @@ from minros.exceptions import (
     TransportInitError,
     TransportTerminated,
 )
-from minros.wire import sockets, tcpros
+from minros.wire import admission, sockets, tcpros
 from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
 
 # the node context (answers before init_node too)
@@ -77,6 +77,9 @@ SEND_STALL_TIMEOUT = 60.0
 _JOIN_LIMIT = 65536
 #: serialized pieces smaller than this are joined with their neighbours (fewer buffers)
 _SMALL_PART = 4096
+#: a request's own buffer starts this small and doubles as its bytes arrive (a lying length
+#: costs nothing: a server must not allocate what a client only announces)
+_FIRST_CHUNK = 64 << 10
 #: the ok byte that starts a successful service response
 _OK = b"\x01"
 
@@ -181,16 +184,21 @@ class Service:
         return {"service": self.resolved_name, "type": self.service_class._type,
                 "md5sum": self.service_class._md5sum, "callerid": _caller_id()}
 
-    def _handle_connection(self, sock: socket.socket, header: Dict[str, str]) -> None:
+    def _handle_connection(self, sock: socket.socket, header: Dict[str, str],
+                           conn: admission.Connection) -> None:
         """Serve one inbound connection (called in the node's connection thread)."""
         try:
-            self._serve(sock, header)
-        except TransportException as exc:
+            self._serve(sock, header, conn)
+        except (TransportException, admission.Refused) as exc:
             _logger.debug("service [%s]: connection ended: %s", self.resolved_name, exc)
         finally:
             sockets.close(sock)
 
-    def _serve(self, sock: socket.socket, header: Dict[str, str]) -> None:
+    def _serve(self, sock: socket.socket, header: Dict[str, str], conn: admission.Connection) -> None:
+        """The exchange, under the TCPROS server's admission policy: a request must arrive by
+        a deadline fixed from its length once it starts (a one-shot client must send it
+        within the header timeout), its bytes count against the node's budget, and a
+        persistent connection waiting for its next request may be closed to make room."""
         sock.settimeout(_POLL)  # every wait, sending or receiving, wakes up to check for shutdown
         error = tcpros.service_header_error(header, self.resolved_name, self.service_class._md5sum)
         if error is None and self.done:
@@ -203,10 +211,13 @@ class Service:
         if header.get("probe") == "1":  # wait_for_service checking we are alive
             return
         persistent = header.get("persistent", "").lower() in ("1", "true")
-        source = sockets.FrameSource(sock, tcpros.FrameReader(buff_size=max(self.buff_size, 16)),
-                                     stop=_is_shutdown)
+        reader = tcpros.FrameReader(buff_size=max(self.buff_size, 16), first_chunk=_FIRST_CHUNK)
+        source = sockets.FrameSource(sock, reader, stop=_is_shutdown, guard=conn)
         while not self.done:
-            frame = source.next()
+            conn.idle()
+            wait_until = None if persistent else time.monotonic() + conn.limits.head_timeout
+            frame = source.next(wait_until)
+            conn.busy()
             if frame is None:
                 if not persistent:
                     logerr(f"incoming connection failed: {_PEER_GONE}")
@@ -218,6 +229,8 @@ class Service:
                 logerr(f"[{self.resolved_name}] error deserializing incoming request: {exc}")
                 return
             request._connection_header = header
+            del frame
+            conn.release()
             try:
                 _send_all(sock, self._respond(request))
             except TransportTerminated as exc:

@@ -5,7 +5,8 @@ none answers at ROS_MASTER_URI), ``/run_id``, cleared and set parameters, then t
 file order, each in its own process group. The monitor restarts ``respawn`` nodes after
 ``respawn_delay``, stops everything when a ``required`` node exits, and on Ctrl-C (SIGINT),
 SIGTERM or SIGHUP stops the nodes in reverse order (SIGINT, then SIGTERM, then SIGKILL, each
-bounded) and the master it started last.
+bounded) and the master it started last. It also rotates the console logs of ``output="log"``
+processes (``<node>-stdout.log``), which ROS lets grow, as a node's own log is rotated.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, TextIO, Tuple
 from urllib.parse import urlparse
 
-from minros import names
+from minros import logfiles, names
 from minros.launch.config import LaunchConfig, LaunchError, NodeSpec
 from minros.rosenv import renew_latest_log_dir, ros_home, ros_log_dir
 
@@ -34,6 +35,8 @@ SIGINT_TIMEOUT = 15.0
 SIGTERM_TIMEOUT = 2.0
 MASTER_START_TIMEOUT = 20.0
 POLL_INTERVAL = 0.05
+#: how often the console logs of ``output="log"`` processes are checked for rotation
+LOG_ROTATION_INTERVAL = 1.0
 
 
 def _xmlrpc_proxy(uri: str, timeout: float = 5.0) -> Any:
@@ -139,9 +142,12 @@ class LaunchProcess:
         self._close_files()
         if not self.screen and self.log_dir is not None:
             self.log_dir.mkdir(parents=True, exist_ok=True)
-            mode = "a" if self.started_once else "w"
-            out = open(self.log_dir / f"{self.log_name()}-stdout.log", mode)  # noqa: SIM115
-            err = open(self.log_dir / f"{self.log_name()}-stderr.log", mode)  # noqa: SIM115
+            # appending (O_APPEND), so that rotate_logs() can empty a file the node writes
+            out = open(self.log_dir / f"{self.log_name()}-stdout.log", "a")  # noqa: SIM115
+            err = open(self.log_dir / f"{self.log_name()}-stderr.log", "a")  # noqa: SIM115
+            if not self.started_once:
+                out.truncate(0)
+                err.truncate(0)
             self._files = [out, err]
             stdout, stderr = out, err
         self.popen = subprocess.Popen(self.argv, env=self.env, cwd=self.cwd, stdin=subprocess.DEVNULL,
@@ -204,6 +210,16 @@ class LaunchProcess:
             pass
         self.poll()
         self._close_files()
+
+    def rotate_logs(self) -> None:
+        """Keep the console logs of an ``output="log"`` process within a node log's bounds
+        (ROS lets them grow; here they rotate at 50 MB keeping 4, as the node's own log)."""
+        for f in self._files:
+            try:
+                logfiles.rotate_copy_truncate(f.name, logfiles.NODE_LOG_MAX_BYTES,
+                                              logfiles.NODE_LOG_BACKUPS)
+            except OSError:
+                pass  # a full disk must not stop the monitor
 
     def _close_files(self) -> None:
         for f in self._files:
@@ -412,7 +428,12 @@ class LaunchRunner:
     # -- monitor
     def _monitor(self) -> None:
         waiting_respawn: Dict[str, LaunchProcess] = {}
+        next_rotation = time.monotonic() + LOG_ROTATION_INTERVAL
         while not self.shutdown.is_set():
+            if time.monotonic() >= next_rotation:
+                next_rotation = time.monotonic() + LOG_ROTATION_INTERVAL
+                for proc in [*self.processes, *([self.master] if self.master else [])]:
+                    proc.rotate_logs()
             for proc in list(self.processes):
                 if proc.poll() or proc.name in waiting_respawn:
                     continue

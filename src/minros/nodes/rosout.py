@@ -8,7 +8,8 @@ The log file is ``$ROS_LOG_DIR/<run_id>/rosout.log`` (``$ROS_HOME/log`` or ``~/.
 
     <secs>.<nsecs> <LEVEL> <node> [<file>:<line>(<function>)] [topics: /a, /b] <text>
 
-and it is rotated at ``MAX_FILE_SIZE`` bytes keeping ``MAX_BACKUPS`` old files.
+and it is rotated as the C++ rosout rotates it (100 MiB, 10 old files), each line truncated
+(:mod:`minros.logfiles`): its text is whatever a node sent.
 """
 
 from __future__ import annotations
@@ -17,13 +18,11 @@ import os
 import sys
 import threading
 import time
-from pathlib import Path
-from typing import Any, List, TextIO
+from typing import Any, List
 
+from minros.logfiles import RotatingLog
 from minros.rosenv import ros_log_dir
 
-MAX_FILE_SIZE = 100 * 1024 * 1024
-MAX_BACKUPS = 10
 _LEVELS = {1: "DEBUG", 2: "INFO", 4: "WARN", 8: "ERROR", 16: "FATAL"}
 
 
@@ -34,45 +33,6 @@ def format_line(msg: Any) -> str:
     topics = ", ".join(msg.topics)
     return (f"{stamp.secs}.{stamp.nsecs:09d} {level} {msg.name} "
             f"[{msg.file}:{msg.line}({msg.function})] [topics: {topics}] {msg.msg}\n")
-
-
-class RotatingLog:
-    """Append-only text log rotated by size (``rosout.log`` -> ``rosout.log.1`` ...)."""
-
-    def __init__(self, path: Path, max_size: int = MAX_FILE_SIZE, backups: int = MAX_BACKUPS) -> None:
-        self.path = path
-        self.max_size = max_size
-        self.backups = backups
-        self._lock = threading.Lock()
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self._file: TextIO = open(path, "a", encoding="utf-8")  # noqa: SIM115 - long-lived
-        self._size = self._file.tell()
-
-    def write(self, line: str) -> None:
-        size = len(line.encode("utf-8"))  # the file's size is counted in bytes, not characters
-        with self._lock:
-            if self._size + size > self.max_size and self._size:
-                self._rotate()
-            self._file.write(line)
-            self._file.flush()
-            self._size += size
-
-    def _rotate(self) -> None:
-        self._file.close()
-        for i in range(self.backups - 1, 0, -1):
-            older = self.path.with_name(f"{self.path.name}.{i}")
-            if older.exists():
-                os.replace(older, self.path.with_name(f"{self.path.name}.{i + 1}"))
-        if self.backups:
-            os.replace(self.path, self.path.with_name(f"{self.path.name}.1"))
-        else:
-            self.path.unlink()
-        self._file = open(self.path, "a", encoding="utf-8")  # noqa: SIM115
-        self._size = 0
-
-    def close(self) -> None:
-        with self._lock:
-            self._file.close()
 
 
 def _exit_with_core(minros: Any) -> None:

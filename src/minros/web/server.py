@@ -13,6 +13,12 @@ callbacks only queue, the writer encodes and sends. A watchdog closes a client w
 been blocked for ``send_timeout`` seconds (a client that stopped reading); MJPEG viewers write
 with the same bound. With a token, every request (WebSocket or HTTP) must carry it, as
 ``?token=`` in the URL or an ``Authorization: Bearer`` header.
+
+Connections are admitted as in every minros server (:mod:`minros.wire.admission`), by a small
+guard around the websockets handler: ROS_ALLOWED_HOSTS, a cap that closes the oldest
+connection still sending its request when full, a per-peer share. websockets' own options do
+the rest: ``open_timeout`` is a deadline for the whole opening handshake, ``max_size`` refuses
+a frame from its announced length, and frames are buffered as their bytes arrive.
 """
 
 from __future__ import annotations
@@ -31,17 +37,21 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional
 
 import minros
+from minros import rosenv
 from minros.web import foxglove_protocol as fp
 from minros.web import video
 from minros.web.foxglove import FoxgloveSession
 from minros.web.outbox import Outbox
 from minros.web.rosbridge import RosbridgeSession
 from minros.web.state import WebState
+from minros.wire import admission
 
 STATIC_DIR = Path(__file__).resolve().parent / "static"
 DEFAULT_PORT = 9090
 DEFAULT_MAX_MESSAGE_SIZE = 64 << 20
 DEFAULT_SEND_TIMEOUT = 10.0
+#: browsers and Foxglove open a few connections each; the handshake of each must end in 10 s
+WEB_LIMITS = admission.Limits(max_connections=512, head_timeout=10.0)
 
 
 class _OneLine(logging.Filter):
@@ -135,6 +145,75 @@ class _Client:
                 return
 
 
+class _Guard:
+    """Admission in front of websockets' per-connection handler: the allow-list, the cap and
+    the per-peer share of :class:`minros.wire.admission.Admission`. A connection counts as
+    evictable until its request has been read (``served``), then as a session."""
+
+    def __init__(self, inner: Any, server: Any, allowed: Any) -> None:
+        self.inner = inner
+        self.server = server
+        self.admission = admission.Admission(WEB_LIMITS, allowed, what="minros web")
+        self._socks: Dict[int, socket.socket] = {}
+        self._keys: Dict[socket.socket, int] = {}
+        self._lock = threading.Lock()
+
+    def __call__(self, sock: socket.socket, addr: Any) -> None:
+        adm = self.admission
+        key = adm.new_key()
+        try:
+            local = sock.getsockname()
+            victims = adm.admit(key, addr[0], local[0] if isinstance(local, tuple) else None)
+        except (admission.Refused, OSError) as exc:
+            if isinstance(exc, admission.Refused):
+                if exc.report:
+                    minros.logwarn(f"[web] {exc}")
+                _refuse(sock, exc.status, str(exc))
+            else:
+                sock.close()
+            with self.server.lock:  # what websockets' handler does on its way out
+                self.server.handler_threads.discard(threading.current_thread())
+            return
+        adm.set_state(key, admission.READING)
+        for victim in victims:
+            with self._lock:
+                other = self._socks.get(victim)
+            if other is not None:
+                try:
+                    other.shutdown(socket.SHUT_RDWR)
+                except OSError:
+                    pass
+        with self._lock:
+            self._socks[key] = sock
+            self._keys[sock] = key
+        try:
+            self.inner(sock, addr)
+        finally:
+            with self._lock:
+                self._socks.pop(key, None)
+                self._keys.pop(sock, None)
+            adm.leave(key)
+
+    def served(self, sock: socket.socket) -> None:
+        """The connection's request is in: a session or a stream now, never evicted."""
+        with self._lock:
+            key = self._keys.get(sock)
+        if key is not None:
+            self.admission.set_state(key, admission.BUSY)
+
+
+def _refuse(sock: socket.socket, status: int, reason: str) -> None:
+    body = (reason + "\n").encode("utf-8", "replace")
+    try:
+        sock.settimeout(1.0)
+        sock.sendall(f"HTTP/1.1 {status} {'Forbidden' if status == 403 else 'Service Unavailable'}"
+                     f"\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: {len(body)}"
+                     "\r\nConnection: close\r\n\r\n".encode("latin-1") + body)
+    except OSError:
+        pass
+    sock.close()
+
+
 class WebServer:
     """Serves rosbridge, Foxglove, video and static files on one port (see the module doc)."""
 
@@ -159,7 +238,9 @@ class WebServer:
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._server: Any = None
+        self._guard: Any = None
         self._threads: List[threading.Thread] = []
+        self.allowed = rosenv.allowed_hosts()  # ValueError naming a malformed entry
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -172,7 +253,9 @@ class WebServer:
             select_subprotocol=self._select_subprotocol, server_header="minros web",
             compression="deflate" if self.compression else None,
             max_size=self.max_message_size, logger=_ws_logger(), ping_interval=20,
-            ping_timeout=None, open_timeout=10, close_timeout=2)
+            ping_timeout=None, open_timeout=WEB_LIMITS.head_timeout, close_timeout=2)
+        self._guard = _Guard(self._server.handler, self._server, self.allowed)
+        self._server.handler = self._guard
         self.port = self._server.socket.getsockname()[1]
         for target, name in ((self._server.serve_forever, "minros-web-server"),
                              (self._watchdog, "minros-web-watchdog")):
@@ -238,6 +321,7 @@ class WebServer:
         return self._response(status, (text + "\n").encode("utf-8"))
 
     def _process_request(self, connection: Any, request: Any) -> Any:
+        self._guard.served(connection.socket)
         path, _, query = request.path.partition("?")
         if not self._token_ok(request, query):
             peer = connection.remote_address

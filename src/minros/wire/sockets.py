@@ -20,6 +20,8 @@ from minros.wire import tcpros
 
 __all__ = ["FrameSource", "close", "read_header", "send_all"]
 
+#: the most of a connection header received at once
+_HEADER_CHUNK = 65536
 #: buffers handed to one sendmsg call (Linux takes up to IOV_MAX = 1024)
 _MAX_IOV = 512
 _HAS_SENDMSG = hasattr(socket.socket, "sendmsg")
@@ -43,31 +45,46 @@ def close(sock: Optional[socket.socket]) -> None:
         pass
 
 
-def _recv_exact(sock: socket.socket, size: int) -> bytes:
-    buf = bytearray(size)
-    view = memoryview(buf)
-    got = 0
-    while got < size:
+def _recv_exact(sock: socket.socket, size: int, deadline: float | None,
+                charge: Callable[[int], Any] | None) -> bytes:
+    """``size`` bytes, kept as they arrive (a length a peer only announces costs nothing),
+    before ``deadline`` however slowly they trickle in."""
+    buf = bytearray()
+    while len(buf) < size:
+        if deadline is not None:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise tcpros.HeaderError("timed out waiting for the connection header")
+            sock.settimeout(remaining)
         try:
-            n = sock.recv_into(view[got:])
+            chunk = sock.recv(min(size - len(buf), _HEADER_CHUNK))
         except socket.timeout:
             raise tcpros.HeaderError("timed out waiting for the connection header") from None
         except OSError as exc:
             raise tcpros.HeaderError(f"unable to receive the connection header: {exc}") from None
-        if not n:
-            raise tcpros.HeaderError(f"connection closed after {got} of {size} header bytes")
-        got += n
+        if not chunk:
+            raise tcpros.HeaderError(f"connection closed after {len(buf)} of {size} header bytes")
+        if charge is not None:
+            charge(len(chunk))
+        buf += chunk
     return bytes(buf)
 
 
-def read_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER) -> Dict[str, str]:
+def read_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER, *,
+                deadline: float | None = None,
+                charge: Callable[[int], Any] | None = None) -> Dict[str, str]:
     """Read exactly one connection header from ``sock`` (nothing beyond it), for either side of
-    a topic or service handshake. The socket's timeout bounds every read; every failure is a
-    HeaderError naming it."""
-    (size,) = struct.unpack("<I", _recv_exact(sock, 4))
+    a topic or service handshake. The whole header must arrive before ``deadline``
+    (``time.monotonic()``; default: the socket's timeout from now), so a peer trickling it
+    cannot hold the caller longer; ``charge(n)`` is told of every ``n`` bytes received (and
+    may raise to stop). Every failure of the peer is a HeaderError naming it."""
+    if deadline is None:
+        timeout = sock.gettimeout()
+        deadline = None if timeout is None else time.monotonic() + timeout
+    (size,) = struct.unpack("<I", _recv_exact(sock, 4, deadline, charge))
     if size > max_size:
         raise tcpros.HeaderError(f"connection header of {size} bytes exceeds the limit of {max_size}")
-    return tcpros.decode_header(_recv_exact(sock, size))
+    return tcpros.decode_header(_recv_exact(sock, size, deadline, charge))
 
 
 def send_all(sock: socket.socket, data: Any, *, stall_timeout: float,
@@ -110,22 +127,35 @@ def send_all(sock: socket.socket, data: Any, *, stall_timeout: float,
 
 
 class FrameSource:
-    """Frames from one socket, one at a time (a FrameReader may parse several per recv)."""
+    """Frames from one socket, one at a time (a FrameReader may parse several per recv).
+
+    With a ``guard`` (a :class:`minros.wire.admission.Connection`, on a server) frames are read
+    under the admission policy: their bytes are charged as they arrive, and once a frame's
+    first byte is in, the whole frame must arrive by a deadline fixed from its announced
+    length, however slowly the peer trickles it.
+    """
 
     def __init__(self, sock: socket.socket, reader: tcpros.FrameReader,
-                 stop: Callable[[], bool] = _never) -> None:
+                 stop: Callable[[], bool] = _never, guard: Any = None) -> None:
         self.sock = sock
         self.reader = reader
         self.stop = stop
+        self.guard = guard
         self.pending: collections.deque = collections.deque()
+        self._poll = sock.gettimeout()  # paces the checks of stop()
+        self._started: float | None = None  # when the frame in progress began to arrive
 
-    def next(self) -> Any:
+    def next(self, wait_until: float | None = None) -> Any:
         """The next frame; None if the peer closed cleanly between frames. A socket timeout
-        only paces the check of ``stop()``."""
+        only paces the check of ``stop()``. ``wait_until`` (``time.monotonic()``, with a
+        guard) bounds the wait for a frame's first byte: TransportTerminated after it."""
         reader = self.reader
+        guard = self.guard
         while not self.pending:
             target = reader.recv_buffer()
             while True:
+                if guard is not None:
+                    self._pace(wait_until)
                 try:
                     n = self.sock.recv_into(target)
                     break
@@ -140,6 +170,26 @@ class FrameSource:
             if not n:
                 reader.eof()  # FrameError (a TransportException) when cut mid-frame
                 return None
-            reader.received(n)
-            self.pending.extend(reader.frames())
+            frames = reader.received_frames(n)
+            if guard is not None:
+                guard.charge(n)  # the policy counts a request as reading from its first bytes
+                if frames or self._started is None:
+                    self._started = time.monotonic() if reader.pending() else None
+            self.pending.extend(frames)
         return self.pending.popleft()
+
+    def _pace(self, wait_until: float | None) -> None:
+        """Before a guarded recv: fail past the deadline, else wait no longer than it."""
+        if self._started is None:
+            deadline = wait_until
+            what = "no request arrived"
+        else:
+            deadline = self._started + self.guard.limits.transfer_time(self.reader.announced() or 0)
+            what = "the request did not arrive"
+        if deadline is None:
+            self.sock.settimeout(self._poll)
+            return
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            raise TransportTerminated(f"{what} within the deadline")
+        self.sock.settimeout(remaining if self._poll is None else min(self._poll, remaining))

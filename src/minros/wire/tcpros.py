@@ -264,10 +264,11 @@ class FrameReader:
 
     __slots__ = ("_buf", "_view", "_start", "_end", "_big", "_big_len", "_big_fill",
                  "_big_ok", "max_frame", "ok_byte", "_ready", "bytes_received", "_error",
-                 "reuse_big", "_spare")
+                 "reuse_big", "_spare", "first_chunk")
 
     def __init__(self, max_frame: int = DEFAULT_MAX_FRAME, buff_size: int = DEFAULT_BUFF_SIZE,
-                 ok_byte: bool = False, reuse_big: bool = False) -> None:
+                 ok_byte: bool = False, reuse_big: bool = False,
+                 first_chunk: int = _FIRST_CHUNK) -> None:
         # The shared buffer only ever holds small frames; anything larger goes to a buffer of
         # its own, so a huge buff_size (rospy users pass 2**24 for images) must not turn big
         # frames into copies out of the shared buffer.
@@ -290,6 +291,8 @@ class FrameReader:
         # same size is received into the same bytearray: no allocation and zero-fill per image
         self.reuse_big = reuse_big
         self._spare: bytearray | None = None
+        #: a big frame's own buffer starts at most this large, then doubles as bytes arrive
+        self.first_chunk = first_chunk
 
     # -- I/O side --------------------------------------------------------------------------
 
@@ -356,6 +359,15 @@ class FrameReader:
         if self._big is not None:
             return self._big_fill
         return self._end - self._start
+
+    def announced(self) -> int | None:
+        """The length of the frame being received, once its length prefix is in."""
+        if self._big is not None:
+            return self._big_len
+        prefix = 5 if self.ok_byte else 4
+        if self._end - self._start < prefix:
+            return None
+        return _U32.unpack_from(self._buf, self._start + prefix - 4)[0]
 
     def eof(self) -> None:
         """The peer closed the stream: an error if it stopped in the middle of a frame."""
@@ -448,7 +460,7 @@ class FrameReader:
                 if big is not None and len(big) == size and not any(f is big for f in ready):
                     self._spare = None
                 else:
-                    big = bytearray(min(size, max(_FIRST_CHUNK, have)))
+                    big = bytearray(min(size, max(self.first_chunk, have)))
                 big[:have] = view[body:end]
                 self._big = big
                 self._big_len = size

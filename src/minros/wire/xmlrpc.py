@@ -5,10 +5,13 @@ convention is :mod:`minros.wire.rosapi`, the ROS_IP/ROS_HOSTNAME rules :mod:`min
 Server behaviour matches what ROS nodes expect from rosgraph's ``ThreadingXMLRPCServer``:
 HTTP/1.1 keep-alive, one thread per connection (so one kept-alive client never blocks another),
 ``system.multicall``, ``allow_none`` off, faults formatted as ``"<class 'E'>:message"`` with code 1.
-On top of that it defends itself: bodies over ``max_body`` are refused from their Content-Length
-before any byte is read, ``<!DOCTYPE``/entities are refused (no entity expansion), clients that
-connect and stay silent are dropped after ``idle_timeout``, and the number of connection threads
-is bounded. Nothing is logged per request (and no reverse DNS lookups are ever made).
+On top of that it defends itself: requests are read by a sans-IO :class:`RequestReader`
+under the deadlines, memory budget, connection cap and allow-list of
+:class:`minros.wire.admission.Admission` (a trickling client cannot extend its deadline, bytes
+are charged as they arrive, never as announced, a full server closes its idlest or slowest
+connection); bodies over ``max_body`` are refused from their Content-Length, ``<!DOCTYPE``/
+entities are refused (no entity expansion). Nothing is logged per request (and no reverse DNS
+lookups are ever made).
 """
 
 from __future__ import annotations
@@ -21,6 +24,8 @@ import xmlrpc.client
 from typing import Any, Callable, Dict, List, Sequence, Tuple
 from urllib.parse import urlparse
 from xmlrpc.client import Binary, DateTime, Fault, ProtocolError  # noqa: F401 - re-exported
+
+from minros.wire import admission
 
 # ------------------------------------------------------------------ limits
 
@@ -123,14 +128,15 @@ class Dispatcher:
         return response.encode("utf-8", "xmlcharrefreplace")
 
 
-# ------------------------------------------------------------------ HTTP server
+# ------------------------------------------------------------------ HTTP requests (sans-IO)
 
-_REASONS = {200: "OK", 400: "Bad Request", 404: "Not Found", 408: "Request Timeout",
-            503: "Service Unavailable",
-            411: "Length Required", 413: "Payload Too Large", 414: "URI Too Long",
-            431: "Request Header Fields Too Large", 501: "Not Implemented",
-            505: "HTTP Version Not Supported"}
+_REASONS = {200: "OK", 400: "Bad Request", 403: "Forbidden", 404: "Not Found",
+            408: "Request Timeout", 411: "Length Required", 413: "Payload Too Large",
+            414: "URI Too Long", 431: "Request Header Fields Too Large", 501: "Not Implemented",
+            503: "Service Unavailable", 505: "HTTP Version Not Supported"}
 _RPC_PATHS = ("/", "/RPC2")
+#: the longest request head: the request line and every header line at their limits
+MAX_HEAD = MAX_HEADER_LINE * (MAX_HEADER_LINES + 1)
 
 
 class _HttpError(Exception):
@@ -146,9 +152,149 @@ def _status_response(status: int, detail: str) -> bytes:
     return head.encode("latin-1") + body
 
 
+class RequestHead:
+    """What the head of one XML-RPC request says."""
+
+    __slots__ = ("version", "length", "keep_alive", "expect_continue")
+
+    def __init__(self, version: str, length: int, keep_alive: bool, expect_continue: bool) -> None:
+        self.version = version
+        self.length = length
+        self.keep_alive = keep_alive
+        self.expect_continue = expect_continue
+
+
+def parse_request_head(block: bytes, max_body: int) -> RequestHead:
+    """Check the head of a request (request line and headers, without the blank line that
+    ends it) and return what the server needs of it; _HttpError with the status otherwise."""
+    lines = block.decode("latin-1").split("\n")  # latin-1: one character per byte
+    line = lines[0].rstrip("\r")
+    if len(line) > MAX_HEADER_LINE:
+        raise _HttpError(414, "request line too long")
+    parts = line.split()
+    if len(parts) != 3:
+        raise _HttpError(400, f"bad request line {line[:80]!r}")
+    verb, path, version = parts
+    if not version.startswith("HTTP/1."):
+        raise _HttpError(505, version)
+    if len(lines) - 1 > MAX_HEADER_LINES:
+        raise _HttpError(431, "too many header lines")
+    headers: Dict[str, str] = {}
+    for hline in lines[1:]:
+        if len(hline) > MAX_HEADER_LINE:
+            raise _HttpError(431, "header line too long")
+        key, sep, value = hline.partition(":")
+        if not sep:
+            raise _HttpError(400, "malformed header line")
+        headers[key.strip().lower()] = value.strip()
+    if verb != "POST":
+        raise _HttpError(501, f"Unsupported method ({verb!r})")
+    if path != "/" and path != "/RPC2" and path.split("?", 1)[0] not in _RPC_PATHS:
+        raise _HttpError(404, path)
+    if "transfer-encoding" in headers and "chunked" in headers["transfer-encoding"].lower():
+        raise _HttpError(411, "chunked requests are not supported; send Content-Length")
+    length_text = headers.get("content-length")
+    if length_text is None:
+        raise _HttpError(411, "Content-Length required")
+    try:
+        length = int(length_text)
+    except ValueError:
+        raise _HttpError(400, "bad Content-Length") from None
+    if length < 0:
+        raise _HttpError(400, "bad Content-Length")
+    if length > max_body:
+        raise _HttpError(413, f"body of {length} bytes exceeds the limit of {max_body}")
+    connection = headers.get("connection", "").lower()
+    if version == "HTTP/1.0":
+        keep_alive = "keep-alive" in connection
+    else:
+        keep_alive = "close" not in connection
+    expect = "expect" in headers and headers["expect"].lower() == "100-continue" and version != "HTTP/1.0"
+    return RequestHead(version, length, keep_alive, expect)
+
+
+class RequestReader:
+    """XML-RPC requests out of a byte stream, without I/O (the way h11 reads HTTP).
+
+    ``received(data)`` appends bytes; ``started()`` says whether a request has begun to
+    arrive (blank lines between requests do not count); ``head()`` returns the parsed head
+    once it is complete (None before; _HttpError when it is malformed or too long), and
+    ``body()`` the body once it is complete. ``next_request()`` then starts over with the
+    bytes that followed. Bytes are kept as they arrive: nothing is allocated for what a
+    request only announces.
+    """
+
+    def __init__(self, max_body: int = DEFAULT_MAX_BODY) -> None:
+        self.max_body = max_body
+        self._buf = bytearray()
+        self._scanned = 0  # bytes of _buf searched for the end of the head already
+        self._head: RequestHead | None = None
+        self._body = bytearray()
+
+    def received(self, data: bytes) -> None:
+        if self._head is None:
+            self._buf += data
+        else:
+            self._body += data
+
+    def started(self) -> bool:
+        buf = self._buf
+        if self._head is not None:
+            return True
+        if buf[:1] in (b"\r", b"\n"):
+            del buf[:len(buf) - len(buf.lstrip(b"\r\n"))]
+            self._scanned = 0
+        return bool(buf)
+
+    def head(self) -> RequestHead | None:
+        if self._head is not None:
+            return self._head
+        buf = self._buf
+        if not self.started():
+            return None
+        # a head trickled in byte by byte is searched once, not once per byte
+        since = max(0, self._scanned - 2)
+        end = buf.find(b"\n\r\n", since)
+        stop = end + 3
+        bare = buf.find(b"\n\n", since)
+        if bare >= 0 and (end < 0 or bare < end):
+            end, stop = bare, bare + 2
+        if end < 0:
+            self._scanned = len(buf)
+            if len(buf) > MAX_HEADER_LINE and buf.find(b"\n", 0, MAX_HEADER_LINE + 1) < 0:
+                raise _HttpError(414, "request line too long")
+            if len(buf) > MAX_HEAD:
+                raise _HttpError(431, "request head too long")
+            return None
+        self._head = parse_request_head(bytes(buf[:end]), self.max_body)
+        self._body = buf[stop:]
+        self._buf = bytearray()
+        self._scanned = 0
+        return self._head
+
+    def body(self) -> bytearray | None:
+        head = self.head()
+        if head is None or len(self._body) < head.length:
+            return None
+        body = self._body
+        if len(body) > head.length:  # the start of a pipelined next request
+            self._buf = body[head.length:]
+            del body[head.length:]
+        return body
+
+    def next_request(self) -> int:
+        """Forget the request just served; returns the bytes already held of the next one."""
+        self._head = None
+        self._body = bytearray()
+        return len(self._buf)
+
+
+# ------------------------------------------------------------------ HTTP server
+
 _logger = logging.getLogger("minros.xmlrpc")
 #: per connection thread: the hooks of the request being handled (None outside a request)
 _request = threading.local()
+_RECV_SIZE = 65536
 
 
 def after_reply(hook: Callable[[], Any]) -> None:
@@ -162,36 +308,52 @@ def after_reply(hook: Callable[[], Any]) -> None:
         hooks.append(hook)
 
 
+def _report_refusal(peer: str, reason: str) -> None:
+    _logger.warning("%s", reason)
+
+
+class _Closed(Exception):
+    """The connection ends quietly: peer gone, idle too long, or closed to make room."""
+
+
 class XmlRpcServer:
     """Threaded XML-RPC server for ``handler`` (see module docstring).
 
     ``start()`` binds, listens and returns; ``port`` is then the bound port. ``shutdown()`` closes
-    the listening socket and every open connection.
+    the listening socket and every open connection. Who is served, for how long and with how
+    much memory is :class:`minros.wire.admission.Admission`'s policy (``limits``); ``allowed``
+    is the allow-list (:func:`minros.rosenv.allowed_hosts`), and ``on_refused(peer, reason)``
+    reports a refused peer (rate-limited by the policy).
     """
 
     def __init__(self, handler: Any, host: str = "", port: int = 0, *,
                  max_body: int = DEFAULT_MAX_BODY, idle_timeout: float = DEFAULT_IDLE_TIMEOUT,
                  max_connections: int = DEFAULT_MAX_CONNECTIONS, backlog: int = 1024,
-                 ipv6: bool | None = None, body_budget: int | None = None) -> None:
+                 ipv6: bool | None = None, body_budget: int | None = None,
+                 limits: admission.Limits | None = None,
+                 allowed: Sequence[Any] | None = None,
+                 on_refused: Callable[[str, str], Any] = _report_refusal,
+                 what: str = "") -> None:
         self.dispatcher = Dispatcher(handler)
         self.host = host
         self.requested_port = port
         self.max_body = max_body
-        self.idle_timeout = idle_timeout
-        self.max_connections = max_connections
+        if limits is None:
+            budget = max(max_body, body_budget if body_budget is not None else 4 * max_body)
+            limits = admission.Limits(max_connections=max_connections, idle_timeout=idle_timeout,
+                                      budget=budget)
+        self.limits = limits
+        self.admission = admission.Admission(limits, allowed, what=what or "this XML-RPC server")
+        self.on_refused = on_refused
         self.backlog = backlog
         self.ipv6 = (":" in host) if ipv6 is None else ipv6
         self._sock: socket.socket | None = None
-        self._slots = threading.BoundedSemaphore(max_connections)
+        # the hard bound on connection threads; evicted ones release it as they exit
+        self._slots = threading.BoundedSemaphore(limits.max_connections)
         self._conns: Dict[int, socket.socket] = {}
-        #: connections waiting for their next request, and since when (reclaimable when full)
-        self._idle_since: Dict[int, float] = {}
         self._conns_lock = threading.Lock()
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
-        self.body_budget = max(max_body, body_budget if body_budget is not None else 4 * max_body)
-        self._budget_used = 0
-        self._budget_cond = threading.Condition()
         self.port = 0
 
     # -- life cycle
@@ -226,42 +388,21 @@ class XmlRpcServer:
         with self._conns_lock:
             conns = list(self._conns.values())
         for conn in conns:
-            try:
-                conn.shutdown(socket.SHUT_RDWR)
-            except OSError:
-                pass
+            _shut(conn)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(2.0)
-
-    def _reserve(self, size: int) -> bool:
-        with self._budget_cond:
-            if not self._budget_cond.wait_for(
-                    lambda: self._budget_used + size <= self.body_budget, timeout=self.idle_timeout):
-                return False
-            self._budget_used += size
-            return True
-
-    def _release(self, size: int) -> None:
-        with self._budget_cond:
-            self._budget_used -= size
-            self._budget_cond.notify_all()
-
-    def _reclaim_idle(self) -> None:
-        with self._conns_lock:
-            if not self._idle_since:
-                return
-            key = min(self._idle_since, key=self._idle_since.__getitem__)
-            del self._idle_since[key]
-            conn = self._conns.get(key)
-        if conn is not None:
-            try:
-                conn.shutdown(socket.SHUT_RDWR)
-            except OSError:
-                pass
 
     def connection_count(self) -> int:
         with self._conns_lock:
             return len(self._conns)
+
+    def _evict(self, keys: List[int]) -> None:
+        """Close connections the policy chose to make room (their threads then exit)."""
+        for key in keys:
+            with self._conns_lock:
+                conn = self._conns.get(key)
+            if conn is not None:
+                _shut(conn)
 
     # -- accepting
 
@@ -269,162 +410,177 @@ class XmlRpcServer:
         sock = self._sock
         assert sock is not None
         while not self._stopping.is_set():
-            # Bound the connection threads. When all are taken, close the connection that has
-            # waited longest for its next request (clients reopen a kept-alive connection the
-            # server closed: Python's and roscpp's XML-RPC clients retry once), so that a crowd
-            # of idle or silent clients cannot lock new ones out.
-            while not self._slots.acquire(timeout=0.05):
-                if self._stopping.is_set():
-                    return
-                self._reclaim_idle()
             try:
-                conn, _addr = sock.accept()
+                conn, addr = sock.accept()
             except OSError:
-                self._slots.release()
                 if self._stopping.is_set():
                     return
                 # e.g. EMFILE (out of file descriptors): back off instead of spinning
                 self._stopping.wait(0.05)
                 continue
-            try:
-                conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                conn.settimeout(self.idle_timeout)
-                with self._conns_lock:
-                    self._conns[id(conn)] = conn
-                threading.Thread(target=self._serve_connection, args=(conn,), daemon=True,
-                                 name=f"xmlrpc-conn:{self.port}").start()
-            except BaseException:  # noqa: BLE001 - e.g. cannot start a thread: drop this client
-                with self._conns_lock:
-                    self._conns.pop(id(conn), None)
-                conn.close()
-                self._slots.release()
+            self._admit(conn, addr)
+
+    def _admit(self, conn: socket.socket, addr: Any) -> None:
+        """Serve ``conn`` in a thread of its own if the policy lets it in (closing others to
+        make room when the server is full); refuse it with one status line otherwise."""
+        key = self.admission.new_key()
+        try:
+            victims = self.admission.admit(key, addr[0], _local_address(conn))
+        except admission.Refused as refused:
+            if refused.report:
+                self.on_refused(addr[0], str(refused))
+            _refuse(conn, refused.status, str(refused))
+            return
+        except OSError:  # the peer left already
+            self.admission.leave(key)
+            conn.close()
+            return
+        self._evict(victims)
+        # the evicted connections' threads exit at once; wait for one of their slots
+        if not self._slots.acquire(timeout=2.0):
+            self.admission.leave(key)
+            _refuse(conn, 503, "server busy, try again")
+            return
+        try:
+            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            with self._conns_lock:
+                self._conns[key] = conn
+            threading.Thread(target=self._serve_connection, args=(conn, key), daemon=True,
+                             name=f"xmlrpc-conn:{self.port}").start()
+        except BaseException:  # noqa: BLE001 - e.g. cannot start a thread: drop this client
+            with self._conns_lock:
+                self._conns.pop(key, None)
+            self.admission.leave(key)
+            conn.close()
+            self._slots.release()
 
     # -- one connection, many requests (keep-alive)
 
-    def _serve_connection(self, conn: socket.socket) -> None:
-        reader = conn.makefile("rb", buffering=65536)
+    def _serve_connection(self, conn: socket.socket, key: int) -> None:
+        reader = RequestReader(self.max_body)
         try:
             while not self._stopping.is_set():
                 try:
-                    request = self._read_request(reader, conn)
+                    head, body = self._read_request(conn, key, reader)
                 except _HttpError as err:
-                    try:
-                        conn.sendall(_status_response(err.status, str(err)))
-                    except OSError:
-                        pass
+                    _send_quietly(conn, _status_response(err.status, str(err)))
                     return
-                if request is None:
+                except admission.Refused as refused:
+                    _send_quietly(conn, _status_response(refused.status, str(refused)))
                     return
-                body, keep_alive = request
+                except _Closed:
+                    return
+                self.admission.set_state(key, admission.BUSY)
                 hooks: List[Callable[[], Any]] = []
                 _request.after_reply = hooks
                 try:
                     payload = self.dispatcher.handle_request_body(body)
                 finally:
                     _request.after_reply = None
-                    self._release(len(body))
                     del body
-                head = ("HTTP/1.1 200 OK\r\nServer: minros\r\nContent-type: text/xml\r\n"
-                        f"Content-length: {len(payload)}\r\n"
-                        + ("" if keep_alive else "Connection: close\r\n") + "\r\n")
+                    self.admission.release(key)
+                    leftover = reader.next_request()
+                head_text = ("HTTP/1.1 200 OK\r\nServer: minros\r\nContent-type: text/xml\r\n"
+                             f"Content-length: {len(payload)}\r\n"
+                             + ("" if head.keep_alive else "Connection: close\r\n") + "\r\n")
                 try:
-                    conn.sendall(head.encode("latin-1") + payload)
+                    # a client that does not read its reply has until the deadline to start
+                    conn.settimeout(self.limits.transfer_time(len(payload)))
+                    conn.sendall(head_text.encode("latin-1") + payload)
+                    self.admission.set_state(key, admission.IDLE)
                 finally:
                     for hook in hooks:
                         try:
                             hook()
                         except Exception:  # noqa: BLE001 - a hook must not end the connection thread
                             _logger.exception("after-reply hook failed")
-                if not keep_alive:
+                if not head.keep_alive:
                     return
-        except (OSError, ValueError):
-            pass  # peer went away, idle timeout, or shutdown
+                if leftover:  # a pipelined request: its first bytes are in memory already
+                    self._evict(self.admission.charge(key, leftover))
+        except (OSError, ValueError, admission.Refused):
+            pass  # peer went away, did not read its reply, or shutdown
         finally:
-            try:
-                reader.close()
-            except OSError:
-                pass
             try:
                 conn.close()
             except OSError:
                 pass
             with self._conns_lock:
-                self._conns.pop(id(conn), None)
+                self._conns.pop(key, None)
+            self.admission.leave(key)
             self._slots.release()
 
-    def _read_request(self, reader: Any, conn: socket.socket) -> Tuple[bytes, bool] | None:
-        """Read one request; ``None`` when the peer closed between requests or stayed idle."""
-        key = id(conn)
-        with self._conns_lock:
-            self._idle_since[key] = time.monotonic()
-        try:
-            line = reader.readline(MAX_HEADER_LINE + 1)
-            while line in (b"\r\n", b"\n"):  # tolerate stray blank lines between requests
-                line = reader.readline(MAX_HEADER_LINE + 1)
-        except socket.timeout:
-            return None
-        finally:
-            with self._conns_lock:
-                self._idle_since.pop(key, None)
-        if not line:
-            return None
-        if len(line) > MAX_HEADER_LINE:
-            raise _HttpError(414, "request line too long")
-        parts = line.decode("latin-1").split()
-        if len(parts) != 3:
-            raise _HttpError(400, f"bad request line {line[:80]!r}")
-        verb, path, version = parts
-        if not version.startswith("HTTP/1."):
-            raise _HttpError(505, version)
-        headers: Dict[str, str] = {}
-        for _ in range(MAX_HEADER_LINES + 1):
-            hline = reader.readline(MAX_HEADER_LINE + 1)
-            if len(hline) > MAX_HEADER_LINE:
-                raise _HttpError(431, "header line too long")
-            if hline in (b"\r\n", b"\n", b""):
-                break
-            key, sep, value = hline.decode("latin-1").partition(":")
-            if not sep:
-                raise _HttpError(400, "malformed header line")
-            headers[key.strip().lower()] = value.strip()
-        else:
-            raise _HttpError(431, "too many header lines")
-        if verb != "POST":
-            raise _HttpError(501, f"Unsupported method ({verb!r})")
-        if path.split("?", 1)[0] not in _RPC_PATHS:
-            raise _HttpError(404, path)
-        if "chunked" in headers.get("transfer-encoding", "").lower():
-            raise _HttpError(411, "chunked requests are not supported; send Content-Length")
-        length_text = headers.get("content-length")
-        if length_text is None:
-            raise _HttpError(411, "Content-Length required")
-        try:
-            length = int(length_text)
-        except ValueError:
-            raise _HttpError(400, "bad Content-Length") from None
-        if length < 0:
-            raise _HttpError(400, "bad Content-Length")
-        if length > self.max_body:
-            raise _HttpError(413, f"body of {length} bytes exceeds the limit of {self.max_body}")
-        # Bodies in memory at once are bounded too, not only each one: wait for room, briefly.
-        if not self._reserve(length):
-            raise _HttpError(503, "server busy with large requests, try again")
-        if headers.get("expect", "").lower() == "100-continue" and version != "HTTP/1.0":
+    def _read_request(self, conn: socket.socket, key: int, reader: RequestReader
+                      ) -> Tuple[RequestHead, bytearray]:
+        """Read one request under the policy's deadlines and memory budget."""
+        limits = self.limits
+        idle_until = time.monotonic() + limits.idle_timeout
+        while not reader.started():
+            self._receive(conn, key, reader, idle_until, None)
+        start = time.monotonic()  # the policy took the first bytes' charge as the start too
+        deadline = start + limits.head_timeout
+        while (head := reader.head()) is None:
+            self._receive(conn, key, reader, deadline, "request head")
+        if head.expect_continue:
+            conn.settimeout(limits.head_timeout)
             conn.sendall(b"HTTP/1.1 100 Continue\r\n\r\n")  # curl & co. wait for it
+        deadline = limits.body_deadline(start, head.length)
+        while (body := reader.body()) is None:
+            self._receive(conn, key, reader, deadline, "request body")
+        return head, body
+
+    def _receive(self, conn: socket.socket, key: int, reader: RequestReader, deadline: float,
+                 what: str | None) -> None:
+        """One recv before ``deadline``, charged to the budget as it arrives. ``what`` names
+        the part of a request being read (None: waiting between requests, which ends quietly)."""
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            if what is None:
+                raise _Closed()
+            raise _HttpError(408, f"{what} not received within the deadline")
+        conn.settimeout(remaining)
         try:
-            body = reader.read(length)
-        except BaseException:
-            self._release(length)
-            raise
-        if len(body) != length:
-            self._release(length)
-            return None  # peer closed mid-body
-        connection = headers.get("connection", "").lower()
-        if version == "HTTP/1.0":
-            keep_alive = "keep-alive" in connection
-        else:
-            keep_alive = "close" not in connection
-        return body, keep_alive
+            data = conn.recv(_RECV_SIZE)
+        except socket.timeout:
+            if what is None:
+                raise _Closed() from None
+            raise _HttpError(408, f"{what} not received within the deadline") from None
+        if not data:  # the peer left, or the server closed the connection (shutdown, eviction)
+            raise _Closed()
+        victims = self.admission.charge(key, len(data))  # Refused once evicted
+        if victims:
+            self._evict(victims)
+        reader.received(data)
+
+
+def _local_address(conn: socket.socket) -> str | None:
+    """The address a connection arrived at (a peer at that address is this host)."""
+    name = conn.getsockname()
+    return name[0] if isinstance(name, tuple) else None
+
+
+def _shut(conn: socket.socket) -> None:
+    try:
+        conn.shutdown(socket.SHUT_RDWR)
+    except OSError:
+        pass
+
+
+def _send_quietly(conn: socket.socket, data: bytes) -> None:
+    try:
+        conn.settimeout(1.0)
+        conn.sendall(data)
+    except OSError:
+        pass
+
+
+def _refuse(conn: socket.socket, status: int, reason: str) -> None:
+    """Answer a connection the server will not serve with one status line, then close it."""
+    _send_quietly(conn, _status_response(status, reason))
+    try:
+        conn.close()
+    except OSError:
+        pass
 
 
 # ------------------------------------------------------------------ client
@@ -567,6 +723,9 @@ class ServerProxy:
             raise ProtocolError(self.uri, 413, "response too large", headers)
         if status != 200:
             self._drop()
+            if headers.get("content-type", "").startswith("text/plain") and len(data) < 1024:
+                # a refusal's one line says why (minros's servers name the setting to change)
+                reason = data.decode("utf-8", "replace").strip() or reason
             raise ProtocolError(self.uri, status, reason, headers)
         _check_markup(data)
         result, _ = xmlrpc.client.loads(data, use_builtin_types=False)
