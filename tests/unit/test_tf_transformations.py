@@ -239,6 +239,9 @@ def test_decompositions_rebuild_the_same_transform(oracle, a, axis, point, facto
        angles=st.tuples(*[st.floats(-1.5, 1.5)] * 3), trans=vec3,
        persp=st.tuples(*[st.floats(-0.1, 0.1)] * 3))
 def test_compose_and_decompose_match_debian(oracle, scale, shear, angles, trans, persp):
+    # compose_matrix divides by 1 + perspective . translation: near 0 (persp 0.1 with a translation
+    # of -10), two correct implementations differ by rounding alone; compare where it is defined
+    assume(abs(1.0 + numpy.dot(persp, trans)) > 0.2)
     p = list(persp) + [1.0]
     m = T.compose_matrix(scale, shear, angles, trans, p)
     assert close(m, oracle.transformations("compose_matrix", scale, shear, angles, trans, p), 1e-9)
