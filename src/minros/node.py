@@ -791,9 +791,13 @@ class Node:
         if not self._started:
             return
         calls = self._unregistration_calls()
-        if calls and not self._master_lost:
+        if calls:
+            # tried even when the probe lost the master: a master that was only slow for a
+            # moment would otherwise keep our registrations forever; one that is gone costs
+            # a short wait
             try:
-                ServerProxy(self.master_uri, timeout=2.0).system.multicall(calls)
+                ServerProxy(self.master_uri, timeout=0.5 if self._master_lost else 2.0
+                            ).system.multicall(calls)
             except Exception as exc:
                 _logger.warning("unregistration from the master failed: %s", exc)
         with self._registry_lock:

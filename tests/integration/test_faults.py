@@ -430,7 +430,7 @@ def test_roslaunch_sigkilled_leaves_no_orphans(ros_home, tmp_path):
         counter = Counted([PYTHON, "-c", CHATTER_COUNTER], ros_env(port, ros_home))
         counter.wait_count("got", 5)
         os.kill(launch.proc.pid, signal.SIGKILL)  # roslaunch alone, no chance to clean up
-        wait_until(lambda: not any(_alive(p) for p in pids), 10, what="its nodes gone")
+        wait_until(lambda: not any(_alive(p) for p in pids), 20, what="its nodes gone")
         counter.drain()
         counted = len(counter.numbers("got"))
         time.sleep(1.0)  # the talker published at 10 Hz: nothing more comes
