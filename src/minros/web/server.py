@@ -3,7 +3,8 @@
 Built on the threading server of ``websockets`` (one thread per connection, like the rest of
 minros). A connection is told apart by:
 
-* the WebSocket subprotocol: ``foxglove.websocket.v1`` -> :class:`FoxgloveSession`; no (or any
+* the WebSocket subprotocol: ``foxglove.websocket.v1`` -> :class:`FoxgloveSession`;
+  ``minros.page.v1`` (the page at ``/``) -> :class:`~minros.web.page.PageSession`; no (or any
   other) subprotocol -> :class:`RosbridgeSession` (roslibjs and roslibpy ask for none);
 * for plain HTTP (no ``Upgrade``), the path: ``/stream``, ``/snapshot``, ``/stream_viewer``,
   ``/streams`` (web_video_server's endpoints), else the static files of ``minros/web/static``.
@@ -42,6 +43,8 @@ from minros.web import foxglove_protocol as fp
 from minros.web import video
 from minros.web.foxglove import FoxgloveSession
 from minros.web.outbox import Outbox
+from minros.web.page import SUBPROTOCOL as PAGE_SUBPROTOCOL
+from minros.web.page import PageHub, PageSession
 from minros.web.rosbridge import RosbridgeSession
 from minros.web.state import WebState
 from minros.wire import admission
@@ -233,6 +236,7 @@ class WebServer:
         self.compression = compression
         self.static_dir = static_dir
         self.clients: Dict[str, _Client] = {}
+        self.page_hub = PageHub(state)
         self.viewers = 0
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
@@ -265,6 +269,7 @@ class WebServer:
 
     def shutdown(self) -> None:
         self._stop.set()
+        self.page_hub.stop()
         if self._server is not None:
             for client in list(self.clients.values()):
                 client.outbox.close()
@@ -290,7 +295,10 @@ class WebServer:
 
     @staticmethod
     def _select_subprotocol(connection: Any, offered: Any) -> Optional[str]:
-        return fp.SUBPROTOCOL if fp.SUBPROTOCOL in offered else None
+        for known in (fp.SUBPROTOCOL, PAGE_SUBPROTOCOL):
+            if known in offered:
+                return known
+        return None
 
     def _token_ok(self, request: Any, query: str) -> bool:
         if self.token is None:
@@ -458,18 +466,23 @@ class WebServer:
         client_id = f"{peer[0]}:{peer[1]}#{next(self._ids)}" if peer else str(next(self._ids))
         client = _Client(self, connection, client_id)
         foxglove = connection.subprotocol == fp.SUBPROTOCOL
+        page = connection.subprotocol == PAGE_SUBPROTOCOL
+        kind = "Foxglove" if foxglove else "page" if page else "rosbridge"
         if foxglove:
             client.session = FoxgloveSession(client_id, self.state, client.outbox, client.close,
                                              server_name=self.name)
+        elif page:
+            client.session = PageSession(client_id, self.state, client.outbox, client.close,
+                                         self.page_hub, rosapi=self.rosapi)
         else:
             client.session = RosbridgeSession(client_id, self.state, client.outbox, client.close,
                                               rosapi=self.rosapi)
         with self._lock:
             self.clients[client_id] = client
-        minros.loginfo(f"[web] {'Foxglove' if foxglove else 'rosbridge'} client {client_id} connected")
+        minros.loginfo(f"[web] {kind} client {client_id} connected")
         client.writer.start()
         try:
-            if foxglove:
+            if foxglove or page:
                 client.session.start()
             while True:
                 data = connection.recv()
