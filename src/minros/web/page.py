@@ -56,6 +56,12 @@ SUBPROTOCOL = "minros.page.v1"
 MAX_STATS_TOPICS = 200
 #: points one plot keeps for a client that does not read fast enough (the oldest go first)
 MAX_PLOT_POINTS = 100_000
+#: plots, echoes and publications one page may have running at a time
+MAX_PLOTS = 32
+MAX_ECHOES = 16
+MAX_PUBLISHING = 32
+#: dynamic_reconfigure clients the server keeps for pages (the least recently used go first)
+MAX_DYNREC_CLIENTS = 32
 #: log lines sent in one ``log`` frame
 LOG_BATCH = 5_000
 PLOT_INTERVAL = 0.05
@@ -66,7 +72,6 @@ DYNREC_TIMEOUT = 3.0
 MAX_PUBLISH_RATE = 1000.0
 CONSOLE_TOPIC = "/rosout_agg"
 LOG_TYPE = "rosgraph_msgs/Log"
-DESCRIPTION_TYPE = "dynamic_reconfigure/ConfigDescription"
 
 
 class PageHub:
@@ -98,7 +103,8 @@ class PageHub:
             self.sessions.pop(id(session), None)
 
     def start_console(self) -> None:
-        """Tap /rosout_agg once; the lines are kept while the server runs."""
+        """Tap /rosout_agg once (when the first page connects); the lines are kept while the
+        server runs, so a page opened later shows what happened before."""
         with self.lock:
             if self._console_tapped:
                 return
@@ -128,15 +134,23 @@ class PageHub:
         from minros.dynamic_reconfigure.client import Client
 
         with self.lock:
-            client = self._dynrec.get(server)
+            client = self._dynrec.pop(server, None)
+            if client is not None:
+                self._dynrec[server] = client  # now the most recently used
         if client is None:
             client = Client(server, timeout=DYNREC_TIMEOUT)
+            evicted = []
             with self.lock:
                 if server in self._dynrec:
-                    client.close()
+                    evicted.append(client)
                     client = self._dynrec[server]
                 else:
                     self._dynrec[server] = client
+                    while len(self._dynrec) > MAX_DYNREC_CLIENTS:
+                        oldest = next(iter(self._dynrec))
+                        evicted.append(self._dynrec.pop(oldest))
+            for old in evicted:
+                old.close()
         return client
 
     def forget_dynrec(self, server: str) -> None:
@@ -365,6 +379,8 @@ class PageSession(RosbridgeSession):
             self.fail(msg, str(exc))
             return
         self.unplot({"id": plot_id})
+        if len(self.plots) >= MAX_PLOTS:
+            raise OpError(f"{MAX_PLOTS} plots are running already: remove one first")
         entry = _Plot(plot_id, fields)
         slot = ("page", "plot", plot_id)
         self.outbox.open_slot(slot, lambda _token: self._render_plot(entry), maxlen=1,
@@ -427,6 +443,8 @@ class PageSession(RosbridgeSession):
             self.fail(msg, f"topic {topic} does not exist (or has no type yet)")
             return
         self.unecho({"id": echo_id})
+        if len(self.echoes) >= MAX_ECHOES:
+            raise OpError(f"{MAX_ECHOES} echoes are running already: stop one first")
         slot = ("page", "echo", echo_id)
         count = [0]
 
@@ -455,7 +473,6 @@ class PageSession(RosbridgeSession):
     # -- the console -----------------------------------------------------------------------
 
     def console(self, msg: Dict[str, Any]) -> None:
-        self.hub.start_console()
         self.outbox.open_slot(("page", "console"), lambda _token: self._render_log(), maxlen=1,
                               min_interval=LOG_INTERVAL)
         with self.page_lock:
@@ -591,6 +608,8 @@ class PageSession(RosbridgeSession):
         else:
             populate_message(msg.get("msg", {}), instance, self.state.now)
         self.pub_stop({"id": msg["id"]})
+        if rate and len(self.publishing) >= MAX_PUBLISHING:
+            raise OpError(f"{MAX_PUBLISHING} topics are being published already: stop one first")
         self.state.acquire_publisher(self, topic, cls, queue_size=100)
         self.published.add(topic)
         job = _Publishing(self, msg["id"], topic, instance, rate)

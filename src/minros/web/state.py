@@ -232,32 +232,26 @@ class SharedPublisher:
 class _GraphUpdates:
     """The XML-RPC API the master calls (only ``graphUpdate``)."""
 
-    def __init__(self, on_update: Callable[[int], None]) -> None:
+    def __init__(self, on_update: Callable[[], None]) -> None:
         self._on_update = on_update
 
     def graphUpdate(self, caller_id: str, version: int) -> List[Any]:
-        self._on_update(int(version) if isinstance(version, int) else -1)
+        self._on_update()
         return [1, "", 0]
 
 
 class GraphPush:
     """An XML-RPC endpoint of our own for ``graphUpdate`` calls (not the node's slave API, whose
-    methods stay exactly rospy's)."""
+    methods stay exactly rospy's); ``on_update()`` runs in the server's connection thread."""
 
-    def __init__(self, on_update: Callable[[int], None]) -> None:
+    def __init__(self, on_update: Callable[[], None]) -> None:
         from minros import rosenv
         from minros.wire.xmlrpc import XmlRpcServer
 
-        self.pushes = 0
-        self._on_update = on_update
-        self.server = XmlRpcServer(_GraphUpdates(self._update), rosenv.get_bind_address(), 0,
+        self.server = XmlRpcServer(_GraphUpdates(on_update), rosenv.get_bind_address(), 0,
                                    max_connections=8)
         self.server.start()
         self.uri = rosenv.create_local_xmlrpc_uri(self.server.port)
-
-    def _update(self, version: int) -> None:
-        self.pushes += 1
-        self._on_update(version)
 
     def close(self) -> None:
         self.server.shutdown()
@@ -313,13 +307,12 @@ class WebState:
 
     # -- lifecycle -------------------------------------------------------------------------
 
-    def start(self, push: bool = True) -> None:
-        """Read the graph, ask the master to push changes (``push``), start the graph thread."""
-        if push:
-            try:
-                self._push = GraphPush(lambda version: self._wake.set())
-            except OSError as exc:
-                minros.logwarn(f"[web] cannot listen for the master's graph pushes ({exc})")
+    def start(self) -> None:
+        """Ask the master to push graph changes, read the graph, start the graph thread."""
+        try:
+            self._push = GraphPush(self._wake.set)
+        except OSError as exc:
+            minros.logwarn(f"[web] cannot listen for the master's graph pushes ({exc})")
         self._renew_graph_push()
         self.refresh_graph()
         self._thread = threading.Thread(target=self._graph_loop, name="minros-web-graph",
@@ -349,8 +342,8 @@ class WebState:
         """Read the graph again now (a client connected, or advertised something)."""
         self._wake.set()
 
-    def _renew_graph_push(self) -> bool:
-        """subscribeGraph (again); sets ``graph_mode``. True when the mode changed."""
+    def _renew_graph_push(self) -> None:
+        """subscribeGraph (again), which sets ``graph_mode``."""
         self._renewed = time.monotonic()
         mode = "poll"
         if self._push is not None:
@@ -359,12 +352,10 @@ class WebState:
                 mode = "push"
             except Exception as exc:  # rosmaster: no such method; or the master is away
                 minros.logdebug(f"[web] the master does not push graph changes: {exc}")
-        changed = mode != self.graph_mode
-        if changed:
+        if mode != self.graph_mode:
             self.graph_mode = mode
             minros.loginfo("[web] graph: " + ("pushed by the master" if mode == "push" else
                                                f"read every {self.options.graph_interval:g} s"))
-        return changed
 
     def _graph_loop(self) -> None:
         while not self._stop.is_set() and not minros.is_shutdown():
