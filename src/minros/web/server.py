@@ -13,7 +13,8 @@ Each WebSocket client has an :class:`~minros.web.outbox.Outbox` and a writer thr
 callbacks only queue, the writer encodes and sends. A watchdog closes a client whose send has
 been blocked for ``send_timeout`` seconds (a client that stopped reading); MJPEG viewers write
 with the same bound. With a token, every request (WebSocket or HTTP) must carry it, as
-``?token=`` in the URL or an ``Authorization: Bearer`` header.
+``?token=`` in the URL or an ``Authorization: Bearer`` header, except the page's scripts and
+styles (:data:`PUBLIC_ASSETS`), which hold nothing of the ROS system.
 
 Connections are admitted as in every minros server (:mod:`minros.wire.admission`), by a small
 guard around the websockets handler: ROS_ALLOWED_HOSTS, a cap that closes the oldest
@@ -28,6 +29,7 @@ import hmac
 import itertools
 import logging
 import mimetypes
+import posixpath
 import select
 import socket
 import threading
@@ -50,6 +52,8 @@ from minros.web.state import WebState
 from minros.wire import admission
 
 STATIC_DIR = Path(__file__).resolve().parent / "static"
+#: paths of the page's code and styles, served without the token
+PUBLIC_ASSETS = ("/js/", "/vendor/", "/page.css")
 DEFAULT_PORT = 9090
 DEFAULT_MAX_MESSAGE_SIZE = 64 << 20
 DEFAULT_SEND_TIMEOUT = 10.0
@@ -331,12 +335,18 @@ class WebServer:
     def _process_request(self, connection: Any, request: Any) -> Any:
         self._guard.served(connection.socket)
         path, _, query = request.path.partition("?")
+        upgrade = request.headers.get("Upgrade", "").lower() == "websocket"
+        if not upgrade and posixpath.normpath(urllib.parse.unquote(path)).startswith(PUBLIC_ASSETS):
+            # the page's code is the same in every install: a browser fetches it without the
+            # token (a module's imports carry no query); the page itself and every piece of
+            # data (WebSocket, video) still need the token
+            return self._static(path)
         if not self._token_ok(request, query):
             peer = connection.remote_address
             minros.logwarn(f"[web] refused {peer[0] if peer else '?'}: wrong or missing token")
             return self._text(401, "minros web: wrong or missing token. Add ?token=TOKEN to the "
                                    "URL (the token `minros web --token` was started with).")
-        if request.headers.get("Upgrade", "").lower() == "websocket":
+        if upgrade:
             return None
         try:
             return self._http(connection, path, query)
