@@ -582,7 +582,7 @@ class PageSession(RosbridgeSession):
     # -- publishing ------------------------------------------------------------------------
 
     def pub_start(self, msg: Dict[str, Any]) -> None:
-        from minros.tools.fill import fill_message_args, substitution_keys
+        from minros.msgs.fill import fill_message_args, substitution_keys
 
         _check(msg, [(True, "id", (str, int)), (True, "topic", (str,)), (True, "type", (str,)),
                      (False, "yaml", (str,)), (False, "msg", (dict,)), (False, "rate", (int, float))])
