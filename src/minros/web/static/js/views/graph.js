@@ -10,8 +10,10 @@ import {clear, fill, formatBytes, formatRate, h} from "../ui.js";
 const SVG = "http://www.w3.org/2000/svg";
 const FONT = "12px system-ui, sans-serif";
 const LOGGER_SERVICES = ["/get_loggers", "/set_logger_level"];
-/** the smallest zoom at which labels can be read; a first view never zooms out further */
+/** the smallest zoom at which labels can be read on a large screen (on a phone: larger); a
+ * first view never zooms out further, the rest of the graph is a drag or the Fit button away */
 const READABLE_SCALE = 0.5;
+const READABLE_SCALE_PHONE = 0.8;
 
 function s(tag, attrs = {}, ...children) {
   const el = document.createElementNS(SVG, tag);
@@ -59,7 +61,8 @@ export function graphModel(graph, isQuiet, {debug = false, services = true} = {}
 }
 
 export function createGraphView(app) {
-  const options = {debug: false, services: true};
+  // services make a graph twice as wide: shown by default only where there is room
+  const options = {debug: false, services: window.innerWidth > 600};
   const svg = s("svg", {class: "graph-svg", role: "img", "aria-label": "ROS computation graph"});
   const defs = s("defs", {},
     s("marker", {id: "arrow", viewBox: "0 0 10 10", refX: "9", refY: "5", markerWidth: "7", markerHeight: "7", orient: "auto-start-reverse"},
@@ -70,12 +73,13 @@ export function createGraphView(app) {
   const modeNote = h("span", {class: "muted"});
   const toolbar = h("div", {class: "toolbar"},
     h("label", {}, h("input", {type: "checkbox", onchange: (e) => { options.debug = e.target.checked; draw(true); }}), " debug"),
-    h("label", {}, h("input", {type: "checkbox", checked: true, onchange: (e) => { options.services = e.target.checked; draw(true); }}), " services"),
+    h("label", {}, h("input", {type: "checkbox", checked: options.services, onchange: (e) => { options.services = e.target.checked; draw(true); }}), " services"),
     h("button", {onclick: () => fit(), title: "show the whole graph"}, "Fit"),
     h("button", {onclick: () => zoomBy(1.25), title: "zoom in"}, "+"),
     h("button", {onclick: () => zoomBy(0.8), title: "zoom out"}, "−"),
     modeNote);
-  const canvas = h("div", {class: "graph-canvas"}, svg, h("div", {class: "graph-hint muted"}, "Click a node or a topic."));
+  const canvas = h("div", {class: "graph-canvas"}, svg,
+    h("div", {class: "graph-hint muted"}, "Click a node or a topic; drag to move, wheel or +/− to zoom."));
   const el = h("section", {}, toolbar, h("div", {class: "graph-layout"}, canvas, info));
 
   let transform = {x: 0, y: 0, k: 1};
@@ -85,7 +89,6 @@ export function createGraphView(app) {
   let fitted = false;
   let visible = false;
   let selectionTimer = null;
-  let rankdir = "LR";
 
   const apply = () => world.setAttribute("transform", `translate(${transform.x},${transform.y}) scale(${transform.k})`);
 
@@ -95,17 +98,12 @@ export function createGraphView(app) {
     const box = canvas.getBoundingClientRect();
     if (!size.width || !box.width) return;
     let k = Math.min(box.width / (size.width + 40), box.height / (size.height + 40), 1.2);
-    if (readable) k = Math.max(k, READABLE_SCALE);
+    if (readable) k = Math.max(k, window.innerWidth > 600 ? READABLE_SCALE : READABLE_SCALE_PHONE);
     const place = (room, extent) => (room >= extent * k ? (room - extent * k) / 2 : 10);
     transform = {k, x: place(box.width, size.width), y: place(box.height, size.height)};
     apply();
   }
 
-  /** Left to right as rqt_graph, top to bottom on a tall (phone) screen. */
-  function direction() {
-    const box = canvas.getBoundingClientRect();
-    return box.height > box.width * 1.2 ? "TB" : "LR";
-  }
 
   function zoomBy(factor, cx, cy) {
     const box = canvas.getBoundingClientRect();
@@ -137,20 +135,12 @@ export function createGraphView(app) {
   });
   canvas.addEventListener("pointerup", () => { drag = null; });
 
-  function draw(force = false) {
-    const graph = app.graph;
-    modeNote.textContent = graph.mode === "push" ? "live: the master pushes changes" :
-      graph.mode ? "live: read every second (this master cannot push)" : "";
-    const model = graphModel(graph, (n) => app.isQuiet(n), options);
-    const sig = JSON.stringify(model);
-    if (!force && sig === signature && rankdir === direction()) return;
-    signature = sig;
-    rankdir = direction();
+  function layout(model, direction) {
     const g = new dagre.graphlib.Graph();
     // greedy cycle breaking keeps feedback loops (odom -> localization -> planner -> cmd_vel)
     // from stretching the graph into one long row
-    g.setGraph({rankdir, acyclicer: "greedy", nodesep: rankdir === "LR" ? 8 : 16, ranksep: rankdir === "LR" ? 40 : 34,
-                edgesep: 6, marginx: 10, marginy: 10});
+    g.setGraph({rankdir: direction, acyclicer: "greedy", nodesep: direction === "LR" ? 8 : 16,
+                ranksep: direction === "LR" ? 40 : 34, edgesep: 6, marginx: 10, marginy: 10});
     g.setDefaultEdgeLabel(() => ({}));
     for (const v of model.vertices) {
       const w = textWidth(v.label) + (v.kind === "node" ? 30 : 16);
@@ -158,9 +148,27 @@ export function createGraphView(app) {
     }
     for (const e of model.edges) g.setEdge(e.from, e.to, {kind: e.kind});
     dagre.layout(g);
-    const layout = g.graph();
+    return g;
+  }
+
+  function draw(force = false) {
+    const graph = app.graph;
+    modeNote.textContent = graph.mode === "push" ? "live: the master pushes changes" :
+      graph.mode ? "live: read every second (this master cannot push)" : "";
+    const model = graphModel(graph, (n) => app.isQuiet(n), options);
+    const box = canvas.getBoundingClientRect();
+    const sig = JSON.stringify(model);
+    if (!force && sig === signature) return;
+    signature = sig;
+    // left to right as rqt_graph; top to bottom when that fits the window better (a phone)
+    const scaleOf = (g) => Math.min(box.width / (g.graph().width + 40), box.height / (g.graph().height + 40));
+    let g = layout(model, "LR");
+    if (box.height > box.width) {
+      const tall = layout(model, "TB");
+      if (scaleOf(tall) > scaleOf(g) * 1.1) g = tall;
+    }
     const finite = (v) => (Number.isFinite(v) && v > 0 ? v : 0);
-    size = {width: finite(layout.width), height: finite(layout.height)};
+    size = {width: finite(g.graph().width), height: finite(g.graph().height)};
     clear(world);
     const edgeLayer = s("g", {class: "edges"});
     const vertexLayer = s("g", {class: "vertices"});
@@ -281,9 +289,7 @@ export function createGraphView(app) {
   }
 
   app.onGraph(() => { if (visible) draw(); });
-  new ResizeObserver(() => {
-    if (visible && (!fitted || rankdir !== direction())) draw(true);
-  }).observe(canvas);
+  new ResizeObserver(() => { if (visible && !fitted) draw(true); }).observe(canvas);
 
   return {
     id: "graph", el,
