@@ -13,7 +13,10 @@ Layout, from pure to I/O:
   to nodes: a few worker threads, at most one call in flight per node and calls to one node
   in order, each call bounded by a timeout; a slow or dead node never delays an API reply;
 * :class:`MasterHandler` — the XML-RPC methods with rosmaster's argument validation and exact
-  ``[code, statusMessage, value]`` results;
+  ``[code, statusMessage, value]`` results, plus one minros extension: ``subscribeGraph`` /
+  ``unsubscribeGraph``, after which the master calls ``graphUpdate(caller_id, version)`` on the
+  subscriber's URI whenever a registration changes (``minros web`` pushes its graph that way;
+  against rosmaster, which has no such method, it polls);
 * :class:`Master` — handler + :class:`minros.wire.xmlrpc.XmlRpcServer`.
 """
 
@@ -53,6 +56,8 @@ CALLBACK_WORKERS = 16  # started on demand; many slow nodes do not stall the oth
 MAX_QUEUED_PER_NODE = 10000
 #: Queued calls to one node beyond which a newer update replaces a queued one for the same key.
 COALESCE_BACKLOG = 32
+#: Bound on graph watchers (subscribeGraph), so the table cannot be grown without limit.
+MAX_GRAPH_WATCHERS = 256
 
 #: What the master did (+PUB, -SUB, +PARAM ... as in rosmaster's master.log); no handler is
 #: attached unless :func:`configure_log_file` is called, so library use stays silent.
@@ -540,6 +545,11 @@ class MasterHandler:
         self._topic_types: Dict[str, str] = {}
         self._shutdown_requested = threading.Event()
         self._on_shutdown: Callable[[str], None] | None = None
+        #: graph watchers: api -> caller_id; a watcher has at most one graphUpdate in flight
+        #: and is sent the newest version when it answers (so a burst costs it two calls)
+        self._graph_version = 0
+        self._graph_watchers: Dict[str, str] = {}
+        self._graph_sent: Dict[str, int] = {}
 
     # -- internal (not callable over XML-RPC: leading underscore)
 
@@ -565,6 +575,31 @@ class MasterHandler:
                                  coalesce=("paramUpdate", key),
                                  on_result=functools.partial(self._param_update_result, caller_api,
                                                              key))
+
+    def _graph_changed(self) -> None:
+        """A registration changed (called with ``_lock`` held): tell the graph watchers."""
+        self._graph_version += 1
+        for watcher_api in self._graph_watchers:
+            self._send_graph_update(watcher_api)
+
+    def _send_graph_update(self, watcher_api: str) -> None:
+        if watcher_api in self._graph_sent:
+            return  # one in flight: its answer sends the newest version
+        self._graph_sent[watcher_api] = self._graph_version
+        self._pool.queue(watcher_api, "graphUpdate", ("/master", self._graph_version),
+                         on_result=functools.partial(self._graph_update_result, watcher_api))
+
+    def _graph_update_result(self, watcher_api: str, result: Any) -> None:
+        with self._lock:
+            sent = self._graph_sent.pop(watcher_api, None)
+            ok = isinstance(result, (list, tuple)) and len(result) == 3 and result[0] == 1
+            if not ok:
+                # gone, or no longer interested: a watcher subscribes again when it wants more
+                if self._graph_watchers.pop(watcher_api, None) is not None:
+                    _log.info("-GRAPH %s (graphUpdate answered %r)", watcher_api, result)
+                return
+            if watcher_api in self._graph_watchers and sent != self._graph_version:
+                self._send_graph_update(watcher_api)
 
     def _param_update_result(self, caller_api: str, key: str, result: Any) -> None:
         # A node answering -1 is not (or no longer) subscribed: stop sending it updates.
@@ -680,6 +715,7 @@ class MasterHandler:
                         caller_api: str) -> Any:
         with self._lock:
             self._reg.register_service(service, caller_id, caller_api, service_api)
+            self._graph_changed()
         _log.info("+SERVICE [%s] %s %s", service, caller_id, caller_api)
         return 1, f"Registered [{caller_id}] as provider of [{service}]", 1
 
@@ -695,6 +731,8 @@ class MasterHandler:
     def unregisterService(self, caller_id: str, service: str, service_api: str) -> Any:
         with self._lock:
             result = self._reg.unregister_service(service, caller_id, service_api)
+            if result[2]:
+                self._graph_changed()
         _log.info("-SERVICE [%s] %s %s", service, caller_id, service_api)
         return result
 
@@ -708,6 +746,7 @@ class MasterHandler:
             if topic not in self._topic_types and topic_type != ANYTYPE:
                 self._topic_types[topic] = topic_type
             pub_uris = self._reg.publishers.get_apis(topic)
+            self._graph_changed()
         _log.info("+SUB [%s] %s %s", topic, caller_id, caller_api)
         return 1, f"Subscribed to [{topic}]", pub_uris
 
@@ -715,6 +754,8 @@ class MasterHandler:
     def unregisterSubscriber(self, caller_id: str, topic: str, caller_api: str) -> Any:
         with self._lock:
             result = self._reg.unregister_subscriber(topic, caller_id, caller_api)
+            if result[2]:
+                self._graph_changed()
         _log.info("-SUB [%s] %s %s", topic, caller_id, caller_api)
         return result
 
@@ -728,6 +769,7 @@ class MasterHandler:
                 self._topic_types[topic] = topic_type
             self._notify_topic_subscribers(topic)
             sub_uris = self._reg.subscribers.get_apis(topic)
+            self._graph_changed()
         _log.info("+PUB [%s] %s %s", topic, caller_id, caller_api)
         return 1, f"Registered [{caller_id}] as publisher of [{topic}]", sub_uris
 
@@ -737,10 +779,30 @@ class MasterHandler:
             result = self._reg.unregister_publisher(topic, caller_id, caller_api)
             if result[2]:
                 self._notify_topic_subscribers(topic)
+                self._graph_changed()
         _log.info("-PUB [%s] %s %s", topic, caller_id, caller_api)
         return result
 
     # -- graph introspection
+
+    @api(0, (is_api("caller_api"),))
+    def subscribeGraph(self, caller_id: str, caller_api: str) -> Any:
+        """minros extension: call ``graphUpdate(caller_id, version)`` on ``caller_api`` after
+        every registration change; the value is the current version."""
+        with self._lock:
+            if caller_api not in self._graph_watchers and len(self._graph_watchers) >= MAX_GRAPH_WATCHERS:
+                return -1, f"too many graph watchers ({MAX_GRAPH_WATCHERS}): poll getSystemState", 0
+            self._graph_watchers[caller_api] = caller_id
+            version = self._graph_version
+        _log.info("+GRAPH [%s] %s", caller_id, caller_api)
+        return 1, "Subscribed to graph changes", version
+
+    @api(0, (is_api("caller_api"),))
+    def unsubscribeGraph(self, caller_id: str, caller_api: str) -> Any:
+        with self._lock:
+            known = self._graph_watchers.pop(caller_api, None) is not None
+        _log.info("-GRAPH [%s] %s", caller_id, caller_api)
+        return 1, "Unsubscribed from graph changes", int(known)
 
     @api("", (valid_name("node"),))
     def lookupNode(self, caller_id: str, node_name: str) -> Any:

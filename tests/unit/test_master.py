@@ -304,3 +304,71 @@ def test_namespaces_are_handed_out_as_snapshots():
     h.setParam("/w", "/ns/d", 3)
     assert value == {"a": {"b": 1}} and subscribed == {"a": {"b": 1}}
     assert h.getParam("/r", "/ns")[2] == {"a": {"b": 1, "c": 2}, "d": 3}
+
+
+# ---------------------------------------------------------------- graph watchers (minros extension)
+
+
+class RecordingPool:
+    """Records queued callbacks with their on_result, so a test can answer them."""
+
+    def __init__(self) -> None:
+        self.calls = []
+
+    def queue(self, api, method, args, coalesce=None, on_result=None):
+        self.calls.append((api, method, args, on_result))
+
+    def answer(self, index, result):
+        self.calls[index][3](result)
+
+
+NODE_API = "http://node:1/"
+WATCHER = "http://watcher:2/"
+
+
+def test_graph_watcher_gets_one_update_in_flight_then_the_newest_version():
+    pool = RecordingPool()
+    h = MasterHandler(pool)
+    code, _msg, version = h.subscribeGraph("/web", WATCHER)
+    assert code == 1 and version == 0
+    h.registerPublisher("/talker", "/chatter", "std_msgs/String", NODE_API)
+    updates = [c for c in pool.calls if c[1] == "graphUpdate"]
+    assert [(c[0], c[2]) for c in updates] == [(WATCHER, ("/master", 1))]
+    # a burst while the first update is in flight queues nothing more ...
+    h.registerSubscriber("/listener", "/chatter", "std_msgs/String", "http://node:3/")
+    h.registerService("/talker", "/srv", "rosrpc://node:4", NODE_API)
+    assert len([c for c in pool.calls if c[1] == "graphUpdate"]) == 1
+    # ... and its answer sends the newest version once
+    pool.answer(pool.calls.index(updates[0]), [1, "", 0])
+    updates = [c for c in pool.calls if c[1] == "graphUpdate"]
+    assert [c[2] for c in updates] == [("/master", 1), ("/master", 3)]
+    pool.answer(pool.calls.index(updates[1]), [1, "", 0])
+    assert len([c for c in pool.calls if c[1] == "graphUpdate"]) == 2  # up to date: quiet
+
+
+def test_graph_watcher_is_dropped_when_it_fails_and_unregistering_nothing_is_no_change():
+    pool = RecordingPool()
+    h = MasterHandler(pool)
+    h.subscribeGraph("/web", WATCHER)
+    h.unregisterPublisher("/talker", "/nothing", NODE_API)  # nothing was registered
+    assert not [c for c in pool.calls if c[1] == "graphUpdate"]
+    h.registerPublisher("/talker", "/chatter", "std_msgs/String", NODE_API)
+    pool.answer(len(pool.calls) - 1, ConnectionRefusedError(111, "refused"))
+    h.unregisterPublisher("/talker", "/chatter", NODE_API)
+    assert len([c for c in pool.calls if c[1] == "graphUpdate"]) == 1  # the dead one is gone
+    code, _msg, version = h.subscribeGraph("/web", WATCHER)
+    assert code == 1 and version == 2
+    assert h.unsubscribeGraph("/web", WATCHER)[2] == 1
+    assert h.unsubscribeGraph("/web", WATCHER)[2] == 0
+    assert h.subscribeGraph("/web", "not a uri")[0] == -1
+
+
+def test_graph_watchers_are_bounded():
+    from minros.master import MAX_GRAPH_WATCHERS
+
+    h = MasterHandler(RecordingPool())
+    for i in range(MAX_GRAPH_WATCHERS):
+        assert h.subscribeGraph("/web", f"http://w:{i + 1}/")[0] == 1
+    code, msg, _ = h.subscribeGraph("/web", "http://w:9999/")
+    assert code == -1 and "too many graph watchers" in msg
+    assert h.subscribeGraph("/web", "http://w:1/")[0] == 1  # a known watcher renews

@@ -17,15 +17,7 @@ from typing import Dict, List, Tuple
 from xml.sax.saxutils import escape
 
 from minros.tools.common import ToolError, parser, run_tool
-from minros.tools.master import Master
-
-#: substrings that mark debug nodes/topics (rqt_graph's "Hide Debug")
-QUIET_NAMES = ("/diag_agg", "/runtime_logger", "/pr2_dashboard", "/rviz", "/rosout", "/cpu_monitor",
-               "/monitor", "/hd_monitor", "/rxloggerlevel", "/clock", "/rqt", "/statistics", "/rosapi")
-
-
-def is_quiet(name: str) -> bool:
-    return any(q in name for q in QUIET_NAMES)
+from minros.tools.master import Master, is_quiet
 
 
 class Graph:

@@ -16,10 +16,11 @@ from typing import List
 def _parser(prog: str) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=prog,
-        description="Serve the ROS graph to browsers and GUIs on one port: rosbridge v2 with "
-                    "rosapi (roslibjs, roslibpy, webviz), the Foxglove WebSocket protocol "
-                    "(Foxglove, Lichtblick) and web_video_server's /stream, /snapshot and "
-                    "/stream_viewer endpoints.")
+        description="Serve the ROS graph to browsers and GUIs on one port: a page at / to see "
+                    "and drive it (graph, topics, plots, images, turtlesim, parameters, services, "
+                    "console), rosbridge v2 with rosapi (roslibjs, roslibpy, webviz), the "
+                    "Foxglove WebSocket protocol (Foxglove, Lichtblick) and web_video_server's "
+                    "/stream, /snapshot and /stream_viewer endpoints.")
     parser.add_argument("--port", type=int, default=9090, help="TCP port (default 9090)")
     parser.add_argument("--host", default="127.0.0.1",
                         help="address to listen on (default 127.0.0.1: this machine only; "
@@ -40,7 +41,8 @@ def _parser(prog: str) -> argparse.ArgumentParser:
                         help="close a client that reads nothing for this long while data waits "
                              "(default 10)")
     parser.add_argument("--graph-interval", type=float, default=1.0, metavar="SECONDS",
-                        help="how often the master's graph is read (default 1)")
+                        help="how often the graph is read from a master that cannot push its "
+                             "changes, such as rosmaster (default 1; minros's master pushes)")
     parser.add_argument("--compression", action="store_true",
                         help="offer permessage-deflate (costs CPU on images)")
     return parser

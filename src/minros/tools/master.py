@@ -19,6 +19,16 @@ DEFAULT_MASTER_URI = rosenv.DEFAULT_MASTER_URI
 TOOL_TIMEOUT = 5.0
 
 
+#: substrings that mark debug nodes and topics (/rosout, /rosout_agg, /clock, rqt, rviz, ...):
+#: rqt_graph's "Hide Debug", which minros graph and the web page's graph apply too
+QUIET_NAMES = ("/diag_agg", "/runtime_logger", "/pr2_dashboard", "/rviz", "/rosout", "/cpu_monitor",
+               "/monitor", "/hd_monitor", "/rxloggerlevel", "/clock", "/rqt", "/statistics", "/rosapi")
+
+
+def is_quiet(name: str) -> bool:
+    return any(q in name for q in QUIET_NAMES)
+
+
 class MasterException(Exception):
     """Base of master call errors."""
 

@@ -144,6 +144,7 @@ def _banner(server: Any, settings: Settings) -> str:
     token = f"?token={settings.token}" if settings.token else ""
     return "\n".join([
         f"minros web: listening on {url}/{token} (node {minros.get_name()})",
+        f"  the page               {url}/{token}   (graph, topics, plot, images, turtlesim, ...)",
         f"  rosbridge v2 + rosapi  {ws}{token}   (roslibjs, roslibpy, webviz)",
         f"  Foxglove WebSocket     {ws}{token}   (Foxglove, Lichtblick: 'Foxglove WebSocket')",
         f"  video                  {url}/streams{token}   (/stream?topic=..., /snapshot?topic=...)",

@@ -3,7 +3,8 @@
 Built on the threading server of ``websockets`` (one thread per connection, like the rest of
 minros). A connection is told apart by:
 
-* the WebSocket subprotocol: ``foxglove.websocket.v1`` -> :class:`FoxgloveSession`; no (or any
+* the WebSocket subprotocol: ``foxglove.websocket.v1`` -> :class:`FoxgloveSession`;
+  ``minros.page.v1`` (the page at ``/``) -> :class:`~minros.web.page.PageSession`; no (or any
   other) subprotocol -> :class:`RosbridgeSession` (roslibjs and roslibpy ask for none);
 * for plain HTTP (no ``Upgrade``), the path: ``/stream``, ``/snapshot``, ``/stream_viewer``,
   ``/streams`` (web_video_server's endpoints), else the static files of ``minros/web/static``.
@@ -12,7 +13,8 @@ Each WebSocket client has an :class:`~minros.web.outbox.Outbox` and a writer thr
 callbacks only queue, the writer encodes and sends. A watchdog closes a client whose send has
 been blocked for ``send_timeout`` seconds (a client that stopped reading); MJPEG viewers write
 with the same bound. With a token, every request (WebSocket or HTTP) must carry it, as
-``?token=`` in the URL or an ``Authorization: Bearer`` header.
+``?token=`` in the URL or an ``Authorization: Bearer`` header, except the page's scripts and
+styles (:data:`PUBLIC_ASSETS`), which hold nothing of the ROS system.
 
 Connections are admitted as in every minros server (:mod:`minros.wire.admission`), by a small
 guard around the websockets handler: ROS_ALLOWED_HOSTS, a cap that closes the oldest
@@ -27,6 +29,7 @@ import hmac
 import itertools
 import logging
 import mimetypes
+import posixpath
 import select
 import socket
 import threading
@@ -42,11 +45,15 @@ from minros.web import foxglove_protocol as fp
 from minros.web import video
 from minros.web.foxglove import FoxgloveSession
 from minros.web.outbox import Outbox
+from minros.web.page import SUBPROTOCOL as PAGE_SUBPROTOCOL
+from minros.web.page import PageHub, PageSession
 from minros.web.rosbridge import RosbridgeSession
 from minros.web.state import WebState
 from minros.wire import admission
 
 STATIC_DIR = Path(__file__).resolve().parent / "static"
+#: paths of the page's code and styles, served without the token
+PUBLIC_ASSETS = ("/js/", "/vendor/", "/page.css")
 DEFAULT_PORT = 9090
 DEFAULT_MAX_MESSAGE_SIZE = 64 << 20
 DEFAULT_SEND_TIMEOUT = 10.0
@@ -233,6 +240,7 @@ class WebServer:
         self.compression = compression
         self.static_dir = static_dir
         self.clients: Dict[str, _Client] = {}
+        self.page_hub = PageHub(state)
         self.viewers = 0
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
@@ -265,6 +273,7 @@ class WebServer:
 
     def shutdown(self) -> None:
         self._stop.set()
+        self.page_hub.stop()
         if self._server is not None:
             for client in list(self.clients.values()):
                 client.outbox.close()
@@ -290,7 +299,10 @@ class WebServer:
 
     @staticmethod
     def _select_subprotocol(connection: Any, offered: Any) -> Optional[str]:
-        return fp.SUBPROTOCOL if fp.SUBPROTOCOL in offered else None
+        for known in (fp.SUBPROTOCOL, PAGE_SUBPROTOCOL):
+            if known in offered:
+                return known
+        return None
 
     def _token_ok(self, request: Any, query: str) -> bool:
         if self.token is None:
@@ -323,12 +335,18 @@ class WebServer:
     def _process_request(self, connection: Any, request: Any) -> Any:
         self._guard.served(connection.socket)
         path, _, query = request.path.partition("?")
+        upgrade = request.headers.get("Upgrade", "").lower() == "websocket"
+        if not upgrade and posixpath.normpath(urllib.parse.unquote(path)).startswith(PUBLIC_ASSETS):
+            # the page's code is the same in every install: a browser fetches it without the
+            # token (a module's imports carry no query); the page itself and every piece of
+            # data (WebSocket, video) still need the token
+            return self._static(path)
         if not self._token_ok(request, query):
             peer = connection.remote_address
             minros.logwarn(f"[web] refused {peer[0] if peer else '?'}: wrong or missing token")
             return self._text(401, "minros web: wrong or missing token. Add ?token=TOKEN to the "
                                    "URL (the token `minros web --token` was started with).")
-        if request.headers.get("Upgrade", "").lower() == "websocket":
+        if upgrade:
             return None
         try:
             return self._http(connection, path, query)
@@ -458,18 +476,23 @@ class WebServer:
         client_id = f"{peer[0]}:{peer[1]}#{next(self._ids)}" if peer else str(next(self._ids))
         client = _Client(self, connection, client_id)
         foxglove = connection.subprotocol == fp.SUBPROTOCOL
+        page = connection.subprotocol == PAGE_SUBPROTOCOL
+        kind = "Foxglove" if foxglove else "page" if page else "rosbridge"
         if foxglove:
             client.session = FoxgloveSession(client_id, self.state, client.outbox, client.close,
                                              server_name=self.name)
+        elif page:
+            client.session = PageSession(client_id, self.state, client.outbox, client.close,
+                                         self.page_hub, rosapi=self.rosapi)
         else:
             client.session = RosbridgeSession(client_id, self.state, client.outbox, client.close,
                                               rosapi=self.rosapi)
         with self._lock:
             self.clients[client_id] = client
-        minros.loginfo(f"[web] {'Foxglove' if foxglove else 'rosbridge'} client {client_id} connected")
+        minros.loginfo(f"[web] {kind} client {client_id} connected")
         client.writer.start()
         try:
-            if foxglove:
+            if foxglove or page:
                 client.session.start()
             while True:
                 data = connection.recv()

@@ -3,8 +3,13 @@
 :class:`WebState` is the web server's node on the ROS graph. It holds, each in one place:
 
 * the graph as the master last told it (topics and types, publishers, subscribers, services,
-  service types), refreshed by one thread and pushed to whoever listens (Foxglove sessions, and
-  later the web page);
+  service types), refreshed by one thread and pushed to whoever listens (Foxglove sessions, the
+  web page). The master pushes: minros's master calls ``graphUpdate`` on a small XML-RPC
+  endpoint of ours (:class:`GraphPush`) after every registration change, and the thread reads
+  the graph then; Debian's rosmaster has no ``subscribeGraph``, so against it the thread reads
+  the graph every ``graph_interval`` seconds instead (``graph_mode`` says which);
+* the parameters, for listeners (Foxglove, the page): one ``subscribeParam('/')`` of the node,
+  so the master pushes every change with ``paramUpdate`` (any master has that);
 * the *taps*: one raw subscriber per topic however many clients want it. A tap receives the
   TCPROS message bytes unchanged (an ``AnyMsg``-style class, so nothing is deserialized for
   clients that forward bytes) and hands one shared :class:`Incoming` to every listener; whatever
@@ -32,8 +37,13 @@ import minros
 from minros.tools.services import probe_service
 from minros.web.rosapi import Graph
 
-#: seconds between two readings of the master's graph
+#: seconds between two readings of the master's graph when it cannot push (rosmaster)
 DEFAULT_GRAPH_INTERVAL = 1.0
+#: seconds between two subscribeGraph calls while pushed to (they renew the subscription, so a
+#: restarted master pushes again, and tell a version we may have missed)
+GRAPH_RENEW_INTERVAL = 5.0
+#: registrations arriving within this many seconds of a push are read with it
+GRAPH_SETTLE = 0.02
 #: rosbridge's unregister_timeout: a publisher outlives its last client by this long
 DEFAULT_UNREGISTER_TIMEOUT = 10.0
 #: messages published in a publisher's first second are replayed to late subscribers
@@ -217,6 +227,36 @@ class SharedPublisher:
         self.publisher.publish(msg)
 
 
+# -- the master's pushes ---------------------------------------------------------------------
+
+class _GraphUpdates:
+    """The XML-RPC API the master calls (only ``graphUpdate``)."""
+
+    def __init__(self, on_update: Callable[[], None]) -> None:
+        self._on_update = on_update
+
+    def graphUpdate(self, caller_id: str, version: int) -> List[Any]:
+        self._on_update()
+        return [1, "", 0]
+
+
+class GraphPush:
+    """An XML-RPC endpoint of our own for ``graphUpdate`` calls (not the node's slave API, whose
+    methods stay exactly rospy's); ``on_update()`` runs in the server's connection thread."""
+
+    def __init__(self, on_update: Callable[[], None]) -> None:
+        from minros import rosenv
+        from minros.wire.xmlrpc import XmlRpcServer
+
+        self.server = XmlRpcServer(_GraphUpdates(on_update), rosenv.get_bind_address(), 0,
+                                   max_connections=8)
+        self.server.start()
+        self.uri = rosenv.create_local_xmlrpc_uri(self.server.port)
+
+    def close(self) -> None:
+        self.server.shutdown()
+
+
 # -- the state -----------------------------------------------------------------------------
 
 @dataclass
@@ -253,14 +293,27 @@ class WebState:
         self.param_listeners: Dict[Hashable, Callable[[Dict[str, Any], List[str]], None]] = {}
         self._params: Optional[Dict[str, Any]] = None
         self.use_sim_time = bool(self.get_param("/use_sim_time", False))
+        self._params_subscribed = False
+        self._param_handler_added = False
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: Optional[threading.Thread] = None
+        self._push: Optional[GraphPush] = None
+        #: "push" while the master tells us about changes, "poll" otherwise (rosmaster); ""
+        #: before start()
+        self.graph_mode = ""
+        self._renewed = 0.0
         self.started = time.time()
 
     # -- lifecycle -------------------------------------------------------------------------
 
     def start(self) -> None:
+        """Ask the master to push graph changes, read the graph, start the graph thread."""
+        try:
+            self._push = GraphPush(self._wake.set)
+        except OSError as exc:
+            minros.logwarn(f"[web] cannot listen for the master's graph pushes ({exc})")
+        self._renew_graph_push()
         self.refresh_graph()
         self._thread = threading.Thread(target=self._graph_loop, name="minros-web-graph",
                                         daemon=True)
@@ -269,6 +322,12 @@ class WebState:
     def stop(self) -> None:
         self._stop.set()
         self._wake.set()
+        if self._push is not None:
+            try:
+                self._call("unsubscribeGraph", self._push.uri)
+            except Exception:
+                pass  # the master is gone: it forgets us on the next failed push anyway
+            self._push.close()
         with self.lock:
             taps, self.taps = list(self.taps.values()), {}
             pubs, self.publishers = list(self.publishers.values()), {}
@@ -283,16 +342,37 @@ class WebState:
         """Read the graph again now (a client connected, or advertised something)."""
         self._wake.set()
 
+    def _renew_graph_push(self) -> None:
+        """subscribeGraph (again), which sets ``graph_mode``."""
+        self._renewed = time.monotonic()
+        mode = "poll"
+        if self._push is not None:
+            try:
+                self._call("subscribeGraph", self._push.uri)
+                mode = "push"
+            except Exception as exc:  # rosmaster: no such method; or the master is away
+                minros.logdebug(f"[web] the master does not push graph changes: {exc}")
+        if mode != self.graph_mode:
+            self.graph_mode = mode
+            minros.loginfo("[web] graph: " + ("pushed by the master" if mode == "push" else
+                                               f"read every {self.options.graph_interval:g} s"))
+
     def _graph_loop(self) -> None:
         while not self._stop.is_set() and not minros.is_shutdown():
-            self._wake.wait(self.options.graph_interval)
+            push = self.graph_mode == "push"
+            woken = self._wake.wait(GRAPH_RENEW_INTERVAL if push else self.options.graph_interval)
             self._wake.clear()
+            if woken and push:
+                self._stop.wait(GRAPH_SETTLE)  # let a burst of registrations land
+                self._wake.clear()
             if self._stop.is_set():
                 return
             try:
+                if time.monotonic() - self._renewed >= GRAPH_RENEW_INTERVAL:
+                    self._renew_graph_push()
                 self.refresh_graph()
-                if self.param_listeners:
-                    self._poll_params()
+                if self.param_listeners and not self._params_subscribed:
+                    self._subscribe_params()
             except Exception as exc:  # the master may be restarting: try again next round
                 minros.logdebug(f"[web] graph refresh failed: {exc}")
 
@@ -496,6 +576,8 @@ class WebState:
 
     def set_param(self, name: str, value: Any) -> None:
         minros.set_param(name, value)
+        # the master sends no paramUpdate to the node that set the value
+        self._on_param_update(minros.resolve_name(name), value)
 
     def has_param(self, name: str) -> bool:
         return minros.has_param(name)
@@ -511,32 +593,56 @@ class WebState:
 
     def add_param_listener(self, key: Hashable,
                            listener: Callable[[Dict[str, Any], List[str]], None]) -> None:
+        """``listener(changed leaves, removed leaves)`` after each change of the parameters."""
         with self.lock:
             self.param_listeners[key] = listener
-        self.poke()
+            subscribed = self._params_subscribed
+        if not subscribed:
+            try:
+                self._subscribe_params()
+            except Exception as exc:  # the master is away: the graph thread tries again
+                minros.logdebug(f"[web] subscribeParam failed: {exc}")
+                self.poke()
+
+    def param_tree(self) -> Any:
+        """The whole parameter tree, read from the master now."""
+        return self._call("getParam", "/")
 
     def remove_param_listener(self, key: Hashable) -> None:
         with self.lock:
             self.param_listeners.pop(key, None)
-            if not self.param_listeners:
-                self._params = None
 
-    def _poll_params(self) -> None:
-        """One read of the whole parameter tree; listeners get the leaves that changed."""
-        tree = self._call("getParam", "/")
+    def _subscribe_params(self) -> None:
+        """subscribeParam('/') once: the master then pushes every change (paramUpdate), except
+        the ones this node makes, which :meth:`set_param` applies itself."""
+        from minros.node import default_node
+
+        node = default_node()
+        with self.lock:
+            if self._params_subscribed:
+                return
+            if not self._param_handler_added:
+                node.add_param_update_handler(self._on_param_update)
+                self._param_handler_added = True
+        tree = node.subscribe_param("/")
         flat: Dict[str, Any] = {}
-        _flatten("", tree, flat)
-        old = self._params
-        self._params = flat
-        if old is None:
-            return
-        changed = {k: v for k, v in flat.items() if old.get(k, _MISSING) != v}
-        removed = sorted(set(old) - set(flat))
-        if changed or removed:
-            with self.lock:
-                listeners = list(self.param_listeners.values())
-            for listener in listeners:
+        flatten_params("", tree, flat)
+        with self.lock:
+            self._params = flat
+            self._params_subscribed = True
+
+    def _on_param_update(self, key: str, value: Any) -> bool:
+        with self.lock:
+            if self._params is None:
+                return True
+            changed, removed = apply_param_update(self._params, key, value)
+            listeners = list(self.param_listeners.values()) if changed or removed else []
+        for listener in listeners:
+            try:
                 listener(changed, removed)
+            except Exception as exc:
+                minros.logerr(f"[web] parameter listener failed: {exc}")
+        return True
 
     # -- time ------------------------------------------------------------------------------
 
@@ -552,9 +658,34 @@ class WebState:
 _MISSING = object()
 
 
-def _flatten(prefix: str, value: Any, out: Dict[str, Any]) -> None:
+def apply_param_update(flat: Dict[str, Any], key: str, value: Any
+                       ) -> Tuple[Dict[str, Any], List[str]]:
+    """Apply a paramUpdate (``key`` set to ``value``; ``{}`` when deleted) to the flat leaf
+    table ``flat`` in place; the leaves that changed and the ones that are gone."""
+    key = key.rstrip("/") or "/"
+    prefix = "/" if key == "/" else key + "/"
+    new: Dict[str, Any] = {}
+    if not (isinstance(value, dict) and not value):
+        flatten_params("" if key == "/" else key, value, new)
+    old = {k: v for k, v in flat.items() if k == key or k.startswith(prefix)}
+    parts = key.split("/")
+    for depth in range(1, len(parts) - 1):  # a value that was where a namespace now is
+        ancestor = "/".join(parts[:depth + 1])
+        if ancestor in flat:
+            old[ancestor] = flat[ancestor]
+    changed = {k: v for k, v in new.items() if old.get(k, _MISSING) != v}
+    removed = sorted(set(old) - set(new))
+    for name in removed:
+        del flat[name]
+    flat.update(changed)
+    return changed, removed
+
+
+def flatten_params(prefix: str, value: Any, out: Dict[str, Any]) -> None:
+    """The leaves of a parameter (sub)tree into ``out``: ``{"/ns/name": value}``; an empty
+    namespace is a leaf of value ``{}``."""
     if isinstance(value, dict) and value:
         for key, item in value.items():
-            _flatten(f"{prefix}/{key}", item, out)
+            flatten_params(f"{prefix}/{key}", item, out)
     else:
         out[prefix or "/"] = value
