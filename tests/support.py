@@ -52,6 +52,36 @@ def require_reference() -> None:
     pytest.skip("Debian's ROS 1 reference is not installed")
 
 
+@functools.cache
+def tf_reference_available() -> bool:
+    """Whether Debian's tf2_py, tf2_ros, tf and tf2_geometry_msgs are installed."""
+    if not os.path.exists(REFERENCE_PYTHON):
+        return False
+    probe = subprocess.run(
+        [REFERENCE_PYTHON, "-c", "import tf2_py, tf2_ros, tf.transformations, tf2_geometry_msgs"],
+        env=reference_env({}), capture_output=True, timeout=60)
+    return probe.returncode == 0
+
+
+def require_tf_reference() -> None:
+    """Skip when Debian's tf packages are absent locally; in CI their absence is a failure."""
+    if tf_reference_available():
+        return
+    if IN_CI:
+        pytest.fail("Debian's python3-tf2-ros/python3-tf/python3-tf2-geometry-msgs are not "
+                    "installed (scripts/install-ros-reference.sh)")
+    pytest.skip("Debian's python3-tf2-ros/python3-tf are not installed")
+
+
+def run_python(code: str, env_extra: Dict[str, str]) -> subprocess.CompletedProcess:
+    """``code`` run by minros's interpreter in a fresh process (no PYTHONPATH, plus ``env_extra``)."""
+    env = dict(os.environ)
+    env.pop("PYTHONPATH", None)
+    env.update(env_extra)
+    return subprocess.run([PYTHON, "-c", code], capture_output=True, text=True, env=env,
+                          timeout=60)
+
+
 def free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind(("127.0.0.1", 0))

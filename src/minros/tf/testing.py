@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import selectors
 import subprocess
 from typing import Any, Dict, List, Sequence
@@ -223,15 +222,6 @@ class TfOracle:
             self.proc.kill()
             self.proc.wait(5)
         self._selector.close()
-
-
-def reference_environment() -> Dict[str, str]:
-    """os.environ without the venv and PYTHONPATH, for Debian's interpreter."""
-    env = dict(os.environ)
-    for key in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME"):
-        env.pop(key, None)
-    env["PATH"] = "/usr/bin:/bin:/usr/sbin:/sbin"
-    return env
 
 
 def _stamped(parent: str, child: str, t: Sequence[int], xyz: Sequence[float],
