@@ -3,7 +3,8 @@
 Used by minros's own tests and benchmarks (and usable by anyone testing code that handles
 messages). Importing this module needs ``hypothesis`` only when a strategy is requested.
 
-The genpy oracle is a small script run by Debian's ``/usr/bin/python3``: it reads one JSON
+The genpy oracle is a small script run by Debian's ``/usr/bin/python3``
+(:class:`ReferenceProcess`, which minros.tf.testing's oracle uses too): it reads one JSON
 request per line (``{"op": "ser", "type": ..., "value": ...}`` or ``{"op": "de", "type": ...,
 "hex": ...}``) and answers one JSON line, so one long-lived process serves a whole test run.
 """
@@ -188,14 +189,16 @@ for line in sys.stdin:
 '''
 
 
-class GenpyOracle:
-    """One long-lived ``/usr/bin/python3`` process answering genpy (de)serialization requests."""
+class ReferenceProcess:
+    """One long-lived process (by default Debian's ``/usr/bin/python3``) running ``script``,
+    which answers each JSON line it reads with one JSON line; ``name`` is what errors call it."""
 
-    def __init__(self, python: str = "/usr/bin/python3", env: Dict[str, str] | None = None,
-                 timeout: float = 30.0) -> None:
+    def __init__(self, script: str, name: str, python: str = "/usr/bin/python3",
+                 env: Dict[str, str] | None = None, timeout: float = 30.0) -> None:
+        self.name = name
         self.timeout = timeout
         self.proc = subprocess.Popen(
-            [python, "-c", GENPY_ORACLE], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            [python, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL, env=env, text=True, bufsize=1)
         self._selector = selectors.DefaultSelector()
         self._selector.register(self.proc.stdout, selectors.EVENT_READ)
@@ -205,11 +208,29 @@ class GenpyOracle:
         self.proc.stdin.write(json.dumps(req) + "\n")
         self.proc.stdin.flush()
         if not self._selector.select(self.timeout):
-            raise TimeoutError(f"genpy oracle did not answer within {self.timeout} s")
+            raise TimeoutError(f"{self.name} did not answer within {self.timeout} s")
         line = self.proc.stdout.readline()
         if not line:
-            raise RuntimeError("genpy oracle exited")
+            raise RuntimeError(f"{self.name} exited")
         return json.loads(line)
+
+    def close(self) -> None:
+        try:
+            if self.proc.stdin:
+                self.proc.stdin.close()
+            self.proc.wait(5)
+        except (OSError, subprocess.TimeoutExpired):
+            self.proc.kill()
+            self.proc.wait(5)
+        self._selector.close()
+
+
+class GenpyOracle(ReferenceProcess):
+    """One long-lived ``/usr/bin/python3`` process answering genpy (de)serialization requests."""
+
+    def __init__(self, python: str = "/usr/bin/python3", env: Dict[str, str] | None = None,
+                 timeout: float = 30.0) -> None:
+        super().__init__(GENPY_ORACLE, "genpy oracle", python, env, timeout)
 
     def serialize(self, type_name: str, msg: Any) -> bytes:
         answer = self.request(op="ser", type=type_name, value=to_plain(msg))
@@ -222,16 +243,6 @@ class GenpyOracle:
         if "error" in answer:
             raise RuntimeError(f"genpy failed on {type_name}: {answer['error']}")
         return answer["value"]
-
-    def close(self) -> None:
-        try:
-            if self.proc.stdin:
-                self.proc.stdin.close()
-            self.proc.wait(5)
-        except (OSError, subprocess.TimeoutExpired):
-            self.proc.kill()
-            self.proc.wait(5)
-        self._selector.close()
 
 
 def bundled_types() -> List[str]:
