@@ -27,10 +27,10 @@ from __future__ import annotations
 import math
 from typing import Any, Dict, List, Sequence
 
-from minros.msgs.testing import ReferenceProcess
+from minros.msgs.testing import ReferenceProcess, reference_script
 
-ORACLE = r'''
-import json, math, sys, time
+ORACLE = reference_script(r'''
+import json, math, sys
 import rospy
 import tf2_py
 import tf.transformations as tft
@@ -111,20 +111,6 @@ def play(actions):
             out.append({"exc": type(exc).__name__, "msg": str(exc)})
     return core, out
 
-def best_rate(fn, seconds):
-    batch, best, deadline = 1, 0.0, time.perf_counter() + seconds
-    while True:
-        t0 = time.perf_counter()
-        for _ in range(batch):
-            fn()
-        elapsed = time.perf_counter() - t0
-        if elapsed > 0:
-            best = max(best, batch / elapsed)
-        if elapsed < 0.01:
-            batch *= 2
-        if time.perf_counter() > deadline:
-            return best
-
 for line in sys.stdin:
     req = json.loads(line)
     try:
@@ -141,14 +127,14 @@ for line in sys.stdin:
             def one_pass():
                 for target, source, t in queries:
                     lookup(target, source, t)
-            out = {"rate": best_rate(one_pass, req["seconds"]) * len(queries)}
+            out = {"rate": best_rate(one_pass, req["seconds"], 0.01) * len(queries)}
         else:
             out = {"error": "unknown op"}
     except Exception as exc:
         out = {"error": "%s: %s" % (type(exc).__name__, exc)}
     sys.stdout.write(json.dumps(out) + "\n")
     sys.stdout.flush()
-'''
+''')
 
 
 def _plain(value: Any) -> Any:
