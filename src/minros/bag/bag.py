@@ -93,11 +93,11 @@ class Bag:
         self._topic_conn: Dict[str, int] = {}
         self._closed = False
         if mode == "r":
-            self._reader = _open_reader(self._filename, allow_unindexed)
+            self._reader = open_reader(self._filename, allow_unindexed)
             self._version = self._reader.version
         elif mode == "w":
             self._version = 200
-            self._writer = _open_writer(self._filename, compression, chunk_threshold)
+            self._writer = open_writer(self._filename, compression, chunk_threshold)
         else:
             self._version = 200
             self._open_append(allow_unindexed)
@@ -166,7 +166,7 @@ class Bag:
             if self._writer.connections:
                 raise ROSBagException("set the compression before writing the first message")
             self._writer.abort()
-            self._writer = _open_writer(self._filename, compression, self._chunk_threshold)
+            self._writer = open_writer(self._filename, compression, self._chunk_threshold)
         self._compression = compression
 
     compression = property(_get_compression, _set_compression)
@@ -220,14 +220,9 @@ class Bag:
         return counts
 
     def _time_range(self) -> Optional[tuple]:
-        if self._reader is not None and hasattr(self._reader, "start"):
-            if not any(self._counts().values()):
-                return None
-            return self._reader.start, self._reader.end
-        chunks = [c for c in self._chunk_summaries() if c.counts]
-        if not chunks:
-            return None
-        return min(c.start for c in chunks), max(c.end for c in chunks)
+        if self._reader is not None:
+            return self._reader.time_range()
+        return bag1.chunks_time_range(self._chunk_summaries())
 
     def _get_connections(self, topics: Any = None,
                          connection_filter: Optional[Callable] = None) -> Iterator[ConnInfo]:
@@ -497,7 +492,8 @@ def is_mcap(path: str) -> bool:
         return False
 
 
-def _open_reader(path: str, allow_unindexed: bool) -> Any:
+def open_reader(path: str, allow_unindexed: bool) -> Any:
+    """The reader of a bag v2.0 or MCAP file (by its first bytes)."""
     if not os.path.exists(path):
         raise ROSBagException(f"[Errno 2] No such file or directory: '{path}'")
     if is_mcap(path):
@@ -507,7 +503,8 @@ def _open_reader(path: str, allow_unindexed: bool) -> Any:
     return bag1.Bag1Reader(path, allow_unindexed)
 
 
-def _open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
+def open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
+    """A new file's writer: MCAP when the name ends in .mcap (or .mcap.active), else bag v2.0."""
     if path.endswith(".mcap") or path.endswith(".mcap.active"):
         from minros.bag import mcapfile
 

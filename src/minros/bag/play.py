@@ -18,7 +18,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Dict, Iterator, List, Optional, Tuple
 
-from minros.bag.bag import _open_reader
+from minros.bag.bag import open_reader
 from minros.bag.bag1 import ConnInfo
 from minros.bag.errors import ROSBagException
 
@@ -143,7 +143,7 @@ class Player:
         for path in self.opts.bags:
             minros.loginfo(f"Opening {path}")
             try:
-                self.readers.append(_open_reader(path, allow_unindexed=False))
+                self.readers.append(open_reader(path, allow_unindexed=False))
             except ROSBagException as exc:
                 raise ROSBagException(f"Error opening file: {path}: {exc}") from None
 
@@ -183,21 +183,10 @@ class Player:
     # -- the message stream -------------------------------------------------------------
 
     def time_range(self) -> Tuple[int, int]:
-        starts, ends = [], []
-        for reader in self.readers:
-            counts = getattr(reader, "counts", None)
-            if counts is not None:
-                if any(counts.values()):
-                    starts.append(reader.start)
-                    ends.append(reader.end)
-            else:
-                chunks = [c for c in reader.chunks if c.counts]
-                if chunks:
-                    starts.append(min(c.start for c in chunks))
-                    ends.append(max(c.end for c in chunks))
-        if not starts:
+        ranges = [r for r in (reader.time_range() for reader in self.readers) if r is not None]
+        if not ranges:
             return 0, 0
-        return min(starts), max(ends)
+        return min(r[0] for r in ranges), max(r[1] for r in ranges)
 
     def messages(self, start: int, end: Optional[int]) -> Iterator[Tuple[int, int, int, bytes]]:
         """(time, bag index, connection id, bytes) of every selected message, in time order."""

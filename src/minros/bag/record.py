@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Deque, Dict, List, Optional, Tuple
 
 from minros.bag import bag1
+from minros.bag.bag import open_writer
 from minros.bag.errors import Compression
 
 #: a chunk is closed and written out at least this often (seconds) while messages arrive
@@ -172,13 +173,7 @@ class BagSink:
         self.active = self.target + ".active"
         if os.path.exists(self.active):
             os.unlink(self.active)
-        chunk = self.opts.chunksize_kb * 1024
-        if self.target.endswith(".mcap"):
-            from minros.bag import mcapfile
-
-            self.writer = mcapfile.McapWriter(self.active, self.opts.compression, chunk)
-        else:
-            self.writer = bag1.Bag1Writer(self.active, self.opts.compression, chunk)
+        self.writer = open_writer(self.active, self.opts.compression, self.opts.chunksize_kb * 1024)
         self.conn_ids = {}
         self.first_time = None
         self.opened_at = self.chunk_started = time.monotonic()
