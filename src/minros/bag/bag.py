@@ -22,6 +22,7 @@ from minros.bag.errors import (
     ROSBagException,
     ROSBagUnindexedException,
 )
+from minros.names import canonicalize_name
 
 BagMessage = collections.namedtuple("BagMessage", "topic message timestamp")
 BagMessageWithConnectionHeader = collections.namedtuple(
@@ -49,14 +50,6 @@ def _time(ns: int) -> Any:
 
 def _str(value: Any) -> str:
     return value.decode() if isinstance(value, (bytes, bytearray)) else str(value)
-
-
-def _canonical(topic: str) -> str:
-    """rosbag matches topics after roslib.names.canonicalize_name (no doubled or trailing /)."""
-    if not topic or topic == "/":
-        return topic
-    out = "/".join(p for p in topic.split("/") if p)
-    return ("/" + out) if topic.startswith("/") else out
 
 
 class Bag:
@@ -150,8 +143,7 @@ class Bag:
 
     @property
     def size(self) -> int:
-        if self._closed:
-            raise ValueError("I/O operation on closed bag")
+        self._check_open()
         if self._writer is not None:
             return self._writer.tell()
         return os.path.getsize(self._filename)
@@ -179,9 +171,8 @@ class Bag:
             raise ValueError("chunk_threshold must be greater than or equal to zero")
         self.flush()
         self._chunk_threshold = chunk_threshold
-        if self._writer is not None and hasattr(self._writer, "_w"):
-            if isinstance(self._writer, bag1.Bag1Writer):
-                self._writer._w.chunk_threshold = chunk_threshold
+        if isinstance(self._writer, bag1.Bag1Writer):
+            self._writer._w.chunk_threshold = chunk_threshold
 
     chunk_threshold = property(_get_chunk_threshold, _set_chunk_threshold)
 
@@ -227,9 +218,10 @@ class Bag:
     def _get_connections(self, topics: Any = None,
                          connection_filter: Optional[Callable] = None) -> Iterator[ConnInfo]:
         if topics:
-            wanted = {_canonical(t) for t in ([topics] if isinstance(topics, str) else topics)}
+            # rosbag matches topics after roslib.names.canonicalize_name
+            wanted = {canonicalize_name(t) for t in ([topics] if isinstance(topics, str) else topics)}
         for c in self._connections.values():
-            if topics and c.topic not in wanted and _canonical(c.topic) not in wanted:
+            if topics and c.topic not in wanted and canonicalize_name(c.topic) not in wanted:
                 continue
             if connection_filter and not connection_filter(c.topic, c.datatype, c.md5sum,
                                                            c.msg_def, c.header):
