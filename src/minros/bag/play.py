@@ -127,8 +127,8 @@ class Player:
         self.opts = opts
         self.readers: List[Any] = []
         self.publishers: Dict[str, Any] = {}
-        self.classes: Dict[Tuple[int, int], type] = {}
-        self.topic_of: Dict[Tuple[int, int], str] = {}
+        #: (bag index, connection id) -> (publisher, message class, output topic)
+        self.routes: Dict[Tuple[int, int], Tuple[Any, type, str]] = {}
         self.paused = opts.pause
         self.step = False
         self.stop = threading.Event()
@@ -168,8 +168,7 @@ class Player:
                     pub = minros.Publisher(topic, cls, queue_size=self.opts.queue,
                                            latch=conn.latching == "1")
                     self.publishers[topic] = pub
-                self.classes[(i, conn.id)] = pub.data_class
-                self.topic_of[(i, conn.id)] = topic
+                self.routes[(i, conn.id)] = (pub, pub.data_class, topic)
         if self.opts.clock:
             from rosgraph_msgs.msg import Clock
 
@@ -192,7 +191,7 @@ class Player:
         """(time, bag index, connection id, bytes) of every selected message, in time order."""
         streams = []
         for i, reader in enumerate(self.readers):
-            ids = [cid for (b, cid) in self.classes if b == i]
+            ids = [cid for (b, cid) in self.routes if b == i]
             if ids:
                 streams.append(((t, i, cid, data) for cid, t, data, _pos in reader.messages(ids, start, end)))
         return heapq.merge(*streams, key=lambda m: m[0])
@@ -283,6 +282,7 @@ class Player:
         tr.set(start, time.monotonic())
         last_t: Optional[int] = None
         pause_topics = {t if t.startswith("/") else "/" + t for t in self.opts.pause_topics}
+        routes = self.routes
         for t, i, cid, data in itertools.chain((first,), stream):
             if last_t is not None and self.opts.skip_empty is not None and \
                     (t - last_t) / 1e9 > self.opts.skip_empty:
@@ -294,9 +294,9 @@ class Player:
             elif self.stop.is_set():
                 return False
             self.publish_clock(t)
-            pub = self.publishers[self.topic_of[(i, cid)]]
-            pub.publish(self.classes[(i, cid)](data))
-            if self.topic_of[(i, cid)] in pause_topics:
+            pub, cls, topic = routes[(i, cid)]
+            pub.publish(cls(data))
+            if topic in pause_topics:
                 self.paused = True
             self.status(t, *span)
         if last_t is not None:
