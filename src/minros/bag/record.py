@@ -381,9 +381,11 @@ class Recorder:
         if self.queue.new_drops and now - self.last_warn >= WARN_INTERVAL:
             self.queue.take_new_drops()
             self.last_warn = now
-            per_topic = ", ".join(f"{t}: {n}" for t, n in sorted(self.queue.drops.items()))
             self._log("warn", "rosbag record buffer exceeded.  Dropping oldest queued message. "
-                              f"(dropped so far: {per_topic})")
+                              f"(dropped so far: {self._drops_per_topic()})")
+
+    def _drops_per_topic(self) -> str:
+        return ", ".join(f"{t}: {n}" for t, n in sorted(self.queue.drops.items()))
 
     def run(self) -> int:
         import minros
@@ -422,9 +424,8 @@ class Recorder:
         writer.join()
         if self.queue.drops:
             total = sum(self.queue.drops.values())
-            per_topic = ", ".join(f"{t}: {n}" for t, n in sorted(self.queue.drops.items()))
             self._log("warn", f"Dropped {total} messages because the buffer (-b {self.opts.buffsize_mb} MB) "
-                              f"was full: {per_topic}")
+                              f"was full: {self._drops_per_topic()}")
         if self.sink.error:
             self._log("error", self.sink.error)
             return 1
