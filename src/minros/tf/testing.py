@@ -137,6 +137,8 @@ for line in sys.stdin:
 ''')
 
 
+# _plain, _stamped, result_of and play repeat the script's plain, stamped, result_of and
+# run on purpose: the script runs under Debian's interpreter, which cannot import minros.
 def _plain(value: Any) -> Any:
     if hasattr(value, "tolist"):
         value = value.tolist()
