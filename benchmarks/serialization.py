@@ -25,34 +25,12 @@ import json
 import os
 import subprocess
 import sys
-import time
-from typing import Any, Callable, Dict, List, Tuple
+from typing import Any, Dict, List, Tuple
 
 from minros.msgs import Time, get_message_class
-from minros.msgs.testing import GENPY_ORACLE, to_plain
+from minros.msgs.testing import GENPY_ORACLE, best_rate, to_plain
 
 REFERENCE_PYTHON = "/usr/bin/python3"
-
-
-def _rate(fn: Callable[[], Any], seconds: float) -> float:
-    """Calls per second in the fastest batch of about 2 ms within ``seconds``.
-
-    The best batch, not the average, so that other processes on a busy machine (preemption,
-    cache thrashing) distort the figure as little as possible; genpy is measured the same way.
-    """
-    batch, best = 1, 0.0
-    deadline = time.perf_counter() + seconds
-    while True:
-        start = time.perf_counter()
-        for _ in range(batch):
-            fn()
-        elapsed = time.perf_counter() - start
-        if elapsed > 0:
-            best = max(best, batch / elapsed)
-        if elapsed < 0.002:
-            batch *= 2
-        if time.perf_counter() > deadline:
-            return best
 
 
 def cases() -> List[Tuple[str, str, Any]]:
@@ -100,12 +78,12 @@ def minros_rates(msg: Any, seconds: float) -> Tuple[float, float, int]:
     def de() -> None:
         cls().deserialize(data)
 
-    return _rate(ser, seconds), _rate(de, seconds), len(data)
+    return best_rate(ser, seconds), best_rate(de, seconds), len(data)
 
 
 def memcpy_rate(size: int, seconds: float) -> float:
     src = memoryview(os.urandom(size))
-    return _rate(lambda: bytes(src), seconds)
+    return best_rate(lambda: bytes(src), seconds)
 
 
 def worker() -> int:

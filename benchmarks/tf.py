@@ -32,7 +32,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from typing import Any, Callable, List
+from typing import Any, List
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -64,26 +64,9 @@ def chain_script(links: int = 10, samples: int = 100, queries: int = 1000, seed:
     return actions, times
 
 
-def best_rate(fn: Callable[[], Any], seconds: float) -> float:
-    """Calls per second of the fastest ~10 ms batch within ``seconds`` (a shared machine's
-    load distorts the best batch least; the oracle measures the same way)."""
-    batch, best = 1, 0.0
-    deadline = time.perf_counter() + seconds
-    while True:
-        start = time.perf_counter()
-        for _ in range(batch):
-            fn()
-        elapsed = time.perf_counter() - start
-        if elapsed > 0:
-            best = max(best, batch / elapsed)
-        if elapsed < 0.01:
-            batch *= 2
-        if time.perf_counter() > deadline:
-            return best
-
-
 def minros_lookups(actions, times, seconds: float, api: str) -> float:
     import minros
+    from minros.msgs.testing import best_rate
     from minros.tf.buffer import Buffer
     from minros.tf.core import BufferCore
     from minros.tf.testing import play
@@ -97,11 +80,12 @@ def minros_lookups(actions, times, seconds: float, api: str) -> float:
         for t in stamps:
             lookup("f0", "f10", t)
 
-    return best_rate(one_pass, seconds) * len(stamps)
+    return best_rate(one_pass, seconds, 0.01) * len(stamps)
 
 
+# run by Debian's interpreter after minros.msgs.testing.reference_script's best_rate
 BUFFER_BENCH = r'''
-import json, sys, time
+import json, sys
 import rospy, tf2_ros
 from geometry_msgs.msg import TransformStamped
 req = json.loads(sys.stdin.readline())
@@ -118,23 +102,14 @@ stamps = [rospy.Time(s, n) for s, n in req["times"]]
 def one_pass():
     for t in stamps:
         buf.lookup_transform("f0", "f10", t)
-batch, best, deadline = 1, 0.0, time.perf_counter() + req["seconds"]
-while True:
-    t0 = time.perf_counter()
-    for _ in range(batch):
-        one_pass()
-    elapsed = time.perf_counter() - t0
-    best = max(best, batch / elapsed)
-    if elapsed < 0.01:
-        batch *= 2
-    if time.perf_counter() > deadline:
-        break
-print(json.dumps({"rate": best * len(stamps)}))
+print(json.dumps({"rate": best_rate(one_pass, req["seconds"], 0.01) * len(stamps)}))
 '''
 
 
 def debian_buffer_lookups(actions, times, seconds: float, env: dict) -> float:
-    done = subprocess.run([REFERENCE_PYTHON, "-c", BUFFER_BENCH], env=env, capture_output=True,
+    from minros.msgs.testing import reference_script
+
+    done = subprocess.run([REFERENCE_PYTHON, "-c", reference_script(BUFFER_BENCH)], env=env, capture_output=True,
                           text=True, timeout=120,
                           input=json.dumps({"actions": actions, "times": times, "seconds": seconds}) + "\n")
     return json.loads(done.stdout.splitlines()[-1])["rate"]

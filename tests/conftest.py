@@ -19,6 +19,7 @@ from support import (  # noqa: E402
     free_port,
     reference_env,
     require_reference,
+    require_tf_reference,
     ros_env,
     wait_for_master,
 )
@@ -67,6 +68,18 @@ def minros_core(ros_home: Path):
         yield port
     finally:
         proc.stop()
+
+
+@pytest.fixture(scope="module")
+def tf_oracle():
+    """Debian's tf2_py and tf.transformations in one /usr/bin/python3 process
+    (minros.tf.testing.TfOracle), one per test module."""
+    require_tf_reference()
+    from minros.tf.testing import TfOracle
+
+    oracle = TfOracle(env=reference_env({}))
+    yield oracle
+    oracle.close()
 
 
 __all__ = ["PYTHON", "REFERENCE_PYTHON", "Proc", "free_port", "reference_env", "ros_env"]

@@ -30,17 +30,19 @@ IN_CI = bool(os.environ.get("CI"))
 
 
 @functools.cache
-def reference_available() -> bool:
-    """Whether Debian's ROS 1 (rospy, rosmaster, genpy, tools) is installed."""
+def reference_imports(modules: str) -> bool:
+    """Whether Debian's interpreter imports ``modules`` ("a, b.c, ...")."""
     if not os.path.exists(REFERENCE_PYTHON):
         return False
-    probe = subprocess.run(
-        [REFERENCE_PYTHON, "-c", "import rospy, rosmaster, genpy, std_msgs.msg"],
-        env=reference_env({}),
-        capture_output=True,
-        timeout=60,
-    )
-    return probe.returncode == 0 and os.path.exists("/usr/bin/rostopic")
+    probe = subprocess.run([REFERENCE_PYTHON, "-c", f"import {modules}"], env=reference_env({}),
+                           capture_output=True, timeout=60)
+    return probe.returncode == 0
+
+
+def reference_available() -> bool:
+    """Whether Debian's ROS 1 (rospy, rosmaster, genpy, tools) is installed."""
+    return (reference_imports("rospy, rosmaster, genpy, std_msgs.msg")
+            and os.path.exists("/usr/bin/rostopic"))
 
 
 def require_reference() -> None:
@@ -50,6 +52,25 @@ def require_reference() -> None:
     if IN_CI:
         pytest.fail("Debian's ROS 1 reference is not installed (scripts/install-ros-reference.sh)")
     pytest.skip("Debian's ROS 1 reference is not installed")
+
+
+def require_tf_reference() -> None:
+    """Skip when Debian's tf packages are absent locally; in CI their absence is a failure."""
+    if reference_imports("tf2_py, tf2_ros, tf.transformations, tf2_geometry_msgs"):
+        return
+    if IN_CI:
+        pytest.fail("Debian's python3-tf2-ros/python3-tf/python3-tf2-geometry-msgs are not "
+                    "installed (scripts/install-ros-reference.sh)")
+    pytest.skip("Debian's python3-tf2-ros/python3-tf are not installed")
+
+
+def run_python(code: str, env_extra: Dict[str, str]) -> subprocess.CompletedProcess:
+    """``code`` run by minros's interpreter in a fresh process (no PYTHONPATH, plus ``env_extra``)."""
+    env = dict(os.environ)
+    env.pop("PYTHONPATH", None)
+    env.update(env_extra)
+    return subprocess.run([PYTHON, "-c", code], capture_output=True, text=True, env=env,
+                          timeout=60)
 
 
 def free_port() -> int:

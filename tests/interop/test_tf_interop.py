@@ -19,32 +19,19 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from minros.tf.core import BufferCore
-from minros.tf.testing import TfOracle, play, reference_environment
-from support import IN_CI, PYTHON, REFERENCE_PYTHON, Proc, reference_env, require_reference, ros_env
+from minros.tf.testing import play
+from support import (
+    IN_CI,
+    PYTHON,
+    REFERENCE_PYTHON,
+    Proc,
+    reference_env,
+    require_tf_reference,
+    ros_env,
+)
 from tf import transformations as T
 
 pytestmark = pytest.mark.interop
-
-
-def require_tf_reference() -> None:
-    require_reference()
-    import subprocess
-
-    probe = subprocess.run([REFERENCE_PYTHON, "-c", "import tf2_py, tf2_ros, tf"],
-                           env=reference_environment(), capture_output=True, timeout=60)
-    if probe.returncode != 0:
-        if IN_CI:
-            pytest.fail("Debian's python3-tf2-ros/python3-tf are not installed "
-                        "(scripts/install-ros-reference.sh)")
-        pytest.skip("Debian's python3-tf2-ros is not installed")
-
-
-@pytest.fixture(scope="module")
-def oracle():
-    require_tf_reference()
-    o = TfOracle(env=reference_environment())
-    yield o
-    o.close()
 
 
 def assert_same(ours, theirs, actions):
@@ -134,12 +121,12 @@ def scenarios(draw):
 @settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
                                                                     HealthCheck.too_slow])
 @given(actions=scenarios())
-def test_buffer_core_matches_debian_on_random_trees(oracle, actions):
+def test_buffer_core_matches_debian_on_random_trees(tf_oracle, actions):
     ours = play(BufferCore(log=lambda level, text: None), actions)
-    assert_same(ours, oracle.play(actions), actions)
+    assert_same(ours, tf_oracle.play(actions), actions)
 
 
-def test_each_exception_class_at_the_same_requests(oracle):
+def test_each_exception_class_at_the_same_requests(tf_oracle):
     q = unit_quaternion([0.1, 0.2, 0.3, 0.9])
     actions = [
         ["set", "world", "a", [10, 0], [1, 2, 3], q, "/me", False],
@@ -171,7 +158,7 @@ def test_each_exception_class_at_the_same_requests(oracle):
         ["yaml"], ["string"],
     ]
     ours = play(BufferCore(log=lambda level, text: None), actions)
-    theirs = oracle.play(actions)
+    theirs = tf_oracle.play(actions)
     assert_same(ours, theirs, actions)
     classes = {r.get("exc") for r in theirs}
     assert {"ExtrapolationException", "ConnectivityException", "LookupException",

@@ -4,12 +4,11 @@ action/ import as <pkg>.msg, and catkin_make's add_action_files."""
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+
+from support import run_python
 
 SUFFIXES = ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result", "Feedback")
 FIBONACCI = "#goal definition\nint32 order\n---\n#result definition\nint32[] sequence\n---\n#feedback\nint32[] sequence\n"
@@ -49,20 +48,12 @@ def test_known_md5_sums_of_the_bundled_actions() -> None:
     assert m.TwoIntsActionGoal._md5sum == "684a2db55d6ffb8046fb9d6764ce0860"
 
 
-def _run(code: str, env_extra: dict) -> subprocess.CompletedProcess:
-    env = dict(os.environ)
-    env.pop("PYTHONPATH", None)
-    env.update(env_extra)
-    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
-                          timeout=60)
-
-
 def test_package_with_only_actions_imports_as_msg(tmp_path: Path) -> None:
     _action_package(tmp_path / "src", "actionlib_tutorials", {"Fibonacci": FIBONACCI})
-    out = _run("import rospy\nfrom actionlib_tutorials.msg import FibonacciAction, FibonacciGoal\n"
-               "import actionlib_tutorials.msg as m\n"
-               "print(FibonacciAction._md5sum, FibonacciGoal(order=3).order, len(m.__all__))\n",
-               {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    out = run_python("import rospy\nfrom actionlib_tutorials.msg import FibonacciAction, FibonacciGoal\n"
+                     "import actionlib_tutorials.msg as m\n"
+                     "print(FibonacciAction._md5sum, FibonacciGoal(order=3).order, len(m.__all__))\n",
+                     {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
     assert out.returncode == 0, out.stderr
     # the md5 sum ROS gives actionlib_tutorials/FibonacciAction
     assert out.stdout == "f59df5767bf7634684781c92598b2406 3 7\n"
@@ -79,8 +70,8 @@ def test_catkin_make_add_action_files(tmp_path: Path) -> None:
     assert (f"Generating .msg files for action actionlib_tutorials/Fibonacci "
             f"{pkg / 'action' / 'Fibonacci.action'}") in lines
     devel = ws / "devel" / "lib" / "python3" / "dist-packages"
-    out = _run("from actionlib_tutorials.msg import FibonacciActionFeedback as F\nprint(F._type)",
-               {"PYTHONPATH": str(devel), "ROS_PACKAGE_PATH": str(ws / "src")})
+    out = run_python("from actionlib_tutorials.msg import FibonacciActionFeedback as F\nprint(F._type)",
+                     {"PYTHONPATH": str(devel), "ROS_PACKAGE_PATH": str(ws / "src")})
     assert out.returncode == 0, out.stderr
     assert out.stdout == "actionlib_tutorials/FibonacciActionFeedback\n"
     (pkg / "action" / "Broken.action").write_text("int32 order\n---\nint32[] sequence\n")

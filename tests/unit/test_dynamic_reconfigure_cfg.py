@@ -3,7 +3,6 @@ line, the import hook, catkin_make; the configuration <-> message encoding as pu
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -12,6 +11,7 @@ import pytest
 
 from minros.dynamic_reconfigure import encoding
 from minros.dynamic_reconfigure.generator import CfgError, module_namespace, run_cfg
+from support import run_python
 
 #: the dynamic_reconfigure wiki tutorial's .cfg (tests/examples/library_tutorials)
 TUTORIAL_CFG = (Path(__file__).resolve().parent.parent / "examples" / "library_tutorials"
@@ -121,14 +121,6 @@ def test_running_a_cfg_by_hand_says_how_it_is_used(tmp_path: Path) -> None:
     assert out.stderr.startswith("ahhhh! Unexpected command line syntax!")
 
 
-def _run(code: str, env_extra: dict) -> subprocess.CompletedProcess:
-    env = dict(os.environ)
-    env.pop("PYTHONPATH", None)
-    env.update(env_extra)
-    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
-                          timeout=60)
-
-
 def test_import_hook_serves_cfg_modules(tmp_path: Path) -> None:
     _package(tmp_path / "src", "dynamic_tutorials", {"Tutorials": TUTORIAL_CFG})
     _package(tmp_path / "src", "other_pkg", {"Named": GROUPS_CFG})  # generates GroupsConfig
@@ -145,7 +137,7 @@ def test_import_hook_serves_cfg_modules(tmp_path: Path) -> None:
         "except ImportError as exc:\n"
         "    print('missing:', exc)\n"
     )
-    out = _run(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    out = run_python(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
     assert lines[0] == "Hello World 2 64"
@@ -155,9 +147,9 @@ def test_import_hook_serves_cfg_modules(tmp_path: Path) -> None:
 def test_import_of_a_broken_cfg_raises_one_line_import_error(tmp_path: Path) -> None:
     broken = TUTORIAL_CFG.replace('"Hello World")', '"Hello World", 1, 2)')
     pkg = _package(tmp_path / "src", "broken_pkg", {"Tutorials": broken})
-    out = _run("import rospy\ntry:\n    from broken_pkg.cfg import TutorialsConfig\n"
-               "except ImportError as exc:\n    print(type(exc).__name__, exc)\n",
-               {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    out = run_python("import rospy\ntry:\n    from broken_pkg.cfg import TutorialsConfig\n"
+                     "except ImportError as exc:\n    print(type(exc).__name__, exc)\n",
+                     {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
     assert out.returncode == 0, out.stderr
     assert out.stdout == (f"ImportError {pkg / 'cfg' / 'Tutorials.cfg'}:10: Exception: Max or min "
                           "specified for str_param, which is of 'str' type\n")
@@ -175,8 +167,8 @@ def test_catkin_make_checks_cfg_and_writes_modules(tmp_path: Path) -> None:
     # the devel module reruns the .cfg on import: an edit needs no rebuild
     (pkg / "cfg" / "Tutorials.cfg").write_text(TUTORIAL_CFG.replace("50,  0, 100", "42,  0, 100"))
     env = {"PYTHONPATH": str(devel), "ROS_PACKAGE_PATH": ""}
-    out = _run("from dynamic_tutorials.cfg import TutorialsConfig as T\nprint(T.defaults['int_param'])",
-               env)
+    out = run_python("from dynamic_tutorials.cfg import TutorialsConfig as T\nprint(T.defaults['int_param'])",
+                     env)
     assert out.returncode == 0, out.stderr
     assert out.stdout == "42\n"
     (pkg / "cfg" / "Tutorials.cfg").write_text(TUTORIAL_CFG.replace('"Hello World")', '"Hi", 1)'))

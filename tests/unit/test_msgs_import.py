@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 from minros.msgs import write_stub_package
+from support import run_python
 
 
 def _make_package(root: Path, name: str = "my_pkg") -> Path:
@@ -19,14 +17,6 @@ def _make_package(root: Path, name: str = "my_pkg") -> Path:
     (pkg / "msg" / "Pair.msg").write_text("Num a\nNum b\n")
     (pkg / "srv" / "AddTwo.srv").write_text("int64 a\nint64 b\n---\nint64 sum\n")
     return pkg
-
-
-def _run(code: str, env_extra: dict) -> subprocess.CompletedProcess:
-    env = dict(os.environ)
-    env.pop("PYTHONPATH", None)
-    env.update(env_extra)
-    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          env=env, timeout=60)
 
 
 def test_import_hook_finds_user_packages(tmp_path: Path) -> None:
@@ -42,7 +32,7 @@ def test_import_hook_finds_user_packages(tmp_path: Path) -> None:
         "assert Pair._type == 'my_pkg/Pair' and sorted(m.__all__) == ['Num', 'Pair']\n"
         "print(Num._type, AddTwo._md5sum)\n"
     )
-    out = _run(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    out = run_python(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
     assert out.returncode == 0, out.stderr
     # same text as rospy_tutorials/AddTwoInts, so the same md5 sum
     assert out.stdout.split() == ["my_pkg/Num", "6a2e34150c00229791cc89ff309fff21"]
@@ -64,7 +54,7 @@ def test_import_hook_leaves_other_imports_alone(tmp_path: Path) -> None:
         "except ImportError as exc:\n"
         "    print('ok', exc)\n"
     )
-    out = _run(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    out = run_python(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
     assert out.returncode == 0, out.stderr
     assert out.stdout.startswith("ok cannot import name 'Missing'")
 
@@ -84,7 +74,7 @@ def test_write_stub_package(tmp_path: Path) -> None:
     # the stubs work without the import hook having been installed first
     code = ("from my_pkg.msg import Num\nfrom my_pkg.srv import AddTwoRequest\n"
             "print(Num.__module__, AddTwoRequest._type)\n")
-    out = _run(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src"), "PYTHONPATH": str(devel)})
+    out = run_python(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src"), "PYTHONPATH": str(devel)})
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["my_pkg.msg", "my_pkg/AddTwoRequest"]
 
@@ -94,7 +84,7 @@ def test_bundled_stub_packages_import_without_ros() -> None:
             "from turtlesim.srv import Spawn, SpawnRequest\nfrom rospy_tutorials.srv import AddTwoInts\n"
             "from sensor_msgs.msg import Image\nfrom rosgraph_msgs.msg import Clock, Log\n"
             "import io; b = io.BytesIO(); String('x').serialize(b); print(b.getvalue().hex())\n")
-    out = _run(code, {"ROS_PACKAGE_PATH": ""})
+    out = run_python(code, {"ROS_PACKAGE_PATH": ""})
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "0100000078"
 

@@ -9,8 +9,7 @@ import sys
 
 import pytest
 
-from minros.tf.testing import reference_environment
-from support import IN_CI, REFERENCE_PYTHON
+from support import REFERENCE_PYTHON, reference_env, require_tf_reference
 
 SCRIPT = r'''
 import json, math
@@ -143,13 +142,8 @@ def test_tf1_api_answers(ours):
 
 
 def test_tf1_and_tf2_geometry_msgs_match_debian(ours):
-    probe = subprocess.run([REFERENCE_PYTHON, "-c", "import tf, tf2_ros, tf2_geometry_msgs"],
-                           env=reference_environment(), capture_output=True, timeout=60)
-    if probe.returncode != 0:
-        if IN_CI:
-            pytest.fail("Debian's python3-tf/python3-tf2-geometry-msgs are not installed")
-        pytest.skip("Debian's python3-tf is not installed")
-    theirs = run(REFERENCE_PYTHON, reference_environment())
+    require_tf_reference()
+    theirs = run(REFERENCE_PYTHON, reference_env({}))
     assert set(ours) == set(theirs)
     for key in theirs:
         assert close(ours[key], theirs[key]), (key, ours[key], theirs[key])

@@ -39,16 +39,8 @@ from .states import (
     GoalStatusCodes,
     SimpleGoalState,
     TerminalState,
+    get_name_of_constant,
 )
-
-
-def get_name_of_constant(C: type, n: int) -> str:
-    """The name of the state constant of class ``C`` whose value is ``n``."""
-    for name, value in vars(C).items():
-        if name.isupper() and isinstance(value, int) and not isinstance(value, bool) and value == n:
-            return name
-    return f"NO_SUCH_STATE_{n}"
-
 
 # actionlib adds to_string to GoalStatus, and code logs states with it
 GoalStatus.to_string = classmethod(lambda cls, n: GoalStatusCodes.to_string(n))

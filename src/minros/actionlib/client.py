@@ -337,7 +337,7 @@ class ActionClient:
     def _connected_to(self, server_id: str) -> bool:
         """Whether goal/cancel reach ``server_id`` and result/feedback come from it."""
         for pub in (self.pub_goal, self.pub_cancel):
-            if server_id not in _subscriber_ids(pub):
+            if server_id not in _peers(pub):
                 return False
         uri, looked_up = self._server_uris.get(server_id, (None, 0.0))
         if uri is None or not self._results_from(uri):
@@ -349,7 +349,7 @@ class ActionClient:
         return uri is not None and self._results_from(uri)
 
     def _results_from(self, uri: str) -> bool:
-        return all(uri in _publisher_uris(sub) for sub in (self.result_sub, self.feedback_sub))
+        return all(uri in _peers(sub) for sub in (self.result_sub, self.feedback_sub))
 
     def _status_cb(self, msg: Any) -> None:
         self.last_status_msg = msg
@@ -371,16 +371,11 @@ def _duration(value: Any) -> Any:
     return value
 
 
-# The connection lists come from getBusInfo's rows (connection id, peer, direction, ...): for a
-# publisher the peer is the subscriber's caller id, for a subscriber the publisher's XML-RPC URI.
-
-def _subscriber_ids(pub: Any) -> set:
-    impl = getattr(pub, "impl", None)
-    return {row[1] for row in impl.get_stats_info()} if impl is not None else set()
-
-
-def _publisher_uris(sub: Any) -> set:
-    impl = getattr(sub, "impl", None)
+def _peers(topic: Any) -> set:
+    """The peers of a Publisher or Subscriber, from its getBusInfo rows (connection id, peer,
+    direction, ...): for a publisher the subscribers' caller ids, for a subscriber the
+    publishers' XML-RPC URIs."""
+    impl = getattr(topic, "impl", None)
     return {row[1] for row in impl.get_stats_info()} if impl is not None else set()
 
 

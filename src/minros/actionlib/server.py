@@ -93,6 +93,18 @@ class ServerGoalHandle:
         goal_id = self.get_goal_id()
         return f"id: {goal_id.id}, stamp: {goal_id.stamp.to_sec():.2f}"
 
+    def _move(self, operation: str, text: str) -> Any:
+        """Apply ``operation`` to the goal's status (the caller holds the server's lock): the
+        status, or None (after actionlib's error line) when the goal cannot take it."""
+        status = self.status_tracker.status
+        new = server_transition(operation, status.status)
+        if new is None:
+            minros.logerr(SERVER_REFUSALS[operation], status.status)
+            return None
+        status.status = new
+        status.text = text
+        return status
+
     def _finish(self, operation: str, result: Any, text: str) -> None:
         """Move the goal to a terminal status and publish its result."""
         if not self.goal:
@@ -101,15 +113,10 @@ class ServerGoalHandle:
         if not result:
             result = self.get_default_result()
         with self.action_server.lock:
-            status = self.status_tracker.status
-            new = server_transition(operation, status.status)
-            if new is None:
-                minros.logerr(SERVER_REFUSALS[operation], status.status)
-                return
-            status.status = new
-            status.text = text
-            self.status_tracker.handle_destruction_time = minros.Time.now()
-            self.action_server.publish_result(status, result)
+            status = self._move(operation, text)
+            if status is not None:
+                self.status_tracker.handle_destruction_time = minros.Time.now()
+                self.action_server.publish_result(status, result)
 
     def set_accepted(self, text: str = "") -> None:
         """PENDING -> ACTIVE, or RECALLING -> PREEMPTING if a cancel came first."""
@@ -118,14 +125,8 @@ class ServerGoalHandle:
             minros.logerr("Attempt to set status on an uninitialized ServerGoalHandle")
             return
         with self.action_server.lock:
-            status = self.status_tracker.status
-            new = server_transition("accept", status.status)
-            if new is None:
-                minros.logerr(SERVER_REFUSALS["accept"], status.status)
-                return
-            status.status = new
-            status.text = text
-            self.action_server.publish_status()
+            if self._move("accept", text) is not None:
+                self.action_server.publish_status()
 
     def set_canceled(self, result: Any = None, text: str = "") -> None:
         """RECALLED if the goal never ran, PREEMPTED if it was running."""

@@ -13,15 +13,18 @@ from __future__ import annotations
 from typing import Dict, Tuple, Union
 
 
+def get_name_of_constant(C: type, n: int) -> str:
+    """The name of the state constant of class ``C`` whose value is ``n``."""
+    for name, value in vars(C).items():
+        if name.isupper() and isinstance(value, int) and not isinstance(value, bool) and value == n:
+            return name
+    return f"NO_SUCH_STATE_{n}"
+
+
 class _Named:
     """Integer constants with ``to_string(value)``, as actionlib's state classes offer."""
 
-    @classmethod
-    def to_string(cls, value: int) -> str:
-        for name, constant in vars(cls).items():
-            if name.isupper() and isinstance(constant, int) and constant == value:
-                return name
-        return f"NO_SUCH_STATE_{value}"
+    to_string = classmethod(get_name_of_constant)
 
 
 class GoalStatusCodes(_Named):

@@ -22,6 +22,7 @@ from minros.bag.errors import (
     ROSBagException,
     ROSBagUnindexedException,
 )
+from minros.names import canonicalize_name
 
 BagMessage = collections.namedtuple("BagMessage", "topic message timestamp")
 BagMessageWithConnectionHeader = collections.namedtuple(
@@ -49,14 +50,6 @@ def _time(ns: int) -> Any:
 
 def _str(value: Any) -> str:
     return value.decode() if isinstance(value, (bytes, bytearray)) else str(value)
-
-
-def _canonical(topic: str) -> str:
-    """rosbag matches topics after roslib.names.canonicalize_name (no doubled or trailing /)."""
-    if not topic or topic == "/":
-        return topic
-    out = "/".join(p for p in topic.split("/") if p)
-    return ("/" + out) if topic.startswith("/") else out
 
 
 class Bag:
@@ -93,11 +86,11 @@ class Bag:
         self._topic_conn: Dict[str, int] = {}
         self._closed = False
         if mode == "r":
-            self._reader = _open_reader(self._filename, allow_unindexed)
+            self._reader = open_reader(self._filename, allow_unindexed)
             self._version = self._reader.version
         elif mode == "w":
             self._version = 200
-            self._writer = _open_writer(self._filename, compression, chunk_threshold)
+            self._writer = open_writer(self._filename, compression, chunk_threshold)
         else:
             self._version = 200
             self._open_append(allow_unindexed)
@@ -150,8 +143,7 @@ class Bag:
 
     @property
     def size(self) -> int:
-        if self._closed:
-            raise ValueError("I/O operation on closed bag")
+        self._check_open()
         if self._writer is not None:
             return self._writer.tell()
         return os.path.getsize(self._filename)
@@ -166,7 +158,7 @@ class Bag:
             if self._writer.connections:
                 raise ROSBagException("set the compression before writing the first message")
             self._writer.abort()
-            self._writer = _open_writer(self._filename, compression, self._chunk_threshold)
+            self._writer = open_writer(self._filename, compression, self._chunk_threshold)
         self._compression = compression
 
     compression = property(_get_compression, _set_compression)
@@ -179,9 +171,8 @@ class Bag:
             raise ValueError("chunk_threshold must be greater than or equal to zero")
         self.flush()
         self._chunk_threshold = chunk_threshold
-        if self._writer is not None and hasattr(self._writer, "_w"):
-            if isinstance(self._writer, bag1.Bag1Writer):
-                self._writer._w.chunk_threshold = chunk_threshold
+        if isinstance(self._writer, bag1.Bag1Writer):
+            self._writer._w.chunk_threshold = chunk_threshold
 
     chunk_threshold = property(_get_chunk_threshold, _set_chunk_threshold)
 
@@ -220,21 +211,17 @@ class Bag:
         return counts
 
     def _time_range(self) -> Optional[tuple]:
-        if self._reader is not None and hasattr(self._reader, "start"):
-            if not any(self._counts().values()):
-                return None
-            return self._reader.start, self._reader.end
-        chunks = [c for c in self._chunk_summaries() if c.counts]
-        if not chunks:
-            return None
-        return min(c.start for c in chunks), max(c.end for c in chunks)
+        if self._reader is not None:
+            return self._reader.time_range()
+        return bag1.chunks_time_range(self._chunk_summaries())
 
     def _get_connections(self, topics: Any = None,
                          connection_filter: Optional[Callable] = None) -> Iterator[ConnInfo]:
         if topics:
-            wanted = {_canonical(t) for t in ([topics] if isinstance(topics, str) else topics)}
+            # rosbag matches topics after roslib.names.canonicalize_name
+            wanted = {canonicalize_name(t) for t in ([topics] if isinstance(topics, str) else topics)}
         for c in self._connections.values():
-            if topics and c.topic not in wanted and _canonical(c.topic) not in wanted:
+            if topics and c.topic not in wanted and canonicalize_name(c.topic) not in wanted:
                 continue
             if connection_filter and not connection_filter(c.topic, c.datatype, c.md5sum,
                                                            c.msg_def, c.header):
@@ -497,7 +484,8 @@ def is_mcap(path: str) -> bool:
         return False
 
 
-def _open_reader(path: str, allow_unindexed: bool) -> Any:
+def open_reader(path: str, allow_unindexed: bool) -> Any:
+    """The reader of a bag v2.0 or MCAP file (by its first bytes)."""
     if not os.path.exists(path):
         raise ROSBagException(f"[Errno 2] No such file or directory: '{path}'")
     if is_mcap(path):
@@ -507,7 +495,8 @@ def _open_reader(path: str, allow_unindexed: bool) -> Any:
     return bag1.Bag1Reader(path, allow_unindexed)
 
 
-def _open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
+def open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
+    """A new file's writer: MCAP when the name ends in .mcap (or .mcap.active), else bag v2.0."""
     if path.endswith(".mcap") or path.endswith(".mcap.active"):
         from minros.bag import mcapfile
 

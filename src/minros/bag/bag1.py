@@ -91,6 +91,14 @@ class ChunkSummary:
     uncompressed_size: int = 0
 
 
+def chunks_time_range(chunks: List[ChunkSummary]) -> Optional[Tuple[int, int]]:
+    """(first, last) receive time in ns of the messages in ``chunks``; None if they have none."""
+    full = [c for c in chunks if c.counts]
+    if not full:
+        return None
+    return min(c.start for c in full), max(c.end for c in full)
+
+
 def ros1_type(msgtype: str) -> str:
     """``std_msgs/msg/String`` (rosbags' spelling) -> ``std_msgs/String``."""
     return denormalize_msgtype(msgtype) if "/msg/" in msgtype else msgtype
@@ -354,6 +362,10 @@ class Bag1Reader:
             compression, size, datasize = r.chunk_meta.get(info.pos, (Compression.NONE, 0, 0))
             self.chunks.append(ChunkSummary(info.pos, info.start_time, info.end_time - 1,
                                             dict(info.connection_counts), compression, datasize, size))
+
+    def time_range(self) -> Optional[Tuple[int, int]]:
+        """(first, last) receive time in ns of the bag's messages; None if it has none."""
+        return chunks_time_range(self.chunks)
 
     def reindex(self, progress: Optional[Callable[[int], None]] = None) -> ScanResult:
         scan = scan_chunks(self.path, progress)

@@ -100,6 +100,10 @@ class McapReader:
 
     index_loaded = True
 
+    def time_range(self) -> Optional[Tuple[int, int]]:
+        """(first, last) log time in ns of the file's messages; None if it has none."""
+        return (self.start, self.end) if any(self.counts.values()) else None
+
     def index_times(self, conn_ids: List[int]) -> List[int]:
         return [t for _c, t, _d, _p in self.messages(conn_ids, None, None)]
 

@@ -19,6 +19,14 @@ def _err(text: str) -> None:
     print(text, file=sys.stderr)
 
 
+def _read_error(path: str, exc: Exception) -> None:
+    """rosbag's line for a bag it could not read: unindexed ones are told to reindex."""
+    if isinstance(exc, ROSBagUnindexedException):
+        _err(f"ERROR bag unindexed: {path}.  Run rosbag reindex.")
+    else:
+        _err(f"ERROR reading {path}: {exc}")
+
+
 def info(paths: List[str], yaml: bool = False, key: Optional[str] = None,
          freq: bool = False) -> int:
     for i, path in enumerate(paths):
@@ -35,16 +43,10 @@ def info(paths: List[str], yaml: bool = False, key: Optional[str] = None,
                 bag.close()
             if i < len(paths) - 1:
                 print("---")
-        except ROSBagUnindexedException:
-            _err(f"ERROR bag unindexed: {path}.  Run rosbag reindex.")
-            return 1
-        except ROSBagException as exc:
-            _err(f"ERROR reading {path}: {exc}")
-            return 1
         except BrokenPipeError:
             raise
-        except OSError as exc:
-            _err(f"ERROR reading {path}: {exc}")
+        except (ROSBagException, OSError) as exc:
+            _read_error(path, exc)
             return 1
     return 0
 
@@ -69,8 +71,8 @@ def filter_bag(inbag_path: str, outbag_path: str, expr: str,
         keep = compile_expression(expr)
         show = compile_expression(print_expr, "print expression") if print_expr else None
         inbag = Bag(inbag_path)
-    except ROSBagUnindexedException:
-        _err(f"ERROR bag unindexed: {inbag_path}.  Run rosbag reindex.")
+    except ROSBagUnindexedException as exc:
+        _read_error(inbag_path, exc)
         return 1
     except ROSBagException as exc:
         _err(f"ERROR: {exc}")
@@ -132,11 +134,8 @@ def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
         try:
             probe = Bag(path, "r", allow_unindexed=reindex)
             probe.close()
-        except ROSBagUnindexedException:
-            _err(f"ERROR bag unindexed: {path}.  Run rosbag reindex.")
-            continue
         except (ROSBagException, OSError) as exc:
-            _err(f"ERROR reading {path}: {exc}")
+            _read_error(path, exc)
             continue
         if reindex and is_mcap(path):
             _err(f"ERROR reading {path}: reindexing MCAP files is not supported by minros")
@@ -196,11 +195,8 @@ def check(path: str) -> int:
     """Which connections' types differ from the installed ones (``rosbag check``)."""
     try:
         bag = Bag(path)
-    except ROSBagUnindexedException:
-        _err(f"ERROR bag unindexed: {path}.  Run rosbag reindex.")
-        return 1
     except ROSBagException as exc:
-        _err(f"ERROR reading {path}: {exc}")
+        _read_error(path, exc)
         return 1
     from minros.msgs import get_message_class
 

@@ -18,7 +18,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Dict, Iterator, List, Optional, Tuple
 
-from minros.bag.bag import _open_reader
+from minros.bag.bag import open_reader
 from minros.bag.bag1 import ConnInfo
 from minros.bag.errors import ROSBagException
 
@@ -127,8 +127,8 @@ class Player:
         self.opts = opts
         self.readers: List[Any] = []
         self.publishers: Dict[str, Any] = {}
-        self.classes: Dict[Tuple[int, int], type] = {}
-        self.topic_of: Dict[Tuple[int, int], str] = {}
+        #: (bag index, connection id) -> (publisher, message class, output topic)
+        self.routes: Dict[Tuple[int, int], Tuple[Any, type, str]] = {}
         self.paused = opts.pause
         self.step = False
         self.stop = threading.Event()
@@ -143,7 +143,7 @@ class Player:
         for path in self.opts.bags:
             minros.loginfo(f"Opening {path}")
             try:
-                self.readers.append(_open_reader(path, allow_unindexed=False))
+                self.readers.append(open_reader(path, allow_unindexed=False))
             except ROSBagException as exc:
                 raise ROSBagException(f"Error opening file: {path}: {exc}") from None
 
@@ -168,8 +168,7 @@ class Player:
                     pub = minros.Publisher(topic, cls, queue_size=self.opts.queue,
                                            latch=conn.latching == "1")
                     self.publishers[topic] = pub
-                self.classes[(i, conn.id)] = pub.data_class
-                self.topic_of[(i, conn.id)] = topic
+                self.routes[(i, conn.id)] = (pub, pub.data_class, topic)
         if self.opts.clock:
             from rosgraph_msgs.msg import Clock
 
@@ -183,27 +182,16 @@ class Player:
     # -- the message stream -------------------------------------------------------------
 
     def time_range(self) -> Tuple[int, int]:
-        starts, ends = [], []
-        for reader in self.readers:
-            counts = getattr(reader, "counts", None)
-            if counts is not None:
-                if any(counts.values()):
-                    starts.append(reader.start)
-                    ends.append(reader.end)
-            else:
-                chunks = [c for c in reader.chunks if c.counts]
-                if chunks:
-                    starts.append(min(c.start for c in chunks))
-                    ends.append(max(c.end for c in chunks))
-        if not starts:
+        ranges = [r for r in (reader.time_range() for reader in self.readers) if r is not None]
+        if not ranges:
             return 0, 0
-        return min(starts), max(ends)
+        return min(r[0] for r in ranges), max(r[1] for r in ranges)
 
     def messages(self, start: int, end: Optional[int]) -> Iterator[Tuple[int, int, int, bytes]]:
         """(time, bag index, connection id, bytes) of every selected message, in time order."""
         streams = []
         for i, reader in enumerate(self.readers):
-            ids = [cid for (b, cid) in self.classes if b == i]
+            ids = [cid for (b, cid) in self.routes if b == i]
             if ids:
                 streams.append(((t, i, cid, data) for cid, t, data, _pos in reader.messages(ids, start, end)))
         return heapq.merge(*streams, key=lambda m: m[0])
@@ -294,6 +282,7 @@ class Player:
         tr.set(start, time.monotonic())
         last_t: Optional[int] = None
         pause_topics = {t if t.startswith("/") else "/" + t for t in self.opts.pause_topics}
+        routes = self.routes
         for t, i, cid, data in itertools.chain((first,), stream):
             if last_t is not None and self.opts.skip_empty is not None and \
                     (t - last_t) / 1e9 > self.opts.skip_empty:
@@ -305,9 +294,9 @@ class Player:
             elif self.stop.is_set():
                 return False
             self.publish_clock(t)
-            pub = self.publishers[self.topic_of[(i, cid)]]
-            pub.publish(self.classes[(i, cid)](data))
-            if self.topic_of[(i, cid)] in pause_topics:
+            pub, cls, topic = routes[(i, cid)]
+            pub.publish(cls(data))
+            if topic in pause_topics:
                 self.paused = True
             self.status(t, *span)
         if last_t is not None:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Deque, Dict, List, Optional, Tuple
 
 from minros.bag import bag1
+from minros.bag.bag import open_writer
 from minros.bag.errors import Compression
 
 #: a chunk is closed and written out at least this often (seconds) while messages arrive
@@ -172,13 +173,7 @@ class BagSink:
         self.active = self.target + ".active"
         if os.path.exists(self.active):
             os.unlink(self.active)
-        chunk = self.opts.chunksize_kb * 1024
-        if self.target.endswith(".mcap"):
-            from minros.bag import mcapfile
-
-            self.writer = mcapfile.McapWriter(self.active, self.opts.compression, chunk)
-        else:
-            self.writer = bag1.Bag1Writer(self.active, self.opts.compression, chunk)
+        self.writer = open_writer(self.active, self.opts.compression, self.opts.chunksize_kb * 1024)
         self.conn_ids = {}
         self.first_time = None
         self.opened_at = self.chunk_started = time.monotonic()
@@ -386,9 +381,11 @@ class Recorder:
         if self.queue.new_drops and now - self.last_warn >= WARN_INTERVAL:
             self.queue.take_new_drops()
             self.last_warn = now
-            per_topic = ", ".join(f"{t}: {n}" for t, n in sorted(self.queue.drops.items()))
             self._log("warn", "rosbag record buffer exceeded.  Dropping oldest queued message. "
-                              f"(dropped so far: {per_topic})")
+                              f"(dropped so far: {self._drops_per_topic()})")
+
+    def _drops_per_topic(self) -> str:
+        return ", ".join(f"{t}: {n}" for t, n in sorted(self.queue.drops.items()))
 
     def run(self) -> int:
         import minros
@@ -427,9 +424,8 @@ class Recorder:
         writer.join()
         if self.queue.drops:
             total = sum(self.queue.drops.values())
-            per_topic = ", ".join(f"{t}: {n}" for t, n in sorted(self.queue.drops.items()))
             self._log("warn", f"Dropped {total} messages because the buffer (-b {self.opts.buffsize_mb} MB) "
-                              f"was full: {per_topic}")
+                              f"was full: {self._drops_per_topic()}")
         if self.sink.error:
             self._log("error", self.sink.error)
             return 1

@@ -361,12 +361,8 @@ def main(argv: Optional[List[str]] = None, prog: str = "rosbag") -> int:
 
 def record_node_main() -> int:
     """``rosrun rosbag record ...`` (the record program of the rosbag package)."""
-    return _run_record_node(sys.argv[1:])
-
-
-def _run_record_node(argv: List[str]) -> int:
     try:
-        return record_cmd(argv, "rosbag", node=True)
+        return record_cmd(sys.argv[1:], "rosbag", node=True)
     except SystemExit as exc:
         return int(exc.code or 0)
 

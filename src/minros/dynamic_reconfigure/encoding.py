@@ -11,7 +11,7 @@ configurations. These functions produce the same messages and dicts as ROS 1's.
 from __future__ import annotations
 
 import copy
-from typing import Any, Dict, Iterable, List
+from typing import Any, Callable, Dict, Iterable, List
 
 from dynamic_reconfigure.msg import (
     BoolParameter,
@@ -148,6 +148,35 @@ def _children(groups: List[Any], parent_id: int, seen: set) -> List[Any]:
     return out
 
 
+def _no_fill(node: Config, group: Any) -> None:
+    pass
+
+
+def _subtree(groups: List[Any], parent_id: int, seen: set,
+             fill: Callable[[Config, Any], None] = _no_fill) -> Config:
+    """The tree nodes of the groups below ``parent_id``, by name; ``fill(node, group)``
+    completes each node from its message before its own subgroups are added."""
+    children = Config({})
+    for group in _children(groups, parent_id, seen):
+        node = group_dict(group)
+        fill(node, group)
+        node["groups"] = _subtree(groups, group.id, seen | {group.id}, fill)
+        children[node["name"]] = node
+    return children
+
+
+def _add_values(node: Dict[str, Any], descr: Dict[str, Any],
+                put: Callable[[Dict[str, Any], str], None]) -> None:
+    """``put(group node, parameter name)`` for every parameter of the description, walking
+    the tree and the description side by side (subgroups matched by name)."""
+    for param in descr["parameters"]:
+        put(node, param["name"])
+    for child in node["groups"].values():
+        for sub in _sub_descriptions(descr):
+            if sub["name"] == child["name"]:
+                _add_values(child, sub, put)
+
+
 def decode_description(msg: Any) -> Config:
     """The group tree of a ConfigDescription, with each parameter's min, max and default."""
     mins, maxes, defaults = decode_config(msg.min), decode_config(msg.max), decode_config(msg.dflt)
@@ -158,41 +187,26 @@ def decode_description(msg: Any) -> Config:
                  "description": p.description, "edit_method": p.edit_method}
                 for p in group.parameters]
 
-    def subtree(parent_id: int, seen: set) -> Config:
-        children = Config({})
-        for group in _children(msg.groups, parent_id, seen):
-            node = group_dict(group)
-            node["parameters"] = params_of(group)
-            node["groups"] = subtree(group.id, seen | {group.id})
-            children[node["name"]] = node
-        return children
+    def fill(node: Config, group: Any) -> None:
+        node["parameters"] = params_of(group)
 
     root_msg = _root(msg.groups)
     tree: Any = {}
     if root_msg is not None:
         tree = group_dict(root_msg)
-        tree["parameters"] = params_of(root_msg)
-        tree["groups"] = subtree(tree["id"], {0})
+        fill(tree, root_msg)
+        tree["groups"] = _subtree(msg.groups, tree["id"], {0}, fill)
     return tree
 
 
 def get_tree(m: Any, group: Any = None) -> Any:
     """The group tree (without parameters) of a message that has ``groups``."""
-
-    def subtree(parent_id: int, seen: set) -> Config:
-        children = Config({})
-        for child in _children(m.groups, parent_id, seen):
-            node = group_dict(child)
-            node["groups"] = subtree(child.id, seen | {child.id})
-            children[node["name"]] = node
-        return children
-
     if group is None:
         group = _root(m.groups)
     if group.id != 0:
-        return subtree(group.id, {0, group.id})
+        return _subtree(m.groups, group.id, {0, group.id})
     tree = group_dict(group)
-    tree["groups"] = subtree(0, {0})
+    tree["groups"] = _subtree(m.groups, 0, {0})
     return tree
 
 
@@ -221,29 +235,15 @@ def initial_config(msg: Any, description: Dict[str, Any] | None = None) -> Confi
     if not msg.groups or description is None:
         return config
 
-    def subtree(parent_id: int, seen: set) -> Config:
-        children = Config({})
-        for child in _children(msg.groups, parent_id, seen):
-            node = group_dict(child)
-            _first_child_state(node, description)
-            node["groups"] = subtree(child.id, seen | {child.id})
-            children[node["name"]] = node
-        return children
-
-    root = _root(msg.groups)
-    tree = group_dict(root)
-    tree["groups"] = subtree(0, {0})
+    tree = group_dict(_root(msg.groups))
+    tree["groups"] = _subtree(msg.groups, 0, {0},
+                              lambda node, group: _first_child_state(node, description))
     config["groups"] = tree
 
-    def add_params(node: Dict[str, Any], descr: Dict[str, Any]) -> None:
-        for param in descr["parameters"]:
-            node["parameters"][param["name"]] = config[param["name"]]
-        for child in node["groups"].values():
-            for sub in _sub_descriptions(descr):
-                if sub["name"] == child["name"]:
-                    add_params(child, sub)
+    def put(node: Dict[str, Any], name: str) -> None:
+        node["parameters"][name] = config[name]
 
-    add_params(tree, description)
+    _add_values(tree, description, put)
     return config
 
 
@@ -255,16 +255,11 @@ def decode_config(msg: Any, description: Dict[str, Any] | None = None) -> Config
         return config
     config["groups"] = get_tree(msg)
 
-    def add_params(node: Dict[str, Any], descr: Dict[str, Any]) -> None:
-        for param in descr["parameters"]:
-            if param["name"] in config:
-                node[param["name"]] = config[param["name"]]
-        for child in node["groups"].values():
-            for sub in _sub_descriptions(descr):
-                if sub["name"] == child["name"]:
-                    add_params(child, sub)
+    def put(node: Dict[str, Any], name: str) -> None:
+        if name in config:
+            node[name] = config[name]
 
-    add_params(config["groups"], description)
+    _add_values(config["groups"], description, put)
     return config
 
 

@@ -161,24 +161,26 @@ class TimeSynchronizer(SimpleFilter):
         self.input_connections = [f.registerCallback(self.add, q, i)
                                   for i, (f, q) in enumerate(zip(fs, self.queues))]
 
-    def _note_time(self, my_queue: Dict[Any, Any], index: int | None) -> Tuple[bool, Any]:
-        """Simulated-time reset bookkeeping; returns (reset active, now)."""
+    def _note_time(self, my_queue: Dict[Any, Any], index: int | None) -> Any:
+        """Simulated-time reset bookkeeping: the time now when resets apply (``reset`` under
+        simulated time), else None, without reading the clock."""
+        if not self.enable_reset or _is_wallclock():
+            return None
         now = minros.Time.now()
-        resetting = self.enable_reset and not _is_wallclock()
-        if resetting and index is not None:
+        if index is not None:
             if now < self.latest_stamps[index]:
                 minros.logdebug("Detected jump back in time. Clearing message filter queue")
                 my_queue.clear()
             self.latest_stamps[index] = now
-        return resetting, now
+        return now
 
     def add(self, msg: Any, my_queue: Dict[Any, Any], my_queue_index: int | None = None) -> None:
         with self.lock:
-            resetting, now = self._note_time(my_queue, my_queue_index)
+            now = self._note_time(my_queue, my_queue_index)
             my_queue[msg.header.stamp] = msg
             while len(my_queue) > self.queue_size:
                 del my_queue[min(my_queue)]
-            if resetting and max(self.latest_stamps) != now:
+            if now is not None and max(self.latest_stamps) != now:
                 return
             common = reduce(set.intersection, [set(q) for q in self.queues])
             for stamp in sorted(common):
@@ -209,9 +211,9 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
         if stamp is None:
             return
         with self.lock:
-            resetting, now = self._note_time(my_queue, my_queue_index)
+            resetting = self._note_time(my_queue, my_queue_index) is not None
             my_queue[stamp] = msg
-            now = minros.Time.now()
+            now = minros.Time.now()  # read again after the reset check, as ROS 1 does
             if now < self.last_added:
                 minros.loginfo("ApproximateTimeSynchronizer: Detected jump back in time. "
                                "Clearing buffer.")
@@ -237,7 +239,7 @@ class ApproximateTimeSynchronizer(TimeSynchronizer):
         others = [i for i in range(len(self.queues)) if i != index]
         candidates: List[List[Tuple[Any, int]]] = []
         for i in others:
-            near = [(s, s.to_nsec()) for s in self.queues[i] if abs(s.to_nsec() - center) <= slop]
+            near = [(s, ns) for s in self.queues[i] if abs((ns := s.to_nsec()) - center) <= slop]
             if not near:
                 return None
             near.sort(key=lambda c: abs(c[1] - center))  # stable: ties keep arrival order

@@ -3,19 +3,22 @@
 Used by minros's own tests and benchmarks (and usable by anyone testing code that handles
 messages). Importing this module needs ``hypothesis`` only when a strategy is requested.
 
-The genpy oracle is a small script run by Debian's ``/usr/bin/python3``: it reads one JSON
+The genpy oracle is a small script run by Debian's ``/usr/bin/python3``
+(:class:`ReferenceProcess`, which minros.tf.testing's oracle uses too): it reads one JSON
 request per line (``{"op": "ser", "type": ..., "value": ...}`` or ``{"op": "de", "type": ...,
 "hex": ...}``) and answers one JSON line, so one long-lived process serves a whole test run.
 """
 
 from __future__ import annotations
 
+import inspect
 import json
 import math
 import os
 import selectors
 import subprocess
-from typing import Any, Dict, List
+import time
+from typing import Any, Callable, Dict, List
 
 from .registry import REGISTRY, MsgContext
 from .spec import split_array
@@ -90,7 +93,36 @@ def to_plain(value: Any) -> Any:
     return value
 
 
-GENPY_ORACLE = r'''
+def best_rate(fn: Callable[[], Any], seconds: float, batch_seconds: float = 0.002) -> float:
+    """Calls per second of ``fn`` in its fastest batch of about ``batch_seconds``, batches
+    repeated for ``seconds``: the best batch, not the mean, so that other processes on a busy
+    machine distort the figure least. Every speed comparison of minros measures this way, on
+    both sides (the scripts Debian's interpreter runs define it from :data:`BEST_RATE_SOURCE`)."""
+    batch, best, deadline = 1, 0.0, time.perf_counter() + seconds
+    while True:
+        start = time.perf_counter()
+        for _ in range(batch):
+            fn()
+        elapsed = time.perf_counter() - start
+        if elapsed > 0:
+            best = max(best, batch / elapsed)
+        if elapsed < batch_seconds:
+            batch *= 2
+        if time.perf_counter() > deadline:
+            return best
+
+
+#: the text of :func:`best_rate`, for scripts run where minros cannot be imported
+BEST_RATE_SOURCE = inspect.getsource(best_rate)
+
+
+def reference_script(body: str) -> str:
+    """``body``, a script for Debian's interpreter, with :func:`best_rate` defined before it
+    (its annotations left unevaluated: the script does not import their names)."""
+    return "from __future__ import annotations\nimport time\n" + BEST_RATE_SOURCE + body
+
+
+GENPY_ORACLE = reference_script(r'''
 import importlib, json, math, sys, io, time
 import genpy
 
@@ -145,21 +177,6 @@ def plain_of(value):
         return {"f": repr(value)}
     return value
 
-def best_rate(fn, seconds):
-    """Calls per second in the fastest batch of about 2 ms (robust to a loaded machine)."""
-    batch, best, deadline = 1, 0.0, time.perf_counter() + seconds
-    while True:
-        t0 = time.perf_counter()
-        for _ in range(batch):
-            fn()
-        elapsed = time.perf_counter() - t0
-        if elapsed > 0:
-            best = max(best, batch / elapsed)
-        if elapsed < 0.002:
-            batch *= 2
-        if time.perf_counter() > deadline:
-            return best
-
 for line in sys.stdin:
     req = json.loads(line)
     try:
@@ -185,17 +202,19 @@ for line in sys.stdin:
         out = {"error": "%s: %s" % (type(exc).__name__, exc)}
     sys.stdout.write(json.dumps(out) + "\n")
     sys.stdout.flush()
-'''
+''')
 
 
-class GenpyOracle:
-    """One long-lived ``/usr/bin/python3`` process answering genpy (de)serialization requests."""
+class ReferenceProcess:
+    """One long-lived process (by default Debian's ``/usr/bin/python3``) running ``script``,
+    which answers each JSON line it reads with one JSON line; ``name`` is what errors call it."""
 
-    def __init__(self, python: str = "/usr/bin/python3", env: Dict[str, str] | None = None,
-                 timeout: float = 30.0) -> None:
+    def __init__(self, script: str, name: str, python: str = "/usr/bin/python3",
+                 env: Dict[str, str] | None = None, timeout: float = 30.0) -> None:
+        self.name = name
         self.timeout = timeout
         self.proc = subprocess.Popen(
-            [python, "-c", GENPY_ORACLE], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            [python, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL, env=env, text=True, bufsize=1)
         self._selector = selectors.DefaultSelector()
         self._selector.register(self.proc.stdout, selectors.EVENT_READ)
@@ -205,11 +224,29 @@ class GenpyOracle:
         self.proc.stdin.write(json.dumps(req) + "\n")
         self.proc.stdin.flush()
         if not self._selector.select(self.timeout):
-            raise TimeoutError(f"genpy oracle did not answer within {self.timeout} s")
+            raise TimeoutError(f"{self.name} did not answer within {self.timeout} s")
         line = self.proc.stdout.readline()
         if not line:
-            raise RuntimeError("genpy oracle exited")
+            raise RuntimeError(f"{self.name} exited")
         return json.loads(line)
+
+    def close(self) -> None:
+        try:
+            if self.proc.stdin:
+                self.proc.stdin.close()
+            self.proc.wait(5)
+        except (OSError, subprocess.TimeoutExpired):
+            self.proc.kill()
+            self.proc.wait(5)
+        self._selector.close()
+
+
+class GenpyOracle(ReferenceProcess):
+    """One long-lived ``/usr/bin/python3`` process answering genpy (de)serialization requests."""
+
+    def __init__(self, python: str = "/usr/bin/python3", env: Dict[str, str] | None = None,
+                 timeout: float = 30.0) -> None:
+        super().__init__(GENPY_ORACLE, "genpy oracle", python, env, timeout)
 
     def serialize(self, type_name: str, msg: Any) -> bytes:
         answer = self.request(op="ser", type=type_name, value=to_plain(msg))
@@ -222,16 +259,6 @@ class GenpyOracle:
         if "error" in answer:
             raise RuntimeError(f"genpy failed on {type_name}: {answer['error']}")
         return answer["value"]
-
-    def close(self) -> None:
-        try:
-            if self.proc.stdin:
-                self.proc.stdin.close()
-            self.proc.wait(5)
-        except (OSError, subprocess.TimeoutExpired):
-            self.proc.kill()
-            self.proc.wait(5)
-        self._selector.close()
 
 
 def bundled_types() -> List[str]:

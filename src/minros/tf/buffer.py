@@ -304,12 +304,13 @@ class Buffer(BufferCore, BufferInterface):
 
 
 class BufferClient(BufferInterface):
-    """tf2_ros.BufferClient asks a tf2 buffer server through actionlib, which minros does not
-    provide yet: use tf2_ros.Buffer with a TransformListener instead."""
+    """tf2_ros.BufferClient asks a tf2 buffer server (tf2_ros's buffer_server node, through
+    its tf2_msgs/LookupTransform action), which minros does not implement yet: use
+    tf2_ros.Buffer with a TransformListener instead."""
 
     def __init__(self, ns: str, check_frequency: Any = None, timeout_padding: Any = None) -> None:
         raise TransformException(
-            "tf2_ros.BufferClient needs actionlib, which this minros does not provide; "
+            "tf2_ros.BufferClient needs a tf2 buffer server, which this minros does not provide; "
             "use tf2_ros.Buffer() with tf2_ros.TransformListener(buffer) instead")
 
 

@@ -635,7 +635,8 @@ class BufferCore:
                 sx, sy, sz, sqx, sqy, sqz, sqw = x, y, z, ax, ay, az, aw
                 first = False
             else:
-                # v' = q v q* + t ; q' = q_link * q
+                # v' = q v q* + t ; q' = q_link * q (written out here and in the target loop:
+                # calling _rotate costs ~15 % more per link on a 10-link chain)
                 k = aw * aw - (ax * ax + ay * ay + az * az)
                 m = 2.0 * (ax * sx + ay * sy + az * sz)
                 w2 = 2.0 * aw
@@ -667,9 +668,7 @@ class BufferCore:
                 break
             s = cache.sample_at(t)
             if s is None:
-                return (EXTRAPOLATION_ERROR, 0,
-                        f"{cache.explain(t)}, when looking up transform from frame "
-                        f"[{self._names[source_id]}] to frame [{self._names[target_id]}]")
+                return EXTRAPOLATION_ERROR, 0, self._extrapolation(cache, t, source_id, target_id)
             _, x, y, z, ax, ay, az, aw = s
             if first:
                 tx, ty, tz, tqx, tqy, tqz, tqw = x, y, z, ax, ay, az, aw
@@ -691,9 +690,7 @@ class BufferCore:
                 return LOOKUP_ERROR, 0, self._loop_text()
         if frame != top and frame != source_id:
             if failed is not None:  # the source side stopped early: that is the real cause
-                return (EXTRAPOLATION_ERROR, 0,
-                        f"{failed.explain(t)}, when looking up transform from frame "
-                        f"[{self._names[source_id]}] to frame [{self._names[target_id]}]")
+                return EXTRAPOLATION_ERROR, 0, self._extrapolation(failed, t, source_id, target_id)
             return CONNECTIVITY_ERROR, 0, self._connectivity_text(source_id, target_id)
         # result = inverse(target-to-top) * source-to-top
         ix, iy, iz = -tqx, -tqy, -tqz
@@ -704,6 +701,11 @@ class BufferCore:
                              tqw * sqy + iy * sqw + iz * sqx - ix * sqz,
                              tqw * sqz + iz * sqw + ix * sqy - iy * sqx,
                              tqw * sqw - ix * sqx - iy * sqy - iz * sqz)
+
+    def _extrapolation(self, cache: Any, t: int, source_id: int, target_id: int) -> str:
+        """tf2's ExtrapolationException text: why ``cache`` cannot serve ``t``, and the lookup."""
+        return (f"{cache.explain(t)}, when looking up transform from frame "
+                f"[{self._names[source_id]}] to frame [{self._names[target_id]}]")
 
     def _loop_text(self) -> str:
         return ("The tf tree is invalid because it contains a loop.\n"
@@ -760,9 +762,7 @@ class BufferCore:
                 break
             parent = cache.parent_at(t)
             if not parent:
-                return EXTRAPOLATION_ERROR, (
-                    f"{cache.explain(t)}, when looking up transform from frame "
-                    f"[{self._names[source_id]}] to frame [{self._names[target_id]}]")
+                return EXTRAPOLATION_ERROR, self._extrapolation(cache, t, source_id, target_id)
             if frame == source_id:
                 if chain is not None:
                     chain[:] = reverse[::-1]
@@ -773,9 +773,7 @@ class BufferCore:
                 return LOOKUP_ERROR, self._loop_text()
         if frame != top:
             if failed is not None:
-                return EXTRAPOLATION_ERROR, (
-                    f"{failed.explain(t)}, when looking up transform from frame "
-                    f"[{self._names[source_id]}] to frame [{self._names[target_id]}]")
+                return EXTRAPOLATION_ERROR, self._extrapolation(failed, t, source_id, target_id)
             return CONNECTIVITY_ERROR, self._connectivity_text(source_id, target_id)
         if chain is not None:
             # both walks end at the common parent: keep it once, drop the shared tail

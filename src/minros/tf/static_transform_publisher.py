@@ -15,7 +15,7 @@ import math
 import sys
 from typing import Any, List, Optional
 
-from .tools import UsageError, number, run_tool, tool_args
+from .tools import command_line, number, run_tool
 
 NAME = "static_transform_publisher"
 USAGE = """A command line utility for manually sending a transform.
@@ -28,6 +28,7 @@ Usage: static_transform_publisher /param_name
 This transform is the transform of the coordinate frame from frame_id into the coordinate frame
 of the child_frame_id.
 """
+WRONG_COUNT = f"[ERROR] {NAME} exited due to not having the right number of arguments"
 
 
 def transform_from_args(args: List[str]) -> Any:
@@ -79,14 +80,7 @@ def main(argv: Optional[List[str]] = None) -> int:
 
     from .broadcaster import StaticTransformBroadcaster
 
-    full_argv = list(sys.argv if argv is None else argv)
-    args = tool_args(full_argv)
-    if args and args[0] in ("-h", "--help"):
-        sys.stdout.write(USAGE)
-        return 0
-    if len(args) not in (1, 8, 9):
-        sys.stdout.write(USAGE)
-        raise UsageError(f"[ERROR] {NAME} exited due to not having the right number of arguments")
+    full_argv, args = command_line(argv, USAGE, (1, 8, 9), WRONG_COUNT)
     transform = transform_from_args(args) if len(args) != 1 else None  # bad numbers: no node
     minros.init_node(NAME, argv=full_argv, anonymous=True)
     if transform is None:

@@ -24,15 +24,13 @@ A result is ``{"ok": value}`` or ``{"exc": class name, "msg": text}``; a lookup'
 
 from __future__ import annotations
 
-import json
 import math
-import os
-import selectors
-import subprocess
 from typing import Any, Dict, List, Sequence
 
-ORACLE = r'''
-import json, math, sys, time
+from minros.msgs.testing import ReferenceProcess, reference_script
+
+ORACLE = reference_script(r'''
+import json, math, sys
 import rospy
 import tf2_py
 import tf.transformations as tft
@@ -113,20 +111,6 @@ def play(actions):
             out.append({"exc": type(exc).__name__, "msg": str(exc)})
     return core, out
 
-def best_rate(fn, seconds):
-    batch, best, deadline = 1, 0.0, time.perf_counter() + seconds
-    while True:
-        t0 = time.perf_counter()
-        for _ in range(batch):
-            fn()
-        elapsed = time.perf_counter() - t0
-        if elapsed > 0:
-            best = max(best, batch / elapsed)
-        if elapsed < 0.01:
-            batch *= 2
-        if time.perf_counter() > deadline:
-            return best
-
 for line in sys.stdin:
     req = json.loads(line)
     try:
@@ -143,16 +127,18 @@ for line in sys.stdin:
             def one_pass():
                 for target, source, t in queries:
                     lookup(target, source, t)
-            out = {"rate": best_rate(one_pass, req["seconds"]) * len(queries)}
+            out = {"rate": best_rate(one_pass, req["seconds"], 0.01) * len(queries)}
         else:
             out = {"error": "unknown op"}
     except Exception as exc:
         out = {"error": "%s: %s" % (type(exc).__name__, exc)}
     sys.stdout.write(json.dumps(out) + "\n")
     sys.stdout.flush()
-'''
+''')
 
 
+# _plain, _stamped, result_of and play repeat the script's plain, stamped, result_of and
+# run on purpose: the script runs under Debian's interpreter, which cannot import minros.
 def _plain(value: Any) -> Any:
     if hasattr(value, "tolist"):
         value = value.tolist()
@@ -167,71 +153,34 @@ class OracleError(RuntimeError):
     """The reference raised an exception that is not a tf2 one (reported as "Class: text")."""
 
 
-class TfOracle:
+class TfOracle(ReferenceProcess):
     """One long-lived Debian ``/usr/bin/python3`` answering tf requests (see module doc)."""
 
     def __init__(self, python: str = "/usr/bin/python3", env: Dict[str, str] | None = None,
                  timeout: float = 60.0) -> None:
-        self.timeout = timeout
-        self.proc = subprocess.Popen(
-            [python, "-c", ORACLE], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL, env=env, text=True, bufsize=1)
-        self._selector = selectors.DefaultSelector()
-        self._selector.register(self.proc.stdout, selectors.EVENT_READ)
+        super().__init__(ORACLE, "tf oracle", python, env, timeout)
 
-    def request(self, **req: Any) -> Dict[str, Any]:
-        assert self.proc.stdin is not None and self.proc.stdout is not None
-        self.proc.stdin.write(json.dumps(req) + "\n")
-        self.proc.stdin.flush()
-        if not self._selector.select(self.timeout):
-            raise TimeoutError(f"tf oracle did not answer within {self.timeout} s")
-        line = self.proc.stdout.readline()
-        if not line:
-            raise RuntimeError("tf oracle exited")
-        return json.loads(line)
+    def _answer(self, key: str, **req: Any) -> Any:
+        """``answer[key]`` of the request; OracleError("Class: text") when the reference raised."""
+        answer = self.request(**req)
+        if "error" in answer:
+            raise OracleError(answer["error"])
+        return answer[key]
 
     def transformations(self, fn: str, *args: Any, **kwargs: Any) -> Any:
         """Debian's ``tf.transformations.fn(*args, **kwargs)`` as plain lists/floats;
         raises OracleError("Class: text") when it raised."""
-        answer = self.request(op="tx", fn=fn, args=_plain(list(args)),
-                              kwargs={k: _plain(v) for k, v in kwargs.items()})
-        if "error" in answer:
-            raise OracleError(answer["error"])
-        return answer["value"]
+        return self._answer("value", op="tx", fn=fn, args=_plain(list(args)),
+                            kwargs={k: _plain(v) for k, v in kwargs.items()})
 
     def play(self, actions: Sequence[Any]) -> List[Dict[str, Any]]:
         """The results of ``actions`` on a fresh Debian tf2_py.BufferCore."""
-        answer = self.request(op="core", actions=_plain(list(actions)))
-        if "error" in answer:
-            raise OracleError(answer["error"])
-        return answer["results"]
+        return self._answer("results", op="core", actions=_plain(list(actions)))
 
     def bench(self, actions: Sequence[Any], queries: Sequence[Any], seconds: float) -> float:
         """Debian's lookups per second over ``queries`` ([target, source, [secs, nsecs]])."""
-        answer = self.request(op="bench", actions=_plain(list(actions)),
-                              queries=_plain(list(queries)), seconds=seconds)
-        if "error" in answer:
-            raise OracleError(answer["error"])
-        return answer["rate"]
-
-    def close(self) -> None:
-        try:
-            if self.proc.stdin:
-                self.proc.stdin.close()
-            self.proc.wait(5)
-        except (OSError, subprocess.TimeoutExpired):
-            self.proc.kill()
-            self.proc.wait(5)
-        self._selector.close()
-
-
-def reference_environment() -> Dict[str, str]:
-    """os.environ without the venv and PYTHONPATH, for Debian's interpreter."""
-    env = dict(os.environ)
-    for key in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME"):
-        env.pop(key, None)
-    env["PATH"] = "/usr/bin:/bin:/usr/sbin:/sbin"
-    return env
+        return self._answer("rate", op="bench", actions=_plain(list(actions)),
+                            queries=_plain(list(queries)), seconds=seconds)
 
 
 def _stamped(parent: str, child: str, t: Sequence[int], xyz: Sequence[float],

@@ -11,7 +11,7 @@ import math
 import sys
 from typing import Any, List, Optional
 
-from .tools import UsageError, number, run_tool, tool_args
+from .tools import UsageError, command_line, number, run_tool
 
 NAME = "tf_echo"
 USAGE = """Usage: tf_echo source_frame target_frame [echo_rate]
@@ -48,14 +48,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     from .exceptions import TransformException
     from .tf1 import TransformListener, strip_leading_slash
 
-    full_argv = list(sys.argv if argv is None else argv)
-    args = tool_args(full_argv)
-    if args and args[0] in ("-h", "--help"):
-        sys.stdout.write(USAGE)
-        return 0
-    if len(args) not in (2, 3):
-        sys.stdout.write(USAGE)
-        raise UsageError("", 255)
+    full_argv, args = command_line(argv, USAGE, (2, 3))
     rate_hz = number(args[2], "echo_rate", NAME) if len(args) == 3 else None
     minros.init_node(NAME, argv=full_argv, anonymous=True)
     if rate_hz is None:

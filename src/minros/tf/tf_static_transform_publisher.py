@@ -12,10 +12,9 @@ from __future__ import annotations
 import sys
 from typing import List, Optional
 
-from .static_transform_publisher import transform_from_args
-from .tools import UsageError, number, run_tool, tool_args
+from .static_transform_publisher import NAME, WRONG_COUNT, transform_from_args
+from .tools import UsageError, command_line, number, run_tool
 
-NAME = "static_transform_publisher"
 USAGE = """A command line utility for manually sending a transform.
 It will periodicaly republish the given transform.
 Usage: static_transform_publisher x y z yaw pitch roll frame_id child_frame_id  period(milliseconds)
@@ -32,14 +31,7 @@ def main(argv: Optional[List[str]] = None) -> int:
 
     from .broadcaster import TransformBroadcaster
 
-    full_argv = list(sys.argv if argv is None else argv)
-    args = tool_args(full_argv)
-    if args and args[0] in ("-h", "--help"):
-        sys.stdout.write(USAGE)
-        return 0
-    if len(args) not in (9, 10):
-        sys.stdout.write(USAGE)
-        raise UsageError(f"[ERROR] {NAME} exited due to not having the right number of arguments")
+    full_argv, args = command_line(argv, USAGE, (9, 10), WRONG_COUNT)
     period_ms = number(args[-1], "period(milliseconds)", NAME)
     if period_ms <= 0:
         raise UsageError(f"{NAME}: period(milliseconds) must be > 0, got {args[-1]}")

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import sys
-from typing import Callable, List, Optional
+from typing import Callable, Collection, List, Optional, Tuple
 
 
 class UsageError(Exception):
-    """Bad command line: the message is printed, the tool exits with ``status``."""
+    """The tool ends at its command line: the message (if any) is printed, the tool exits with
+    ``status``."""
 
     def __init__(self, message: str, status: int = 255) -> None:
         super().__init__(message)
@@ -37,6 +38,22 @@ def tool_args(argv: Optional[List[str]] = None) -> List[str]:
     import minros
 
     return minros.myargv(list(sys.argv if argv is None else argv))[1:]
+
+
+def command_line(argv: Optional[List[str]], usage: str, counts: Collection[int],
+                 error: str = "") -> Tuple[List[str], List[str]]:
+    """(the whole argv, the tool's own arguments) of a tool whose ``usage`` text is printed on
+    stdout for ``-h``/``--help`` (the tool then ends with status 0) and for a number of
+    arguments not in ``counts`` (it then fails with ``error``, status 255)."""
+    full_argv = list(sys.argv if argv is None else argv)
+    args = tool_args(full_argv)
+    if args and args[0] in ("-h", "--help"):
+        sys.stdout.write(usage)
+        raise UsageError("", 0)
+    if len(args) not in counts:
+        sys.stdout.write(usage)
+        raise UsageError(error)
+    return full_argv, args
 
 
 def number(text: str, what: str, tool: str) -> float:
