@@ -237,11 +237,13 @@ def role_srv_client(args) -> None:
     proxy = rospy.ServiceProxy("/bench_srv", SetBool, persistent=args.persistent)
     times = []
     for i in range(args.count + 50):
+        if i == 50:
+            cpu = time.process_time()
         t = time.perf_counter()
         proxy(True)
         if i >= 50:
             times.append(time.perf_counter() - t)
-    _median_report(times)
+    _median_report(times, cpu_us=(time.process_time() - cpu) / args.count * 1e6)
 
 
 def role_rate_pub(args) -> None:
@@ -591,13 +593,16 @@ int main(int argc, char** argv) {
     ros::service::waitForService("/bench_srv", 20000);
     ros::ServiceClient client = nh.serviceClient<std_srvs::SetBool>("/bench_srv", kind == "persistent");
     std_srvs::SetBool call; call.request.data = true;
+    double cpuStart = 0;
     for (int i = 0; i < count + 50; ++i) {
+      if (i == 50) cpuStart = cpuSeconds();
       Clock::time_point t = Clock::now();
       if (!client.call(call)) { printf("{\"error\": \"call failed\"}\n"); return 1; }
       if (i >= 50) times.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t).count());
     }
+    double cpuPerCall = (cpuSeconds() - cpuStart) / count * 1e6;
     std::sort(times.begin(), times.end());
-    printf("{\"median_us\": %f}\n", times[times.size() / 2]);
+    printf("{\"median_us\": %f, \"cpu_us\": %f}\n", times[times.size() / 2], cpuPerCall);
   } else if (role == "cpu-sub") {
     ros::Subscriber s = nh.subscribe<sensor_msgs::Image>("/bench_rate", 10, onImage);
     printf("{\"ready\": true}\n"); fflush(stdout);
@@ -818,6 +823,9 @@ class Runner:
             r = self.pair(who, self.command(who, "srv-server", []),
                           self.command(who, "srv-client", [*(["--persistent"] if persistent else []),
                                                            "--count", count]))
+        if "cpu_us" in r:
+            key = "srv" if persistent else "srvnew"
+            self.cpu[(key, who)] = self.cpu.get((key, who), []) + [r["cpu_us"]]
         return r.get("median_us")
 
     def _start_ready(self, who: str, command: tuple) -> subprocess.Popen:
@@ -1038,25 +1046,27 @@ def main(argv=None) -> int:
             if other in contenders:
                 header.append(f"minros/{other}")
         rows = []
-        for title, key, _fn, _better in scenarios:
-            med = {c: statistics.median(results[(key, c)]) if results[(key, c)] else None
-                   for c in contenders}
+        # CPU time (steadier than wall-clock latency on a loaded or idle machine) follows its scenario
+        cpu_rows = {"lat10": ("10", "CPU per round trip, ping side, q=10 (µs)"),
+                    "srv": ("srv", "CPU per persistent call, client side (µs)"),
+                    "srvnew": ("srvnew", "CPU per new-connection call, client side (µs)")}
+
+        def ratio_row(title: str, med: dict) -> list:
             row = [title] + [_fmt(med[c]) for c in contenders]
             for other in ("rospy", "py-min", "raw", "raw-1"):
                 if other in contenders:
                     ok = med.get("minros") and med.get(other)
                     row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
-            rows.append(row)
-        if "lat10" in [s[1] for s in scenarios]:
-            # CPU time is steadier than wall-clock latency on a loaded machine
-            med = {c: statistics.median(runner.cpu[("10", c)]) if runner.cpu.get(("10", c)) else None
-                   for c in contenders}
-            row = ["CPU per round trip, ping side, q=10 (µs)"] + [_fmt(med[c]) for c in contenders]
-            for other in ("rospy", "py-min", "raw", "raw-1"):
-                if other in contenders:
-                    ok = med.get("minros") and med.get(other)
-                    row.append(f"{med['minros'] / med[other]:.2f}x" if ok else "—")
-            rows.insert(2 if len(rows) > 1 else 1, row)
+            return row
+
+        for title, key, _fn, _better in scenarios:
+            rows.append(ratio_row(title, {c: statistics.median(results[(key, c)])
+                                          if results[(key, c)] else None for c in contenders}))
+            cpu_key, cpu_title = cpu_rows.get(key, (None, ""))
+            if cpu_key and any(runner.cpu.get((cpu_key, c)) for c in contenders):
+                rows.append(ratio_row(cpu_title, {c: statistics.median(runner.cpu[(cpu_key, c)])
+                                                  if runner.cpu.get((cpu_key, c)) else None
+                                                  for c in contenders}))
         widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
         print(f"pubsub benchmark: {args.rounds} interleaved rounds, median; master: "
               f"{'Debian rosmaster' if runner.reference else 'minros'}; {os.cpu_count()} CPUs; "
