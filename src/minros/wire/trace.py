@@ -501,7 +501,7 @@ class _Tap:
                     self._frame_done(t)
                 continue
             if state == self.OPAQUE:
-                self._opaque(bytes(view[pos:end]), self.offset + pos, t)
+                self._flush_opaque(view[pos:end], self.offset + pos, t)
                 pos = end
                 continue
             take = min(self.need - len(self.part), end - pos)
@@ -512,6 +512,8 @@ class _Tap:
             pos += take
             if len(self.part) == self.need:
                 self._part_done(t)
+        if self.state == self.OPAQUE and self.part:
+            self._flush_opaque(b"", self.offset + end, t)
         self.offset += end
 
     def _part_done(self, t: float) -> None:
@@ -586,11 +588,17 @@ class _Tap:
             return {"error": _cut_text(f"cannot decode: {exc}")}
 
     def _to_opaque(self, t: float) -> None:
-        """Not TCPROS after all: the rest of this direction is traced as plain bytes."""
-        data = bytes(self.part)
+        """Not TCPROS after all: the rest of this direction is traced as plain bytes (the
+        bytes read so far go out with the next ones)."""
         self.state = self.OPAQUE
-        self.part = bytearray()
-        self._opaque(data, self.start, t)
+
+    def _flush_opaque(self, rest: Any, off: int, t: float) -> None:
+        if self.part:
+            data, off = bytes(self.part) + bytes(rest), self.start
+            self.part = bytearray()
+        else:
+            data = bytes(rest)
+        self._opaque(data, off, t)
 
     def _opaque(self, data: bytes, off: int, t: float) -> None:
         self.frames += 1
