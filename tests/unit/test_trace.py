@@ -530,7 +530,7 @@ def test_minros_trace_passes_the_exit_status_and_the_settings(tmp_path):
                            sys.executable, "-c", code], capture_output=True, text=True, timeout=30)
     assert done.returncode == 3
     assert done.stdout.split() == [str(target), "1", "all", "16"]
-    assert "read them with: minros trace show" in done.stderr
+    assert f"tracing into {target}; read it with: minros trace show" in done.stderr
     missing = subprocess.run([sys.executable, "-m", "minros", "trace", "-o", str(target), "--",
                               "no-such-program-here"], capture_output=True, text=True, timeout=30)
     assert missing.returncode == 127 and "cannot run no-such-program-here" in missing.stderr

@@ -14,14 +14,12 @@ from __future__ import annotations
 import argparse
 import os
 import shlex
-import signal
-import subprocess
 import sys
 import time
 from typing import List, Optional
 
 USAGE = """usage: minros trace [-o FILE] [--messages] [--frames N] [--bytes N] [--] COMMAND [ARGS...]
-       minros trace show [--follow] [--topic TOPIC] [--service SERVICE] [--frames N|all] [--all] FILE...
+       minros trace show [--follow] [--topic T] [--service S] [--node N] [--frames N|all] [--all] FILE...
        minros trace pcap FILE... [-o OUT.pcap]
 
 Record what minros processes say on the ROS wire (XML-RPC calls, TCPROS connection headers,
@@ -96,37 +94,22 @@ def _record(argv: List[str], prog: str) -> int:
             env[trace.ENV_FRAMES] = args.frames
         if args.bytes is not None:
             env[trace.ENV_BYTES] = str(max(0, args.bytes))
-    status = _run(command, env, prog)
-    if traced:
-        _summary(path, prog)
-    return status
+        print(f"{prog}: tracing into {path}; read it with: minros trace show {path}",
+              file=sys.stderr)
+    return _exec(command, env, prog)
 
 
-def _run(command: List[str], env: dict, prog: str) -> int:
-    """Run ``command``; Ctrl-C reaches it from the terminal, SIGTERM is passed on."""
+def _exec(command: List[str], env: dict, prog: str) -> int:
+    """Become ``command`` (as ``env`` does): its signals, terminal and exit status are its own,
+    so Ctrl-C, ``kill`` and job control behave exactly as without the trace."""
+    sys.stdout.flush()
+    sys.stderr.flush()
     try:
-        child = subprocess.Popen(command, env=env)
+        os.execvpe(command[0], command, env)
     except OSError as exc:
         print(f"{prog}: cannot run {command[0]}: {exc.strerror or exc}", file=sys.stderr)
         return 127
-    previous_int = signal.signal(signal.SIGINT, signal.SIG_IGN)  # the child decides
-    previous_term = signal.signal(signal.SIGTERM, lambda *_: child.terminate())
-    try:
-        status = child.wait()
-    finally:
-        signal.signal(signal.SIGINT, previous_int)
-        signal.signal(signal.SIGTERM, previous_term)
-    return 128 - status if status < 0 else status
-
-
-def _summary(path: str, prog: str) -> None:
-    try:
-        with open(path, "rb") as handle:
-            lines = handle.read().count(b"\n")
-    except OSError:
-        return
-    print(f"{prog}: {lines} events in {path}; read them with: minros trace show {path}",
-          file=sys.stderr)
+    return 0  # not reached
 
 
 # --------------------------------------------------------------------------- show
@@ -154,12 +137,14 @@ def _show(argv: List[str], prog: str) -> int:
                         help="only this topic (repeatable)")
     parser.add_argument("--service", action="append", default=[], metavar="SERVICE",
                         help="only this service (repeatable)")
+    parser.add_argument("--node", action="append", default=[], metavar="NODE",
+                        help="only what this node sends or receives (repeatable)")
     parser.add_argument("--frames", type=_frames_arg, default=3, metavar="N",
                         help="frames shown per connection and direction (default 3; 'all')")
     parser.add_argument("--all", action="store_true", dest="show_all",
                         help="also /rosout, the logger services and the master probes")
     args = parser.parse_args(argv)
-    flt = show.Filter(args.topic, args.service, args.show_all, args.frames)
+    flt = show.Filter(args.topic, args.service, args.show_all, args.frames, args.node)
     if args.follow:
         return _follow(args.files, flt)
     files = []

@@ -365,6 +365,9 @@ class Wire:
     node: str = ""  # the node that did it (opened, closed)
     stats: Optional[Dict[str, Any]] = None
     views: List[str] = field(default_factory=list)
+    #: when the receiver had it, if the receiver was traced (with the sender: the latency)
+    t_in: float = 0.0
+    sent: bool = False  # the sender's view is here (``t`` is when it went out)
 
     @property
     def subject(self) -> Tuple[str, str]:
@@ -542,10 +545,19 @@ class Merger:
             known.views.append(side)
             if known.msg is None and ev.get("msg") is not None:
                 known.msg = ev["msg"]
+            if direction == "in":
+                known.t_in = ev["t"]
+            else:
+                known.sent = True
+                known.t = min(known.t, ev["t"])
             return None
         item = Wire(t=ev["t"], what=what, conn=conn, dir=flow, off=int(ev.get("off", 0)),
                     len=int(ev.get("len", 0)), n=int(ev.get("n", 0)), head=str(ev.get("head", "")),
                     ok=int(ev.get("ok", -1)), msg=ev.get("msg"), node=node, views=[side])
+        if direction == "in":
+            item.t_in = ev["t"]
+        else:
+            item.sent = True
         if what == "header":
             item.fields = [list(pair) for pair in ev.get("fields") or []]
             conn.headers.setdefault(flow, item.fields)

@@ -20,6 +20,7 @@ that registered first shows [1] before [0].
 from __future__ import annotations
 
 import json
+import statistics
 import time
 from typing import Any, Dict, Iterable, List, Optional, Sequence, Set, Tuple
 
@@ -49,9 +50,10 @@ class Filter:
     """Which sections to print."""
 
     def __init__(self, topics: Sequence[str] = (), services: Sequence[str] = (),
-                 show_all: bool = False, frames: int = 3) -> None:
+                 show_all: bool = False, frames: int = 3, nodes: Sequence[str] = ()) -> None:
         self.topics = set(topics)
         self.services = set(services)
+        self.nodes = set(nodes)
         self.show_all = show_all
         self.frames = frames  # frames printed per connection direction (-1: all)
         self.hidden: Dict[str, Set[str]] = {"topic": set(), "service": set(), "other": set()}
@@ -62,6 +64,8 @@ class Filter:
 
     def wants(self, subject: Tuple[str, str], item: Optional[Item] = None) -> bool:
         kind, name = subject
+        if self.nodes and item is not None and not self.nodes & _ends(item):
+            return False
         if self.narrowed:
             return (kind == "topic" and name in self.topics) or (
                 kind == "service" and name in self.services)
@@ -91,6 +95,12 @@ class Filter:
         return "not shown (every node has them): " + "; ".join(parts) + " (--all shows them)"
 
 
+def _ends(item: Item) -> Set[str]:
+    if isinstance(item, Call):
+        return {item.caller, item.callee}
+    return {item.conn.client_node, item.conn.server_node}
+
+
 # --------------------------------------------------------------------------- values
 
 
@@ -116,7 +126,7 @@ def _reply_text(call: Call) -> str:
 def _header_lines(fields: List[List[str]]) -> List[str]:
     lines = []
     for key, value in fields:
-        if "\n" in value.rstrip("\n") or len(value) > 100:
+        if key != "error" and ("\n" in value.rstrip("\n") or len(value) > 100):
             first = value.split("\n", 1)[0]
             more = value.rstrip("\n").count("\n")
             note = f"   (first line of {more + 1})" if more else f"   ({len(value)} chars)"
@@ -130,6 +140,14 @@ def _hex_groups(text: str, limit: int = HEX_SHOWN) -> str:
     raw = text[:limit * 2]
     groups = " ".join(raw[i:i + 8] for i in range(0, len(raw), 8))
     return groups + (" …" if len(text) > limit * 2 else "")
+
+
+def _latency(item: Wire) -> str:
+    """How long a frame took from the sender's send to the receiver's recv, when both ends
+    were traced (one clock: the processes share the machine's)."""
+    if not (item.sent and item.t_in):
+        return ""
+    return f", received {(item.t_in - item.t) * 1000:.2f} ms later"
 
 
 def _prefix_hex(size: int) -> str:
@@ -199,10 +217,13 @@ def who_of(item: Item) -> str:
     return f"{item.sender()} -> {item.receiver()}"
 
 
-def format_item(item: Item, t0: float, layout: Optional[_Layout] = None) -> List[str]:
-    """The lines of one item: time relative to ``t0``, who to whom, what."""
+def format_item(item: Item, t0: float, layout: Optional[_Layout] = None,
+                label: str = "") -> List[str]:
+    """The lines of one item: time relative to ``t0``, who to whom, what (``label`` tells
+    apart the connections of one section: ``#1``, ``#2``, ...)."""
     layout = layout or _Layout()
     _line, _more = layout.line, layout.more
+    tag = f"{label} " if label else ""
     who = who_of(item)
     if isinstance(item, Call):
         lines = [_line(step_of(item), item.t, t0, who, _call_text(item))]
@@ -216,13 +237,16 @@ def format_item(item: Item, t0: float, layout: Optional[_Layout] = None) -> List
     conn = item.conn
     step = step_of(item)
     if item.what == "open":
-        return [_line(step, item.t, t0, who, f"TCP connection {conn.client} -> {conn.server}")]
+        probe = " (a probe: is the service there?)" if conn.kind == "probe" else ""
+        return [_line(step, item.t, t0, who,
+                      f"{tag}TCP connection {conn.client} -> {conn.server}{probe}")]
     if item.what == "header":
         fields = item.fields or []
-        label = "connection header" if not any(k == "error" for k, _ in fields) else \
+        name = "connection header" if not any(k == "error" for k, _ in fields) else \
             "connection header (refusal)"
-        lines = [_line(step, item.t, t0, who, f"{label}: length prefix "
-                       f"{_prefix_hex(item.len - 4)} = {item.len - 4} bytes, {len(fields)} fields")]
+        count = f"{len(fields)} field" + ("s" if len(fields) != 1 else "")
+        lines = [_line(step, item.t, t0, who, f"{tag}{name}: length prefix "
+                       f"{_prefix_hex(item.len - 4)} = {item.len - 4} bytes, {count}")]
         lines.extend(_more("  " + text) for text in _header_lines(fields))
         return lines
     if item.what == "frame":
@@ -231,8 +255,8 @@ def format_item(item: Item, t0: float, layout: Optional[_Layout] = None) -> List
             kind = "request" if item.dir == "c2s" else "response"
         status = f" ok={item.ok}," if item.ok >= 0 else ""
         lines = [_line(step, item.t, t0, who,
-                       f"{kind} {item.n}:{status} length prefix {_prefix_hex(item.len)} "
-                       f"= {item.len} bytes")]
+                       f"{tag}{kind} {item.n}:{status} length prefix {_prefix_hex(item.len)} "
+                       f"= {item.len} bytes{_latency(item)}")]
         if item.head:
             lines.append(_more(f"  body {_hex_groups(item.head)}"))
         if item.msg is not None:
@@ -240,10 +264,10 @@ def format_item(item: Item, t0: float, layout: Optional[_Layout] = None) -> List
         return lines
     if item.what == "data":
         return [_line(step, item.t, t0, who,
-                      f"{item.len} bytes that are not TCPROS: {_hex_groups(item.head, 16)}")]
+                      f"{tag}{item.len} bytes that are not TCPROS: {_hex_groups(item.head, 16)}")]
     if item.what in ("close", "eof"):
         text = "closed the connection" if item.what == "close" else "saw the peer close"
-        return [_line("", item.t, t0, who, text)]
+        return [_line("", item.t, t0, who, f"{tag}{text}")]
     return []
 
 
@@ -263,14 +287,42 @@ def _type_of(items: List[Item]) -> str:
     return ""
 
 
+def _by_connection(items: List[Item]) -> List[Item]:
+    """Each connection's items together, from where it opened: calls and connections in time
+    order, and what happened on one connection in one block, not interleaved with the
+    others' (which on a busy node would be a matter of thread scheduling)."""
+    starts: Dict[int, float] = {}
+    for item in items:
+        if isinstance(item, Wire):
+            starts.setdefault(id(item.conn), item.t)
+    order = {id(item): index for index, item in enumerate(items)}
+
+    def key(item: Item) -> Tuple[float, int]:
+        if isinstance(item, Wire):
+            return starts[id(item.conn)], order[id(item)]
+        return item.t, order[id(item)]
+
+    return sorted(items, key=key)
+
+
 def _section(title: str, items: List[Item], t0: float, flt: Filter, layout: _Layout) -> List[str]:
+    items = _by_connection(items)
     lines = [title]
+    conns: Dict[int, str] = {}
+    for item in items:
+        if isinstance(item, Wire) and id(item.conn) not in conns:
+            conns[id(item.conn)] = f"#{len(conns) + 1}"
+    if len(conns) < 2:
+        conns = {}
     shown: Dict[Tuple[int, str], int] = {}
     skipped: Dict[int, List[int]] = {}  # connection -> [frames, bytes] not printed
     closes: Set[int] = set()
+    latencies: Dict[Tuple[int, str], List[float]] = {}
     for item in items:
         if isinstance(item, Wire):
             conn_key = id(item.conn)
+            if item.what == "frame" and item.sent and item.t_in:
+                latencies.setdefault((conn_key, item.sender()), []).append(item.t_in - item.t)
             if item.what == "frame":
                 key = (conn_key, item.dir)
                 count = shown.get(key, 0)
@@ -287,11 +339,23 @@ def _section(title: str, items: List[Item], t0: float, flt: Filter, layout: _Lay
                     continue
                 closes.add(conn_key)
                 lines.extend(_skipped_lines(item, skipped.pop(conn_key, None), layout))
-        lines.extend(format_item(item, t0, layout))
+        label = conns.get(id(item.conn), "") if isinstance(item, Wire) else ""
+        lines.extend(format_item(item, t0, layout, label))
     for _conn_key, more in skipped.items():
         lines.append(layout.more(f"… {more[0]} more frames, {more[1]} bytes "
                                  "(--frames all shows them)"))
+    for (conn_key, sender), values in latencies.items():
+        label = conns.get(conn_key, "")
+        lines.append(layout.more(f"{label + ' ' if label else ''}{_latency_summary(sender, values)}"))
     return lines
+
+
+def _latency_summary(sender: str, values: List[float]) -> str:
+    """Send-to-receive times of a connection's frames (both of its ends traced)."""
+    ms = sorted(v * 1000 for v in values)
+    p90 = ms[min(len(ms) - 1, int(len(ms) * 0.9))]
+    return (f"from {sender}: {len(ms)} frames received {statistics.median(ms):.2f} ms after "
+            f"they were sent (median), 90% within {p90:.2f} ms, max {ms[-1]:.2f} ms")
 
 
 def _skipped_lines(close: Wire, more: Optional[List[int]], layout: _Layout) -> List[str]:
@@ -315,7 +379,8 @@ def run_heading(run: Run, index: int, count: int) -> List[str]:
     lines = []
     span = f"{_clock(run.start)} to {_clock(run.end)} ({run.end - run.start:.1f} s)"
     prefix = f"run {index} of {count}: " if count > 1 else "run: "
-    lines.append(f"{prefix}master {run.master or '?'}, {len(run.processes)} processes, {span}")
+    count = f"{len(run.processes)} process" + ("es" if len(run.processes) != 1 else "")
+    lines.append(f"{prefix}master {run.master or '?'}, {count}, {span}")
     for proc in sorted(run.processes, key=lambda p: p.first):
         lines.append(f"  pid {proc.pid:<7} {proc.name or '?':<30} {proc.program()}")
     return lines
@@ -351,17 +416,15 @@ def render_run(run: Run, flt: Filter) -> List[str]:
 
 
 def _other_section(items: List[Item], t0: float, layout: _Layout) -> List[str]:
-    """Calls about no topic or service: failures one by one, repeats of a success once."""
+    """Calls about no topic or service. A call repeated (same caller, callee, method, and the
+    same failure if it failed) is printed once, with the count."""
     lines = ["other XML-RPC calls (parameters, graph queries, probes, shutdown)"]
-    repeats: Dict[Tuple[str, str, str], List[Any]] = {}
+    repeats: Dict[Tuple[str, str, str, str], List[Any]] = {}
     order: List[Any] = []
     for item in items:
         if not isinstance(item, Call):
             continue
-        if not item.ok:
-            order.append(item)
-            continue
-        key = (item.caller, item.callee, item.method)
+        key = (item.caller, item.callee, item.method, item.error or item.fault)
         if key in repeats:
             repeats[key][1] += 1
             repeats[key][2] = item.t
@@ -369,13 +432,11 @@ def _other_section(items: List[Item], t0: float, layout: _Layout) -> List[str]:
         repeats[key] = [item, 1, item.t]
         order.append(key)
     for entry in order:
-        if isinstance(entry, Call):
-            lines.extend(format_item(entry, t0, layout))
-            continue
         first, count, last = repeats[entry]
         lines.extend(format_item(first, t0, layout))
         if count > 1:
-            lines.append(layout.more(f"(and {count - 1} more times, the last at {last - t0:+.3f})"))
+            times = "time" if count == 2 else "times"
+            lines.append(layout.more(f"(and {count - 1} more {times}, the last at {last - t0:+.3f})"))
     return lines
 
 
