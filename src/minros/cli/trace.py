@@ -61,9 +61,12 @@ def _record_parser(prog: str) -> argparse.ArgumentParser:
 def _record(argv: List[str], prog: str) -> int:
     from minros.wire import trace
 
-    if not argv or argv[0] in ("-h", "--help"):
-        print(USAGE if not argv else _record_parser(prog).format_help().rstrip())
-        return 0 if argv else 2
+    if not argv:
+        print(USAGE, file=sys.stderr)
+        return 2
+    if argv[0] in ("-h", "--help"):
+        print(USAGE + "\n\n" + _record_parser(prog).format_help().split("\n", 2)[2].rstrip())
+        return 0
     args = _record_parser(prog).parse_args(argv)
     command = args.command[1:] if args.command[:1] == ["--"] else args.command
     if not command:
