@@ -307,46 +307,66 @@ def _by_connection(items: List[Item]) -> List[Item]:
 
 def _section(title: str, items: List[Item], t0: float, flt: Filter, layout: _Layout) -> List[str]:
     items = _by_connection(items)
+    labels: Dict[int, str] = {}
+    for item in items:
+        if isinstance(item, Wire) and id(item.conn) not in labels:
+            labels[id(item.conn)] = f"#{len(labels) + 1}"
+    if len(labels) < 2:
+        labels = {}
     lines = [title]
-    conns: Dict[int, str] = {}
+    i = 0
+    while i < len(items):
+        item = items[i]
+        if not isinstance(item, Wire):
+            lines.extend(format_item(item, t0, layout))
+            i += 1
+            continue
+        j = i
+        while j < len(items) and isinstance(items[j], Wire) and items[j].conn is item.conn:
+            j += 1
+        lines.extend(_connection_lines(items[i:j], t0, flt, layout, labels.get(id(item.conn), "")))
+        i = j
+    return lines
+
+
+def _connection_lines(items: List[Wire], t0: float, flt: Filter, layout: _Layout,
+                      label: str) -> List[str]:
+    """One connection's block: opening, headers, the first frames of each direction, what
+    was left out, the send-to-receive times when both ends were traced, the close."""
+    lines: List[str] = []
+    shown: Dict[str, int] = {}
+    more = [0, 0]  # frames and bytes not printed
+    latencies: Dict[str, List[float]] = {}
+    close: Optional[Wire] = None
     for item in items:
-        if isinstance(item, Wire) and id(item.conn) not in conns:
-            conns[id(item.conn)] = f"#{len(conns) + 1}"
-    if len(conns) < 2:
-        conns = {}
-    shown: Dict[Tuple[int, str], int] = {}
-    skipped: Dict[int, List[int]] = {}  # connection -> [frames, bytes] not printed
-    closes: Set[int] = set()
-    latencies: Dict[Tuple[int, str], List[float]] = {}
-    for item in items:
-        if isinstance(item, Wire):
-            conn_key = id(item.conn)
-            if item.what == "frame" and item.sent and item.t_in:
-                latencies.setdefault((conn_key, item.sender()), []).append(item.t_in - item.t)
-            if item.what == "frame":
-                key = (conn_key, item.dir)
-                count = shown.get(key, 0)
-                if 0 <= flt.frames <= count:
-                    more = skipped.setdefault(conn_key, [0, 0])
-                    more[0] += 1
-                    more[1] += item.len + 4
-                    continue
-                shown[key] = count + 1
-            if item.what == "eof":
+        if item.what == "frame":
+            if item.sent and item.t_in:
+                latencies.setdefault(item.sender(), []).append(item.t_in - item.t)
+            count = shown.get(item.dir, 0)
+            if 0 <= flt.frames <= count:
+                more[0] += 1
+                more[1] += item.len + 4
                 continue
-            if item.what == "close":
-                if conn_key in closes:
-                    continue
-                closes.add(conn_key)
-                lines.extend(_skipped_lines(item, skipped.pop(conn_key, None), layout))
-        label = conns.get(id(item.conn), "") if isinstance(item, Wire) else ""
+            shown[item.dir] = count + 1
+        elif item.what == "eof":
+            continue
+        elif item.what == "close":
+            close = close or item  # the first to close; printed last
+            continue
         lines.extend(format_item(item, t0, layout, label))
-    for _conn_key, more in skipped.items():
-        lines.append(layout.more(f"… {more[0]} more frames, {more[1]} bytes "
+    tag = f"{label} " if label else ""
+    if more[0]:
+        lines.append(layout.more(f"{tag}… {more[0]} more frames, {more[1]} bytes "
                                  "(--frames all shows them)"))
-    for (conn_key, sender), values in latencies.items():
-        label = conns.get(conn_key, "")
-        lines.append(layout.more(f"{label + ' ' if label else ''}{_latency_summary(sender, values)}"))
+    stats = (close.stats or {}) if close is not None else {}
+    untraced = int(stats.get("untraced_out", 0)) + int(stats.get("untraced_in", 0))
+    if untraced:
+        lines.append(layout.more(f"{tag}… and {untraced} frames the trace did not keep "
+                                 "(MINROS_TRACE_FRAMES)"))
+    for sender, values in latencies.items():
+        lines.append(layout.more(tag + _latency_summary(sender, values)))
+    if close is not None:
+        lines.extend(format_item(close, t0, layout, label))
     return lines
 
 
@@ -356,19 +376,6 @@ def _latency_summary(sender: str, values: List[float]) -> str:
     p90 = ms[min(len(ms) - 1, int(len(ms) * 0.9))]
     return (f"from {sender}: {len(ms)} frames received {statistics.median(ms):.2f} ms after "
             f"they were sent (median), 90% within {p90:.2f} ms, max {ms[-1]:.2f} ms")
-
-
-def _skipped_lines(close: Wire, more: Optional[List[int]], layout: _Layout) -> List[str]:
-    lines = []
-    if more:
-        lines.append(layout.more(f"… {more[0]} more frames, {more[1]} bytes "
-                                 "(--frames all shows them)"))
-    stats = close.stats or {}
-    untraced = int(stats.get("untraced_out", 0)) + int(stats.get("untraced_in", 0))
-    if untraced:
-        lines.append(layout.more(f"… and {untraced} frames the trace did not keep "
-                                 "(MINROS_TRACE_FRAMES)"))
-    return lines
 
 
 def _clock(t: float) -> str:
