@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterable, Iterator, List, Optional, Tuple
+from typing import Any, Dict, Iterable, List, Optional, Tuple
 from urllib.parse import urlparse
 
 __all__ = [
@@ -22,12 +22,14 @@ __all__ = [
     "Connection",
     "Follower",
     "Merger",
+    "Names",
     "Process",
     "Run",
     "TraceError",
     "TraceFile",
     "Wire",
     "load",
+    "merge",
     "split_runs",
 ]
 
@@ -585,8 +587,3 @@ def merge(run: Run) -> Tuple[List[Item], Names]:
     for ev in run.events:
         merger.add(ev)
     return merger.items, names
-
-
-def iter_paths(paths: Iterable[str]) -> Iterator[TraceFile]:
-    for path in paths:
-        yield load(path)

@@ -26,7 +26,8 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Set, Tuple
 
 from minros.tools.trace.merge import Call, Item, Names, Run, Wire, merge
 
-__all__ = ["LEGEND", "Filter", "format_item", "render_run", "step_of"]
+__all__ = ["LEGEND", "Filter", "LiveView", "format_item", "render", "render_run", "run_heading",
+           "step_of"]
 
 LEGEND = (
     "steps, as courses number them:\n"
