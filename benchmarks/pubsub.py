@@ -32,6 +32,11 @@ Scenarios
 * `rostopic hz` and `rostopic echo` (minros's and Debian's) on a 10 kHz std_msgs/String topic
   from the same publisher: % of one core the tool uses.
 
+``--trace`` adds "minros+trace": minros with every process writing a wire trace of every frame
+(MINROS_TRACE, MINROS_TRACE_FRAMES=all), the cost of ``minros trace``. ``--baseline PY`` adds
+"baseline": minros run by another interpreter, e.g. a venv of another checkout, so two versions
+are compared in one interleaved run.
+
 This same file is also the worker: ``--role ...`` runs one side of a scenario, in whichever
 Python runs it (the venv's for minros and raw, /usr/bin/python3 for rospy), and prints one JSON
 line. ``--minros-python`` picks another interpreter for minros and raw, e.g. a venv made from
@@ -725,7 +730,9 @@ class Runner:
         return env
 
     def contenders(self) -> list:
-        names = ["minros"] + (["rospy"] if self.reference else []) + \
+        names = ["minros"] + (["minros+trace"] if self.args.trace else []) + \
+                (["baseline"] if self.args.baseline else []) + \
+                (["rospy"] if self.reference else []) + \
                 (["roscpp"] if self.roscpp else []) + ["py-min", "raw", "raw-1"]
         if self.args.only:
             names = [n for n in names if n in self.args.only.split(",")]
@@ -734,8 +741,16 @@ class Runner:
     def command(self, who: str, role: str, extra: list) -> tuple:
         if who == "roscpp":
             return [self.roscpp, *extra], self.env(True)
-        python = REFERENCE_PYTHON if who == "rospy" else self.args.minros_python
-        return [python, os.path.abspath(__file__), "--role", role, *extra], self.env(who == "rospy")
+        python = {"rospy": REFERENCE_PYTHON, "baseline": self.args.baseline}.get(
+            who, self.args.minros_python)
+        env = self.env(who == "rospy")
+        if who == "minros+trace":
+            # both processes append to one fresh trace, every frame of it
+            path = os.path.join(self.home, "bench-trace.jsonl")
+            if os.path.exists(path):
+                os.remove(path)
+            env.update(MINROS_TRACE=path, MINROS_TRACE_FRAMES="all")
+        return [python, os.path.abspath(__file__), "--role", role, *extra], env
 
     def pair(self, who: str, first: tuple, second: tuple, timeout: float = 90,
              first_measures: bool = False) -> dict:
@@ -952,8 +967,8 @@ class Runner:
             return None
         code = ("import rospy, time\nrospy.init_node('bench_idle', anonymous=True)\ntime.sleep(1.0)\n"
                 "print([l.split()[1] for l in open('/proc/self/status') if l.startswith('VmRSS')][0])\n")
-        python = REFERENCE_PYTHON if who == "rospy" else self.args.minros_python
-        out = subprocess.run([python, "-c", code], env=self.env(who == "rospy"), capture_output=True,
+        command, env = self.command(who, "", [])
+        out = subprocess.run([command[0], "-c", code], env=env, capture_output=True,
                              text=True, timeout=60).stdout.split()
         return float(out[-1]) / 1024 if out else None
 
@@ -991,6 +1006,17 @@ def _fmt(value) -> str:
     return f"{value:,.0f}" if value >= 100 else f"{value:.1f}"
 
 
+def _own_ratios(med: dict, contenders: list) -> list:
+    """minros+trace/minros (the trace's cost) and minros/baseline (two versions)."""
+    cells = []
+    for other in ("minros+trace", "baseline"):
+        if other in contenders:
+            top, bottom = (other, "minros") if other == "minros+trace" else ("minros", other)
+            ok = med.get(top) and med.get(bottom)
+            cells.append(f"{med[top] / med[bottom]:.2f}x" if ok else "—")
+    return cells
+
+
 def _python_version(python: str) -> str:
     out = subprocess.run([python, "-c", "import sys; print(sys.version.split()[0])"],
                          capture_output=True, text=True)
@@ -1018,6 +1044,10 @@ def main(argv=None) -> int:
                         help="interpreter of the minros and raw workers (default: the venv's)")
     parser.add_argument("--scenarios", default="", help="comma-separated: " +
                         ",".join(s[1] for s in SCENARIOS))
+    parser.add_argument("--trace", action="store_true",
+                        help="add minros+trace: minros writing a wire trace of every frame")
+    parser.add_argument("--baseline", default="", metavar="PY",
+                        help="add 'baseline': minros run by this interpreter (another checkout's venv)")
     args = parser.parse_args(argv)
     if args.role:
         ROLES[args.role](args)
@@ -1040,6 +1070,9 @@ def main(argv=None) -> int:
                         results[(key, who)].append(value)
                     print(f"round {rnd + 1} {key:8} {who:7} {_fmt(value)}", file=sys.stderr, flush=True)
         header = ["scenario", *contenders]
+        for other in ("minros+trace", "baseline"):
+            if other in contenders:
+                header.append(f"{other}/minros" if other == "minros+trace" else "minros/baseline")
         if "rospy" in contenders:
             header.append("minros/rospy")
         for other in ("py-min", "raw", "raw-1"):
@@ -1052,7 +1085,7 @@ def main(argv=None) -> int:
                     "srvnew": ("srvnew", "CPU per new-connection call, client side (µs)")}
 
         def ratio_row(title: str, med: dict) -> list:
-            row = [title] + [_fmt(med[c]) for c in contenders]
+            row = [title] + [_fmt(med[c]) for c in contenders] + _own_ratios(med, contenders)
             for other in ("rospy", "py-min", "raw", "raw-1"):
                 if other in contenders:
                     ok = med.get("minros") and med.get(other)

@@ -23,8 +23,9 @@ PKGS="ros-core python3-rosmaster python3-roslaunch rosout
 # Tools the tests drive besides ROS: a virtual display for turtlesim's window, zsh for
 # devel/setup.zsh; python3-venv and python3-tk so that minros's own venv can be built on the
 # same interpreter as the reference (scripts/test.sh), turtlesim's Tk window included;
-# graphviz for view_frames' frames.pdf; iproute2 for the two-host tests' network namespaces.
-TEST_TOOLS="xvfb zsh python3-venv python3-tk graphviz iproute2"
+# graphviz for view_frames' frames.pdf; iproute2 for the two-host tests' network namespaces;
+# tshark opens the capture files `minros trace pcap` writes.
+TEST_TOOLS="xvfb zsh python3-venv python3-tk graphviz iproute2 tshark"
 # minros web's tests: Debian's Chromium for roslib in a real browser (Playwright drives it),
 # node and npm for Foxglove's and roslib's own client libraries (tests/web/js, npm ci).
 WEB_TEST_TOOLS="chromium nodejs npm"
@@ -40,11 +41,13 @@ if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msg
    && /usr/bin/python3 -c 'import tf2_py, tf2_ros, tf, tf2_geometry_msgs' 2>/dev/null \
    && [ -x /usr/lib/tf/tf_echo ] && [ -x /usr/lib/tf2_tools/view_frames.py ] && command -v dot >/dev/null \
    && [ -x /usr/bin/chromium ] && command -v node >/dev/null && command -v npm >/dev/null \
-   && command -v ip >/dev/null; then
+   && command -v ip >/dev/null && command -v tshark >/dev/null; then
   echo "ROS 1 reference already installed"
   exit 0
 fi
 $SUDO apt-get update -q
+# tshark's package asks whether non-root users may capture: no (and no question)
+echo "wireshark-common wireshark-common/install-setuid boolean false" | $SUDO debconf-set-selections
 # shellcheck disable=SC2086
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $PKGS $TEST_TOOLS $WEB_TEST_TOOLS
 /usr/bin/python3 -c 'import rospy, rosmaster, genpy' && echo "ROS 1 reference installed"

@@ -36,7 +36,7 @@ from typing import Any, Callable, Dict, Iterable, List, Tuple
 from minros import logfiles, rosenv
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
 from minros.names import resolve_name as _resolve_name
-from minros.wire import xmlrpc
+from minros.wire import trace, xmlrpc
 from minros.wire.rosapi import (
     api,
     empty_or_valid_name,
@@ -867,6 +867,7 @@ class Master:
         else:
             self.uri = rosenv.create_local_xmlrpc_uri(self.server.port)
         self.handler._set_uri(self.uri)
+        trace.set_node("/master", self.uri, self.uri)
         return self
 
     @property

@@ -33,7 +33,7 @@ from typing import Any, Callable, Dict, List, Protocol, Sequence, Tuple
 
 from minros import names, rosenv
 from minros.exceptions import ROSException, ROSInitException, ServiceException
-from minros.wire import admission, sockets, tcpros
+from minros.wire import admission, sockets, tcpros, trace
 from minros.wire.rosapi import ParameterInvalid, api, is_topic
 from minros.wire.xmlrpc import ProtocolError, ServerProxy, XmlRpcServer, after_reply
 
@@ -395,6 +395,7 @@ class Node:
         self._xmlrpc.start()
         self.uri = f"http://{self.host}:{self._xmlrpc.port}/"
         _logger.info("ROS Slave URI: [%s]", self.uri)
+        trace.set_node(self.caller_id, self.uri, self.master_uri)
         if self._tcpros_port:
             self.tcpros_address()
         self._started = True
@@ -503,6 +504,7 @@ class Node:
 
     def _handle_inbound(self, sock: socket.socket, addr: Any, key: Any) -> None:
         """Read the connection header and hand the socket to the topic or service."""
+        sock = trace.watch(sock, "accept")
         conn = admission.Connection(self._tcpros_admission, key, self._evict_inbound)
         try:
             conn.reading()

@@ -29,6 +29,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
     "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
+    "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)

@@ -41,7 +41,7 @@ from minros.exceptions import (
     TransportInitError,
     TransportTerminated,
 )
-from minros.wire import admission, sockets, tcpros
+from minros.wire import admission, sockets, tcpros, trace
 from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
 
 # the node context (answers before init_node too)
@@ -365,7 +365,7 @@ def _connect(host: str, port: int, timeout: float) -> socket.socket:
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     except OSError:  # not fatal: only latency
         pass
-    return sock
+    return trace.watch(sock, "connect")
 
 
 class ServiceProxy:

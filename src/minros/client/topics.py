@@ -32,7 +32,7 @@ from minros.exceptions import (
     ROSSerializationException,
     SerializationError,
 )
-from minros.wire import sockets, tcpros
+from minros.wire import sockets, tcpros, trace
 from minros.wire.xmlrpc import ServerProxy
 
 __all__ = [
@@ -730,7 +730,7 @@ class _SubConnection:
 
     def _connect(self, host: str, port: int) -> bool:
         impl = self.impl
-        sock = socket.create_connection((host, port), timeout=10.0)
+        sock = trace.watch(socket.create_connection((host, port), timeout=10.0), "connect")
         self.sock = sock
         if self.done:
             return False

@@ -10,7 +10,7 @@ from __future__ import annotations
 import socket
 from typing import Dict
 
-from minros.wire import sockets, tcpros
+from minros.wire import sockets, tcpros, trace
 from minros.wire.rosapi import parse_rosrpc_uri
 
 __all__ = ["PROBE_TIMEOUT", "probe_service"]
@@ -29,7 +29,7 @@ def probe_service(uri: str, service: str, caller_id: str,
     tcpros.HeaderError when the server cannot be asked or answers garbage.
     """
     host, port = parse_rosrpc_uri(uri)
-    with socket.create_connection((host, port), timeout=timeout) as sock:
+    with trace.watch(socket.create_connection((host, port), timeout=timeout), "connect") as sock:
         sock.sendall(tcpros.encode_header({"probe": "1", "md5sum": "*", "callerid": caller_id,
                                            "service": service}))
         return sockets.read_header(sock, MAX_HEADER)

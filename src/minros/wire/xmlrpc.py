@@ -26,6 +26,7 @@ from urllib.parse import urlparse
 from xmlrpc.client import Binary, DateTime, Fault, ProtocolError  # noqa: F401 - re-exported
 
 from minros.wire import admission
+from minros.wire import trace as _trace
 
 # ------------------------------------------------------------------ limits
 
@@ -155,13 +156,14 @@ def _status_response(status: int, detail: str) -> bytes:
 class RequestHead:
     """What the head of one XML-RPC request says."""
 
-    __slots__ = ("version", "length", "keep_alive", "expect_continue")
+    __slots__ = ("version", "length", "keep_alive", "expect_continue", "raw")
 
     def __init__(self, version: str, length: int, keep_alive: bool, expect_continue: bool) -> None:
         self.version = version
         self.length = length
         self.keep_alive = keep_alive
         self.expect_continue = expect_continue
+        self.raw = b""  # the head as received, blank line included (for the trace)
 
 
 def parse_request_head(block: bytes, max_body: int) -> RequestHead:
@@ -267,6 +269,7 @@ class RequestReader:
                 raise _HttpError(431, "request head too long")
             return None
         self._head = parse_request_head(bytes(buf[:end]), self.max_body)
+        self._head.raw = bytes(buf[:stop])
         self._body = buf[stop:]
         self._buf = bytearray()
         self._scanned = 0
@@ -458,6 +461,8 @@ class XmlRpcServer:
 
     def _serve_connection(self, conn: socket.socket, key: int) -> None:
         reader = RequestReader(self.max_body)
+        served = 0  # requests on this connection (the trace numbers them)
+        addresses: Tuple[str, str] | None = None
         try:
             while not self._stopping.is_set():
                 try:
@@ -471,23 +476,35 @@ class XmlRpcServer:
                 except _Closed:
                     return
                 self.admission.set_state(key, admission.BUSY)
+                served += 1
+                traced = _trace.ON
+                t0 = time.time() if traced else 0.0
+                if traced and addresses is None:
+                    addresses = _addresses(conn)  # now: the peer may be gone after the reply
                 hooks: List[Callable[[], Any]] = []
                 _request.after_reply = hooks
                 try:
                     payload = self.dispatcher.handle_request_body(body)
                 finally:
                     _request.after_reply = None
-                    del body
+                    if not traced:
+                        del body  # not held while the reply goes out
                     self.admission.release(key)
                     leftover = reader.next_request()
                 head_text = ("HTTP/1.1 200 OK\r\nServer: minros\r\nContent-type: text/xml\r\n"
                              f"Content-length: {len(payload)}\r\n"
                              + ("" if head.keep_alive else "Connection: close\r\n") + "\r\n")
+                response = head_text.encode("latin-1") + payload
                 try:
                     # a client that does not read its reply has until the deadline to start
                     conn.settimeout(self.limits.transfer_time(len(payload)))
-                    conn.sendall(head_text.encode("latin-1") + payload)
+                    conn.sendall(response)
                     self.admission.set_state(key, admission.IDLE)
+                    if traced:
+                        request = bytes(body)
+                        del body
+                        _trace.xmlrpc_served(addresses or ("?", "?"), served, t0,
+                                             head.raw + request, request, response, payload)
                 finally:
                     for hook in hooks:
                         try:
@@ -551,6 +568,14 @@ class XmlRpcServer:
         if victims:
             self._evict(victims)
         reader.received(data)
+
+
+def _addresses(sock: socket.socket) -> Tuple[str, str]:
+    """(local, remote) ``host:port`` of a connected socket, for the trace."""
+    try:
+        return _trace.address(sock.getsockname()), _trace.address(sock.getpeername())
+    except OSError:
+        return "?", "?"
 
 
 def _local_address(conn: socket.socket) -> str | None:
@@ -623,6 +648,10 @@ class ServerProxy:
         self._sock: socket.socket | None = None
         self._reader: Any = None
         self._lock = threading.Lock()
+        # for the trace: requests sent on this socket, its addresses, the last raw response
+        self._sent = 0
+        self._addresses: Tuple[str, str] | None = None
+        self._response: bytes | None = None
 
     def __getattr__(self, name: str) -> _Method:
         if name.startswith("__"):
@@ -649,18 +678,33 @@ class ServerProxy:
         with self._lock:
             for attempt in (0, 1):
                 reused = self._sock is not None
+                t0 = time.time() if _trace.ON else 0.0
                 try:
-                    return self._single_request(request)
+                    result = self._single_request(request)
                 except (ConnectionResetError, ConnectionAbortedError, BrokenPipeError,
-                        _PeerClosed):
+                        _PeerClosed) as exc:
+                    if t0:
+                        self._trace(method, params, request, t0, error=exc)
                     self._drop()
                     # A kept-alive connection the server closed while idle: retry once afresh.
                     if attempt or not reused:
                         raise
-                except BaseException:
+                except BaseException as exc:
+                    if t0:
+                        self._trace(method, params, request, t0, error=exc)
                     self._drop()
                     raise
+                else:
+                    if t0:
+                        self._trace(method, params, request, t0, result=result)
+                    return result
         raise AssertionError("unreachable")
+
+    def _trace(self, method: str, params: Tuple[Any, ...], request: bytes, t0: float,
+               result: Any = None, error: BaseException | None = None) -> None:
+        response, self._response = self._response, None
+        _trace.xmlrpc_called(self.uri, method, params, self._sent, self._addresses, t0, request,
+                             response, result, error)
 
     def _drop(self) -> None:
         if self._reader is not None:
@@ -678,13 +722,19 @@ class ServerProxy:
 
     def _single_request(self, request: bytes) -> Any:
         if self._sock is None:
+            self._addresses = None
             sock = socket.create_connection(self._address, timeout=self.timeout)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             self._sock = sock
             self._reader = sock.makefile("rb", buffering=65536)
+            self._sent = 0
+            if _trace.ON:
+                self._addresses = _addresses(sock)
+        self._sent += 1
         self._sock.sendall(request)
         reader = self._reader
         status_line = reader.readline(MAX_HEADER_LINE + 1)
+        raw_head = [status_line]
         if not status_line:
             raise _PeerClosed("connection closed by the server")
         parts = status_line.decode("latin-1").split(None, 2)
@@ -695,6 +745,7 @@ class ServerProxy:
         headers: Dict[str, str] = {}
         for _ in range(MAX_HEADER_LINES + 1):
             line = reader.readline(MAX_HEADER_LINE + 1)
+            raw_head.append(line)
             if line in (b"\r\n", b"\n", b""):
                 break
             key, _sep, value = line.decode("latin-1").partition(":")
@@ -717,6 +768,8 @@ class ServerProxy:
             data = reader.read(length)
             if len(data) != length:
                 raise _PeerClosed("connection closed mid-response")
+        if _trace.ON:
+            self._response = b"".join(raw_head) + data
         if close:
             self._drop()
         if len(data) > self.max_body:
