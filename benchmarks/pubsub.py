@@ -694,6 +694,11 @@ def _cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def _pinned(command: tuple, cpu: int) -> tuple:
+    """``command`` run on one CPU (taskset, so that roscpp's binary is pinned the same way)."""
+    return (["taskset", "-c", str(cpu), *command[0]], command[1])
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -783,26 +788,32 @@ class Runner:
             except subprocess.TimeoutExpired:
                 p1.kill()
 
-    def latency(self, who: str, queue: str):
+    def latency(self, who: str, queue: str, placement: str = ""):
+        """Median round trip; ``placement`` "same" pins both processes to CPU 0, "split" to CPUs
+        0 and 1 (the kernel's choice otherwise, which on a VM decides a wake-up's cost)."""
         if who in ("py-min", "raw", "raw-1"):
             if queue == "none":
                 return None
             port = _free_port()
             kind = "raw" if who == "raw-1" else "raw-pubsub"
             extra = ["--messages"] if who == "py-min" else []
-            r = self.pair(who, self.command(who, f"{kind}-echo", ["--port", str(port), *extra]),
-                          self.command(who, f"{kind}-ping", ["--port", str(port), *extra,
-                                                              "--count", str(self.args.count)]))
+            first = self.command(who, f"{kind}-echo", ["--port", str(port), *extra])
+            second = self.command(who, f"{kind}-ping", ["--port", str(port), *extra,
+                                                        "--count", str(self.args.count)])
         elif who == "roscpp":
             if queue == "none":
                 return None
-            r = self.pair(who, self.command(who, "", ["echo", "small", "10", "0", "0"]),
-                          self.command(who, "", ["ping", "small", "10", "0", str(self.args.count)]))
+            first = self.command(who, "", ["echo", "small", "10", "0", "0"])
+            second = self.command(who, "", ["ping", "small", "10", "0", str(self.args.count)])
         else:
-            r = self.pair(who, self.command(who, "echo", ["--queue", queue]),
-                          self.command(who, "ping", ["--queue", queue, "--count", str(self.args.count)]))
+            first = self.command(who, "echo", ["--queue", queue])
+            second = self.command(who, "ping", ["--queue", queue, "--count", str(self.args.count)])
+        if placement:
+            first, second = _pinned(first, 0), _pinned(second, 0 if placement == "same" else 1)
+        r = self.pair(who, first, second)
         if "cpu_us" in r:
-            self.cpu[(queue, who)] = self.cpu.get((queue, who), []) + [r["cpu_us"]]
+            key = queue + placement
+            self.cpu[(key, who)] = self.cpu.get((key, who), []) + [r["cpu_us"]]
         return r.get("median_us")
 
     def flood(self, who: str, kind: str):
@@ -826,20 +837,25 @@ class Runner:
                           first_measures=True)
         return r.get("rate")
 
-    def service(self, who: str, persistent: bool):
+    def service(self, who: str, persistent: bool, placement: str = ""):
         if who in ("py-min", "raw", "raw-1"):
             return None
-        count = str(max(self.args.count // 4, 100))
+        # as many calls as the topic round trips (a short run measures the CPU waking up);
+        # a quarter when every call opens a connection (each takes ten times longer)
+        count = str(self.args.count if persistent else max(self.args.count // 4, 100))
         if who == "roscpp":
-            r = self.pair(who, self.command(who, "", ["srv-server", "x", "0", "0", "0"]),
-                          self.command(who, "", ["srv-client", "persistent" if persistent else "plain",
-                                                 "0", "0", count]))
+            first = self.command(who, "", ["srv-server", "x", "0", "0", "0"])
+            second = self.command(who, "", ["srv-client", "persistent" if persistent else "plain",
+                                            "0", "0", count])
         else:
-            r = self.pair(who, self.command(who, "srv-server", []),
-                          self.command(who, "srv-client", [*(["--persistent"] if persistent else []),
-                                                           "--count", count]))
+            first = self.command(who, "srv-server", [])
+            second = self.command(who, "srv-client", [*(["--persistent"] if persistent else []),
+                                                      "--count", count])
+        if placement:
+            first, second = _pinned(first, 0), _pinned(second, 0 if placement == "same" else 1)
+        r = self.pair(who, first, second)
         if "cpu_us" in r:
-            key = "srv" if persistent else "srvnew"
+            key = ("srv" if persistent else "srvnew") + placement
             self.cpu[(key, who)] = self.cpu.get((key, who), []) + [r["cpu_us"]]
         return r.get("median_us")
 
@@ -984,11 +1000,18 @@ class Runner:
 SCENARIOS = [
     ("round trip, queue_size=10 (µs)", "lat10", lambda r, w: r.latency(w, "10"), "low"),
     ("round trip, queue_size=None (µs)", "latnone", lambda r, w: r.latency(w, "none"), "low"),
+    ("round trip, q=10, both processes on one CPU (µs)", "lat10same",
+     lambda r, w: r.latency(w, "10", "same"), "low"),
+    ("round trip, q=10, processes on different CPUs (µs)", "lat10split",
+     lambda r, w: r.latency(w, "10", "split"), "low"),
     ("small-message flood (msg/s received)", "flood", lambda r, w: r.flood(w, "small"), "high"),
     ("640x480 bgr8 images (frames/s)", "vga", lambda r, w: r.flood(w, "vga"), "high"),
     ("1920x1080 bgr8 images (frames/s)", "hd", lambda r, w: r.flood(w, "hd"), "high"),
     ("idle node memory (MB RSS)", "mem", lambda r, w: r.idle_memory(w), "low"),
     ("service call, persistent (µs)", "srv", lambda r, w: r.service(w, True), "low"),
+    ("service call, persistent, one CPU (µs)", "srvsame", lambda r, w: r.service(w, True, "same"), "low"),
+    ("service call, persistent, different CPUs (µs)", "srvsplit",
+     lambda r, w: r.service(w, True, "split"), "low"),
     ("service call, new connection each (µs)", "srvnew", lambda r, w: r.service(w, False), "low"),
     ("1 publisher -> 8 subscribers, small (msg/s delivered)", "fan", lambda r, w: r.fanout(w, "small"), "high"),
     ("1 publisher -> 8 subscribers, 640x480 (frames/s delivered)", "fanvga",
@@ -1081,7 +1104,11 @@ def main(argv=None) -> int:
         rows = []
         # CPU time (steadier than wall-clock latency on a loaded or idle machine) follows its scenario
         cpu_rows = {"lat10": ("10", "CPU per round trip, ping side, q=10 (µs)"),
+                    "lat10same": ("10same", "CPU per round trip, one CPU (µs)"),
+                    "lat10split": ("10split", "CPU per round trip, different CPUs (µs)"),
                     "srv": ("srv", "CPU per persistent call, client side (µs)"),
+                    "srvsame": ("srvsame", "CPU per persistent call, one CPU (µs)"),
+                    "srvsplit": ("srvsplit", "CPU per persistent call, different CPUs (µs)"),
                     "srvnew": ("srvnew", "CPU per new-connection call, client side (µs)")}
 
         def ratio_row(title: str, med: dict) -> list:
