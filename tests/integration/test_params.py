@@ -128,3 +128,44 @@ def test_node_private_relative_remapped_and_cached(master_env, tmp_path):
         assert second == {"cached2": {"now": "a dict"}, "master_calls": []}
     finally:
         proc.stop()
+
+
+UNSET_NODE = r'''
+import json, time
+import rospy
+from minros import node
+
+rospy.init_node("unset_node")
+calls = []
+me = node.default_node()
+original = me.master_call
+def counting(method, *args):
+    calls.append(method)
+    return original(method, *args)
+me.master_call = counting
+first = [rospy.get_param_cached("/later", "dflt") for _ in range(5)]
+print("RESULT1 " + json.dumps({"values": first, "master_calls": calls}), flush=True)
+deadline = time.monotonic() + 20
+value = "dflt"
+while time.monotonic() < deadline and value == "dflt":
+    value = rospy.get_param_cached("/later", "dflt")
+    time.sleep(0.01)
+print("RESULT2 " + json.dumps({"value": value}), flush=True)
+rospy.spin()
+'''
+
+
+def test_cached_unset_parameter_asks_the_master_once(master_env, tmp_path):
+    """rospy asks the master again on every get_param_cached of an unset key (the log's
+    /rosout_disable_topics_generation on every log line); minros subscribes once and waits
+    for the master's paramUpdate, which arrives when someone sets the key."""
+    script = tmp_path / "unset_node.py"
+    script.write_text(UNSET_NODE)
+    proc = Proc([PYTHON, str(script)], master_env)
+    try:
+        first = result(proc, "RESULT1")
+        assert first == {"values": ["dflt"] * 5, "master_calls": ["subscribeParam"]}
+        minros.set_param("/later", 42)
+        assert result(proc, "RESULT2") == {"value": 42}
+    finally:
+        proc.stop()

@@ -50,6 +50,9 @@ class ParamCache:
     def __init__(self) -> None:
         self.lock = threading.Lock()
         self.tree: Dict[str, Any] | None = None
+        #: subscribed keys the master answered "not set" for: known unset until a paramUpdate
+        #: or set_param says otherwise (rospy asks the master again on every call instead)
+        self.unset: set = set()
 
     @staticmethod
     def _parts(key: str) -> List[str]:
@@ -74,8 +77,22 @@ class ParamCache:
                 d = child
             d[parts[-1]] = value
 
+    def mark_unset(self, key: str) -> None:
+        """The master says ``key`` is not set, and will tell us (paramUpdate) when it is."""
+        with self.lock:
+            self.unset.add(tuple(self._parts(key)))
+
+    def is_unset(self, key: str) -> bool:
+        return tuple(self._parts(key)) in self.unset
+
     def update(self, key: str, value: Any) -> None:
         """Replace the value at an already cached ``key``; KeyError if it is not cached."""
+        # the master names a key with or without its trailing '/': compare the parts
+        if self.is_unset(key) and not (isinstance(value, dict) and not value):
+            with self.lock:
+                self.unset.discard(tuple(self._parts(key)))
+            self.set(key, value)
+            return
         with self.lock:
             parts = self._parts(key)
             d = self.tree
@@ -106,6 +123,7 @@ class ParamCache:
     def clear(self) -> None:
         with self.lock:
             self.tree = None
+            self.unset.clear()
 
 
 _cache = ParamCache()
@@ -163,16 +181,21 @@ def get_param_cached(param_name: str, default: Any = _unspecified) -> Any:
         return _cache.get(resolved)
     except KeyError:
         pass
+    if _cache.is_unset(resolved):  # subscribed, and not set since: no need to ask again
+        if default is not _unspecified:
+            return default
+        raise KeyError(param_name)
     if not _node_uri():
         # no node to receive paramUpdate: a plain lookup is the best we can do
         return get_param(param_name, default)
     _install_update_handler()
     value = node.subscribe_param(resolved)
-    _cache.set(resolved, value)
     if isinstance(value, dict) and not value:  # subscribeParam answers {} for an unset key
+        _cache.mark_unset(resolved)
         if default is not _unspecified:
             return default
         raise KeyError(param_name)
+    _cache.set(resolved, value)
     return value
 
 
