@@ -36,6 +36,7 @@ from typing import Any, Callable, Dict, Iterable, List, Tuple
 from minros import logfiles, rosenv
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
 from minros.names import resolve_name as _resolve_name
+from minros.signals import SignalWatch
 from minros.wire import trace, xmlrpc
 from minros.wire.rosapi import (
     api,
@@ -912,12 +913,8 @@ def configure_log_file(path: str) -> bool:
 
 
 def install_stop_signals(stop: Callable[[], None]) -> None:
-    """SIGINT/SIGTERM stop the master cleanly (no traceback)."""
-    def handle(signum: int, frame: Any) -> None:
-        stop()
-
-    signal.signal(signal.SIGINT, handle)
-    signal.signal(signal.SIGTERM, handle)
+    """SIGINT/SIGTERM stop the master cleanly (no traceback), from a thread of their own."""
+    SignalWatch(lambda _signum: stop(), "master-signals").install((signal.SIGINT, signal.SIGTERM))
 
 
 def main(argv: List[str] | None = None, prog: str = "minros master") -> int:

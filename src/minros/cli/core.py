@@ -22,6 +22,7 @@ from urllib.parse import urlparse
 
 from minros import logfiles
 from minros.rosenv import renew_latest_log_dir
+from minros.signals import SignalWatch
 
 #: minros implements the Noetic protocols; tools that ask for the distro get a real one.
 ROSDISTRO = "noetic"
@@ -221,12 +222,8 @@ def main(argv: List[str], prog: str = "minros core") -> int:
         return 1
 
     stop = threading.Event()
-
-    def on_signal(signum, frame) -> None:
-        stop.set()
-
-    signal.signal(signal.SIGINT, on_signal)
-    signal.signal(signal.SIGTERM, on_signal)
+    # set from a thread of its own, not in the handler (see minros.signals)
+    SignalWatch(lambda _signum: stop.set(), "core-signals").install((signal.SIGINT, signal.SIGTERM))
 
     from minros.rosenv import ros_log_dir
 

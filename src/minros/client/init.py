@@ -16,14 +16,16 @@ from typing import Any, Dict, List
 from minros import node
 from minros.client import rosout_log, rostime, statistics
 from minros.client.topics import Subscriber
+from minros.signals import SignalWatch
 
 __all__ = ["init_node"]
 
 _signal_chain: Dict[int, Any] = {}
+_watch: List[SignalWatch] = []
 
 
 def _on_signal(signum: int, frame: Any) -> None:
-    node.signal_shutdown(f"signal-{signum}")
+    _watch[0].handler(signum, frame)  # the shutdown itself runs outside the handler
     previous = _signal_chain.get(signum)
     if callable(previous) and previous is not signal.default_int_handler:
         try:
@@ -36,6 +38,8 @@ def _register_signals() -> None:
     """SIGINT and SIGTERM shut the node down (then chain to handlers installed before)."""
     if _signal_chain or threading.current_thread() is not threading.main_thread():
         return
+    _watch.append(SignalWatch(lambda signum: node.signal_shutdown(f"signal-{signum}"),
+                              "minros-signal-shutdown"))
     for signum in (signal.SIGINT, signal.SIGTERM):
         try:
             _signal_chain[signum] = signal.signal(signum, _on_signal)

@@ -27,6 +27,7 @@ from urllib.parse import urlparse
 from minros import logfiles, names
 from minros.launch.config import LaunchConfig, LaunchError, NodeSpec
 from minros.rosenv import renew_latest_log_dir, ros_home, ros_log_dir
+from minros.signals import SignalWatch
 
 Print = Callable[[str], None]
 
@@ -510,8 +511,10 @@ class LaunchRunner:
     def run(self, install_signal_handlers: bool = True) -> int:
         previous = {}
         if install_signal_handlers:
-            for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-                previous[sig] = signal.signal(sig, lambda *_: self.shutdown.set())
+            # the shutdown event is set from a thread of its own, not in the handler
+            # (see minros.signals)
+            previous = SignalWatch(lambda _signum: self.shutdown.set(), "roslaunch-signals").install(
+                (signal.SIGINT, signal.SIGTERM, signal.SIGHUP))
         try:
             try:
                 self._start_master()

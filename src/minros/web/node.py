@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any, List, Optional
 
 import minros
+from minros.signals import SignalWatch
 
 
 @dataclass
@@ -89,8 +90,7 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
         return 1
     minros.init_node(settings.name, argv=argv, disable_signals=True)
     stop = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_args: stop.set())
+    SignalWatch(lambda _signum: stop.set(), "web-signals").install((signal.SIGINT, signal.SIGTERM))
     minros.on_shutdown(stop.set)
     state = WebState(Options(topics_glob=settings.topics_glob, services_glob=settings.services_glob,
                              params_glob=settings.params_glob, graph_interval=settings.graph_interval,
