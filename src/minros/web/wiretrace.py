@@ -15,6 +15,7 @@ in it, including the ones created later) or a quoted glob pattern.
 
 from __future__ import annotations
 
+import functools
 import glob
 import inspect
 import os
@@ -23,6 +24,8 @@ import time
 from collections import OrderedDict, deque
 from typing import Any, Callable, Deque, Dict, Hashable, List, Optional, Sequence, Tuple
 
+from minros.master import MasterHandler
+from minros.node import SlaveApi
 from minros.tools.trace import show
 from minros.tools.trace.merge import Call, Connection, Follower, Item, Wire
 
@@ -39,36 +42,23 @@ POLL_INTERVAL = 0.25
 CUT_AFTER = 2.0
 TRACE_SUFFIX = ".jsonl"
 
-HELP = ("start a traced run: minros trace -o run.jsonl -- roslaunch PKG FILE.launch "
-        "(or MINROS_TRACE=run.jsonl in the environment of each program), then: "
-        "minros web --trace run.jsonl")
 
-
-def _arg_names() -> Dict[str, Tuple[str, ...]]:
+@functools.cache
+def _api_arg_names() -> Dict[str, Tuple[str, ...]]:
     """The parameter names of every Master and Slave API method, from the handlers that serve
     them (caller_id, topic, topic_type, caller_api, ...)."""
-    from minros.master import MasterHandler
-    from minros.node import SlaveApi
-
     names: Dict[str, Tuple[str, ...]] = {}
     for cls in (SlaveApi, MasterHandler):
         for method, function in inspect.getmembers(cls, inspect.isfunction):
-            if method.startswith("_"):
-                continue
             params = list(inspect.signature(function).parameters)[1:]
-            if params[:1] == ["caller_id"]:
+            if not method.startswith("_") and params[:1] == ["caller_id"]:
                 names[method] = tuple(params)
     return names
 
 
-_ARG_NAMES: Optional[Dict[str, Tuple[str, ...]]] = None
-
-
 def arg_names(method: str) -> Tuple[str, ...]:
-    global _ARG_NAMES
-    if _ARG_NAMES is None:
-        _ARG_NAMES = _arg_names()
-    return _ARG_NAMES.get(method, ())
+    """The names of an API method's arguments (none for a method the APIs do not have)."""
+    return _api_arg_names().get(method, ())
 
 
 def _cut(value: str, limit: int = VALUE_LIMIT) -> str:
@@ -412,7 +402,7 @@ class WireFeed:
         return {"specs": self.specs, "files": [p for p in follower.paths
                                                if p not in follower.waiting],
                 "events": self.events, "t0": self.view.t0, "problems": problems,
-                "notes": notes, "help": HELP}
+                "notes": notes}
 
     # -- the pages -------------------------------------------------------------------------
 

@@ -23,13 +23,9 @@ function seconds(t, t0) {
   return (d >= 0 ? "+" : "") + d.toFixed(3);
 }
 
-function jsonText(value) {
-  return JSON.stringify(value);
-}
-
 /** A value of an XML-RPC argument, a result or a message: short ones inline, others as a tree. */
 function valueCell(value) {
-  const text = jsonText(value);
+  const text = JSON.stringify(value);
   if (value === null || typeof value !== "object" || text.length <= 100) return h("code", {class: "wire-value"}, text);
   const tree = treeView(1);
   tree.update(value);
