@@ -2,8 +2,8 @@
 
 ``minros web [--port 9090] [--host 127.0.0.1] [--token TOKEN] [--trace PATH...] ...`` runs
 until Ctrl-C as the node ``/minros_web`` (``__name:=`` renames it); ``--trace`` names the wire
-traces (``minros trace -o FILE -- COMMAND``) the page's Wire view follows. roslaunch users start the same server with
-``roslaunch rosbridge_server rosbridge_websocket.launch`` or
+traces (``minros trace -o FILE -- COMMAND``) the page's Wire view follows. roslaunch users
+start the same server with ``roslaunch rosbridge_server rosbridge_websocket.launch`` or
 ``roslaunch foxglove_bridge foxglove_bridge.launch``.
 """
 
@@ -19,8 +19,8 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         prog=prog,
         description="Serve the ROS graph to browsers and GUIs on one port: a page at / to see "
                     "and drive it (graph, topics, plots, images, turtlesim, parameters, services, "
-                    "console, the wire trace), rosbridge v2 with rosapi (roslibjs, roslibpy, webviz), the "
-                    "Foxglove WebSocket protocol (Foxglove, Lichtblick) and web_video_server's "
+                    "console, the wire trace), rosbridge v2 with rosapi (roslibjs, roslibpy, "
+                    "webviz), the Foxglove WebSocket protocol (Foxglove, Lichtblick) and web_video_server's "
                     "/stream, /snapshot and /stream_viewer endpoints.")
     parser.add_argument("--port", type=int, default=9090, help="TCP port (default 9090)")
     parser.add_argument("--host", default="127.0.0.1",
