@@ -591,9 +591,12 @@ def test_page_works_behind_a_token(browser, system, shots):
 # -- the other views, phone layout ------------------------------------------------------------
 
 def test_wire_and_about_views(page):
-    page.open("wire")
-    page.view("wire").get_by_text("no wire trace yet").wait_for()
-    page.shot("wire")
+    page.open("wire")  # this server follows no trace: the view says how to start a traced run
+    wire = page.view("wire")
+    wire.locator(".wire-help").get_by_text("minros web --trace run.jsonl").wait_for()
+    assert "minros trace -o run.jsonl -- roslaunch" in wire.locator(".wire-help").inner_text()
+    assert wire.locator(".toolbar").is_hidden()
+    page.shot("wire_no_trace")  # wire.png is test_page_wire.py's, on a traced run
     page.page.goto(page.system.url + "#about")
     page.view("about").get_by_text("rosbridge v2").wait_for()
 

@@ -237,8 +237,9 @@ class FakeState:
 
 
 class FakeHub:
-    def __init__(self) -> None:
+    def __init__(self, wire=None) -> None:
         self.sessions = []
+        self.wire = wire
 
     def add(self, session):
         self.sessions.append(session)
@@ -247,12 +248,13 @@ class FakeHub:
         self.sessions.remove(session)
 
 
-def session():
+def session(wire=None):
     from minros.web.page import PageSession
 
     outbox = Outbox()
     state = FakeState()
-    sent = PageSession("test", state, outbox, lambda reason: None, FakeHub(), run_async=lambda fn: fn())
+    sent = PageSession("test", state, outbox, lambda reason: None, FakeHub(wire),
+                       run_async=lambda fn: fn())
     return sent, outbox, state
 
 

@@ -1,8 +1,9 @@
 """``minros web``: rosbridge v2 with rosapi, Foxglove WebSocket and video endpoints on one port.
 
-``minros web [--port 9090] [--host 127.0.0.1] [--token TOKEN] ...`` runs until Ctrl-C as the
-node ``/minros_web`` (``__name:=`` renames it). roslaunch users start the same server with
-``roslaunch rosbridge_server rosbridge_websocket.launch`` or
+``minros web [--port 9090] [--host 127.0.0.1] [--token TOKEN] [--trace PATH...] ...`` runs
+until Ctrl-C as the node ``/minros_web`` (``__name:=`` renames it); ``--trace`` names the wire
+traces (``minros trace -o FILE -- COMMAND``) the page's Wire view follows. roslaunch users
+start the same server with ``roslaunch rosbridge_server rosbridge_websocket.launch`` or
 ``roslaunch foxglove_bridge foxglove_bridge.launch``.
 """
 
@@ -18,8 +19,8 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         prog=prog,
         description="Serve the ROS graph to browsers and GUIs on one port: a page at / to see "
                     "and drive it (graph, topics, plots, images, turtlesim, parameters, services, "
-                    "console), rosbridge v2 with rosapi (roslibjs, roslibpy, webviz), the "
-                    "Foxglove WebSocket protocol (Foxglove, Lichtblick) and web_video_server's "
+                    "console, the wire trace), rosbridge v2 with rosapi (roslibjs, roslibpy, "
+                    "webviz), the Foxglove WebSocket protocol (Foxglove, Lichtblick) and web_video_server's "
                     "/stream, /snapshot and /stream_viewer endpoints.")
     parser.add_argument("--port", type=int, default=9090, help="TCP port (default 9090)")
     parser.add_argument("--host", default="127.0.0.1",
@@ -45,6 +46,11 @@ def _parser(prog: str) -> argparse.ArgumentParser:
                              "changes, such as rosmaster (default 1; minros's master pushes)")
     parser.add_argument("--compression", action="store_true",
                         help="offer permessage-deflate (costs CPU on images)")
+    parser.add_argument("--trace", nargs="+", action="extend", default=[], metavar="PATH",
+                        help="follow these wire traces live in the page's Wire view: files "
+                             "written by 'minros trace -o FILE -- COMMAND' or MINROS_TRACE=FILE "
+                             "(they may not exist yet), directories (their *.jsonl) or quoted "
+                             "glob patterns")
     return parser
 
 
@@ -63,5 +69,6 @@ def main(argv: List[str], prog: str | None = None) -> int:
                         params_glob=parse_globs(args.params_glob),
                         graph_interval=max(0.05, args.graph_interval),
                         send_timeout=max(0.5, args.send_timeout),
-                        max_message_size=args.max_message_size, compression=args.compression)
+                        max_message_size=args.max_message_size, compression=args.compression,
+                        trace=args.trace)
     return run(settings, announce=lambda text: print(text, flush=True))

@@ -37,6 +37,7 @@ class Settings:
     server_name: str = "minros web"
     rosapi: bool = True
     server: bool = True
+    trace: List[str] = field(default_factory=list)  # wire traces for the page's Wire view
 
 
 def parse_globs(value: Any) -> List[str]:
@@ -106,7 +107,7 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
                            name=settings.server_name, rosapi=rosapi,
                            send_timeout=settings.send_timeout,
                            max_message_size=settings.max_message_size,
-                           compression=settings.compression)
+                           compression=settings.compression, trace=settings.trace)
         try:
             server.start()
         except OSError as exc:
@@ -148,7 +149,8 @@ def _banner(server: Any, settings: Settings) -> str:
         f"  rosbridge v2 + rosapi  {ws}{token}   (roslibjs, roslibpy, webviz)",
         f"  Foxglove WebSocket     {ws}{token}   (Foxglove, Lichtblick: 'Foxglove WebSocket')",
         f"  video                  {url}/streams{token}   (/stream?topic=..., /snapshot?topic=...)",
-    ])
+    ] + ([f"  wire trace             {url}/{token}#wire   (following {' '.join(settings.trace)})"]
+         if settings.trace else []))
 
 
 def run_node(default_name: str, default_port: int, server_name: str, serve: bool = True) -> int:

@@ -26,10 +26,13 @@ are pushed:
 ``pub_start``      ``{id, topic, type, yaml | msg, rate}``: publish once (rate 0) or at a rate
                    until ``pub_stop {id}``; YAML as ``rostopic pub`` reads it, ``msg`` as
                    rosbridge's publish
+``wire_watch``     the steps of the wire traces the server follows (``--trace``), then what
+                   changes, as ``wire`` frames: ``steps`` (added or changed, by ``id``),
+                   ``removed`` ids, ``status`` (files, problems); the first has ``reset``
 =================  ==========================================================================
 
 The first frame the server sends is ``hello`` (node name, how the graph is read, the debug
-names the graph hides, whether a wire trace is available). What the session derives (plot
+names the graph hides, whether it follows wire traces and which). What the session derives (plot
 points, stats, log lines) is computed in ROS threads and only queued; the client's writer
 thread encodes and sends, as for every other client (:mod:`minros.web.outbox`).
 """
@@ -40,7 +43,7 @@ import json
 import threading
 import time
 from collections import deque
-from typing import Any, Callable, Deque, Dict, Hashable, List, Optional, Tuple
+from typing import Any, Callable, Deque, Dict, Hashable, List, Optional, Set, Tuple
 
 import minros
 from minros.tools.master import QUIET_NAMES
@@ -50,6 +53,7 @@ from minros.web.outbox import Outbox
 from minros.web.rosapi import Graph
 from minros.web.rosbridge import OpError, RosbridgeSession, _check
 from minros.web.state import Incoming, WebState, flatten_params
+from minros.web.wiretrace import WireFeed
 
 SUBPROTOCOL = "minros.page.v1"
 #: topics one page may ask statistics for at a time
@@ -64,9 +68,12 @@ MAX_PUBLISHING = 32
 MAX_DYNREC_CLIENTS = 32
 #: log lines sent in one ``log`` frame
 LOG_BATCH = 5_000
+#: wire steps sent in one ``wire`` frame
+WIRE_BATCH = 500
 PLOT_INTERVAL = 0.05
 ECHO_INTERVAL = 0.1
 LOG_INTERVAL = 0.1
+WIRE_INTERVAL = 0.1
 NODE_TIMEOUT = 2.0
 DYNREC_TIMEOUT = 3.0
 MAX_PUBLISH_RATE = 1000.0
@@ -76,11 +83,12 @@ LOG_TYPE = "rosgraph_msgs/Log"
 
 class PageHub:
     """What all page sessions of one server share: the console's log ring (one tap on
-    ``/rosout_agg``), dynamic_reconfigure clients, and the one-second ticker that sends
-    statistics."""
+    ``/rosout_agg``), dynamic_reconfigure clients, the one-second ticker that sends
+    statistics, and the wire traces followed (``wire``, None without ``--trace``)."""
 
-    def __init__(self, state: WebState) -> None:
+    def __init__(self, state: WebState, wire: Optional[WireFeed] = None) -> None:
         self.state = state
+        self.wire = wire
         self.log = pagemodel.LogRing()
         self.sessions: Dict[int, PageSession] = {}
         self.lock = threading.Lock()
@@ -243,17 +251,17 @@ class PageSession(RosbridgeSession):
 
     def __init__(self, client_id: str, state: WebState, outbox: Outbox,
                  close_client: Callable[[str], None], hub: PageHub, rosapi: Any = None,
-                 run_async: Optional[Callable[[Callable[[], None]], None]] = None,
-                 wire: bool = False) -> None:
+                 run_async: Optional[Callable[[Callable[[], None]], None]] = None) -> None:
         super().__init__(client_id, state, outbox, close_client, rosapi=rosapi, run_async=run_async)
         self.hub = hub
-        self.wire = wire
         self.key = ("page", client_id)
         self.stats_topics: Dict[str, pagemodel.TopicMeter] = {}
         self.plots: Dict[Any, _Plot] = {}
         self.echoes: Dict[Any, str] = {}
         self.publishing: Dict[Any, _Publishing] = {}
         self.console_seq: Optional[int] = None
+        self.wire_seq: Optional[int] = None  # None: the page does not watch the wire
+        self.wire_sent: Set[int] = set()
         self.params_watched = False
         self.page_lock = threading.Lock()
         self.ops.update({
@@ -263,14 +271,16 @@ class PageSession(RosbridgeSession):
             "params": self.params, "param_set": self.param_set,
             "param_delete": self.param_delete, "dynrec_get": self.dynrec_get,
             "dynrec_set": self.dynrec_set, "pub_start": self.pub_start,
-            "pub_stop": self.pub_stop,
+            "pub_stop": self.pub_stop, "wire_watch": self.wire_watch,
         })
         hub.add(self)
 
     def start(self) -> None:
         self.send({"op": "hello", "protocol": SUBPROTOCOL, "node": minros.get_caller_id(),
                    "graph_mode": self.state.graph_mode, "quiet": list(QUIET_NAMES),
-                   "wire": self.wire, "version": _version(), "started": self.state.started})
+                   "wire": self.hub.wire is not None,
+                   "wire_paths": self.hub.wire.specs if self.hub.wire is not None else [],
+                   "version": _version(), "started": self.state.started})
 
     # -- replies ---------------------------------------------------------------------------
 
@@ -498,6 +508,49 @@ class PageSession(RosbridgeSession):
                 break
         return frames
 
+    # -- the wire --------------------------------------------------------------------------
+
+    def wire_watch(self, msg: Dict[str, Any]) -> None:
+        feed = self.hub.wire
+        if feed is None:
+            self.fail(msg, "this server follows no wire trace: start it with 'minros web "
+                           "--trace FILE' (FILE written by 'minros trace -o FILE -- ...')")
+            return
+        slot = ("page", "wire")
+        self.outbox.open_slot(slot, lambda _token: self._render_wire(), maxlen=1,
+                              min_interval=WIRE_INTERVAL)
+        with self.page_lock:
+            self.wire_seq, self.wire_sent = 0, set()
+        feed.listen(self.key, lambda: self.outbox.put(slot, None))
+        self.outbox.put(slot, None)
+
+    def _render_wire(self) -> List[str]:
+        """What changed since this page's last ``wire`` frame, in frames of WIRE_BATCH steps
+        (the page drops what is ``removed``: the store keeps the newest steps)."""
+        feed = self.hub.wire
+        with self.page_lock:
+            since, sent = self.wire_seq, self.wire_sent
+        if feed is None or since is None:
+            return []
+        steps, removed, status, seq = feed.changes(since, sent)
+        sent.difference_update(removed)
+        sent.update(step["id"] for step in steps)
+        with self.page_lock:
+            if self.wire_sent is not sent:  # the page asked again meanwhile: a new start
+                return []
+            self.wire_seq = seq
+        frames = []
+        for start in range(0, max(1, len(steps)), WIRE_BATCH):
+            frame: Dict[str, Any] = {"op": "wire", "steps": steps[start:start + WIRE_BATCH]}
+            if start == 0:
+                frame["removed"] = removed
+                if since == 0:
+                    frame["reset"] = True
+            if start + WIRE_BATCH >= len(steps):
+                frame["status"] = status
+            frames.append(json.dumps(frame))
+        return frames
+
     # -- parameters ------------------------------------------------------------------------
 
     def params(self, msg: Dict[str, Any]) -> None:
@@ -633,6 +686,8 @@ class PageSession(RosbridgeSession):
 
     def close(self) -> None:
         self.hub.remove(self)
+        if self.hub.wire is not None:
+            self.hub.wire.unlisten(self.key)
         self.state.remove_graph_listener(self.key)
         if self.params_watched:
             self.state.remove_param_listener(self.key)

@@ -37,7 +37,7 @@ import time
 import traceback
 import urllib.parse
 from pathlib import Path
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Sequence
 
 import minros
 from minros import rosenv
@@ -49,6 +49,7 @@ from minros.web.page import SUBPROTOCOL as PAGE_SUBPROTOCOL
 from minros.web.page import PageHub, PageSession
 from minros.web.rosbridge import RosbridgeSession
 from minros.web.state import WebState
+from minros.web.wiretrace import WireFeed
 from minros.wire import admission
 
 STATIC_DIR = Path(__file__).resolve().parent / "static"
@@ -228,7 +229,7 @@ class WebServer:
                  token: Optional[str] = None, name: str = "minros web", rosapi: Any = None,
                  send_timeout: float = DEFAULT_SEND_TIMEOUT,
                  max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE, compression: bool = False,
-                 static_dir: Path = STATIC_DIR) -> None:
+                 static_dir: Path = STATIC_DIR, trace: Sequence[str] = ()) -> None:
         self.state = state
         self.host = host
         self.port = port
@@ -240,7 +241,9 @@ class WebServer:
         self.compression = compression
         self.static_dir = static_dir
         self.clients: Dict[str, _Client] = {}
-        self.page_hub = PageHub(state)
+        #: the wire traces followed for the page's Wire view (``--trace``)
+        self.wire = WireFeed(trace) if trace else None
+        self.page_hub = PageHub(state, self.wire)
         self.viewers = 0
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
@@ -265,6 +268,8 @@ class WebServer:
         self._guard = _Guard(self._server.handler, self._server, self.allowed)
         self._server.handler = self._guard
         self.port = self._server.socket.getsockname()[1]
+        if self.wire is not None:
+            self.wire.start()
         for target, name in ((self._server.serve_forever, "minros-web-server"),
                              (self._watchdog, "minros-web-watchdog")):
             thread = threading.Thread(target=target, name=name, daemon=True)
@@ -274,6 +279,8 @@ class WebServer:
     def shutdown(self) -> None:
         self._stop.set()
         self.page_hub.stop()
+        if self.wire is not None:
+            self.wire.stop()
         if self._server is not None:
             for client in list(self.clients.values()):
                 client.outbox.close()

@@ -38,6 +38,8 @@ TOPIC_METHODS = ("registerPublisher", "unregisterPublisher", "registerSubscriber
                  "unregisterSubscriber", "publisherUpdate", "requestTopic")
 SERVICE_METHODS = ("registerService", "unregisterService", "lookupService")
 DEFAULT_MASTER_PORT = 11311
+#: bytes of a frame's body a live view (a Merger with a limit) keeps
+LIVE_HEAD = 128
 
 
 class TraceError(Exception):
@@ -107,7 +109,8 @@ class _Attributor:
             self.current[pid] = proc
             self.processes.append(proc)
         if ev["ev"] == "process":
-            proc.argv = list(ev.get("argv") or [])
+            argv = ev.get("argv")
+            proc.argv = [str(arg) for arg in argv] if isinstance(argv, list) else []
             proc.host = str(ev.get("host", ""))
             proc.master = str(ev.get("master", ""))
             proc.messages = bool(ev.get("messages"))
@@ -117,8 +120,27 @@ class _Attributor:
             if ev.get("master"):
                 proc.master = str(ev["master"])
         proc.first = min(proc.first, ev["t"])
-        proc.last = max(proc.last, ev.get("t_reply", ev["t"]))
+        t_reply = ev.get("t_reply")
+        proc.last = max(proc.last, t_reply if isinstance(t_reply, (int, float)) else ev["t"])
         ev["_p"] = proc
+
+
+def _parse(raw: bytes) -> Tuple[Optional[Dict[str, Any]], str]:
+    """One line of a trace file: (the event, "") or (None, what is wrong with it)."""
+    if not raw.endswith(b"\n"):
+        return None, "the line is cut off (the file ends in the middle of an event)"
+    try:
+        ev = json.loads(raw)
+    except ValueError:
+        return None, "the line is not JSON"
+    if not _is_event(ev):
+        return None, "the line is not a trace event"
+    return ev, ""
+
+
+def _not_a_trace(path: str, number: int, problem: str) -> str:
+    return (f"{path} is not a minros trace: line {number}: {problem} (a trace is written by "
+            "MINROS_TRACE=FILE or 'minros trace -o FILE -- COMMAND')")
 
 
 def load(path: str) -> TraceFile:
@@ -134,22 +156,10 @@ def load(path: str) -> TraceFile:
     offset = 0
     with handle:
         for number, raw in enumerate(handle, 1):
-            problem = None
-            if not raw.endswith(b"\n"):
-                problem = "the line is cut off (the file ends in the middle of an event)"
-            else:
-                try:
-                    ev = json.loads(raw)
-                except ValueError:
-                    problem = "the line is not JSON"
-                else:
-                    if not _is_event(ev):
-                        problem = "the line is not a trace event"
-            if problem is not None:
+            ev, problem = _parse(raw)
+            if ev is None:
                 if not events:
-                    raise TraceError(
-                        f"{path} is not a minros trace: line {number}: {problem} (a trace is "
-                        "written by MINROS_TRACE=FILE or 'minros trace -o FILE -- COMMAND')")
+                    raise TraceError(_not_a_trace(path, number, problem))
                 stop = (f"{path} stops at line {number} (byte {offset}): {problem}; "
                         f"read the {len(events)} events before it")
                 break
@@ -163,41 +173,77 @@ def load(path: str) -> TraceFile:
 
 
 class Follower:
-    """New events of growing trace files (``show --follow``): whole lines only, so a line
-    being written is read once it is complete."""
+    """New events of growing trace files (``show --follow``, ``minros web --trace``): whole
+    lines only, so a line being written is read once it is complete. A file that does not
+    exist yet is waited for (``waiting`` says why it is not read); one that shrinks
+    (``minros trace -o`` overwrites its file when it starts again) is read again from its
+    start; at a line that is not a trace event, following that file stops (``bad`` says
+    where)."""
 
-    def __init__(self, paths: Iterable[str]) -> None:
-        self.paths = list(paths)
-        self.offsets = {path: 0 for path in self.paths}
-        self.partial = {path: b"" for path in self.paths}
-        self.who = {path: _Attributor(path) for path in self.paths}
+    #: bytes read from one file in one poll
+    CHUNK = 1 << 20
+
+    def __init__(self, paths: Iterable[str] = ()) -> None:
+        self.paths: List[str] = []
+        self.offsets: Dict[str, int] = {}
+        self.partial: Dict[str, bytes] = {}
+        self.who: Dict[str, _Attributor] = {}
+        self.lines: Dict[str, int] = {}  # whole lines read
+        self.line_end: Dict[str, int] = {}  # byte offset after the last whole line
         self.bad: Dict[str, str] = {}
+        self.waiting: Dict[str, str] = {}
+        self.restarts: Dict[str, int] = {}
+        #: the last poll left bytes unread (a file grew by more than CHUNK): poll again soon
+        self.behind = False
+        for path in paths:
+            self.add(path)
+
+    def add(self, path: str) -> None:
+        """Follow one more file (from its start)."""
+        if path not in self.offsets:
+            self.paths.append(path)
+            self._start(path)
+
+    def _start(self, path: str) -> None:
+        self.offsets[path] = self.lines[path] = self.line_end[path] = 0
+        self.partial[path] = b""
+        self.who[path] = _Attributor(path)
 
     def poll(self) -> List[Dict[str, Any]]:
         """Events appended since the last poll, in time order."""
         out: List[Dict[str, Any]] = []
+        self.behind = False
         for path in self.paths:
             if path in self.bad:
                 continue
             try:
                 with open(path, "rb") as handle:
+                    if os.fstat(handle.fileno()).st_size < self.offsets[path]:
+                        self._start(path)  # overwritten: a new trace in the same file
+                        self.restarts[path] = self.restarts.get(path, 0) + 1
                     handle.seek(self.offsets[path])
-                    data = handle.read(1 << 20)
-            except OSError:
-                continue  # not created yet
+                    data = handle.read(self.CHUNK)
+            except OSError as exc:
+                self.waiting[path] = ("does not exist (yet)" if isinstance(exc, FileNotFoundError)
+                                      else f"cannot be read: {exc.strerror or exc}")
+                continue
+            self.waiting.pop(path, None)
             if not data:
                 continue
             self.offsets[path] += len(data)
+            self.behind = self.behind or len(data) == self.CHUNK
             lines = (self.partial[path] + data).split(b"\n")
             self.partial[path] = lines.pop()
             for raw in lines:
-                try:
-                    ev = json.loads(raw)
-                except ValueError:
-                    ev = None
-                if not _is_event(ev):
-                    self.bad[path] = f"{path}: a line is not a trace event; no longer following it"
+                self.lines[path] += 1
+                ev, problem = _parse(raw + b"\n")
+                if ev is None:
+                    number = self.lines[path]
+                    self.bad[path] = (_not_a_trace(path, number, problem) if number == 1 else
+                                      f"{path} stops at line {number} (byte "
+                                      f"{self.line_end[path]}): {problem}; no longer following it")
                     break
+                self.line_end[path] += len(raw) + 1
                 self.who[path].take(ev)
                 out.append(ev)
         out.sort(key=lambda ev: ev["t"])
@@ -434,17 +480,26 @@ class Names:
 class Merger:
     """Events (in time order) in, items out: one :class:`Call` per XML-RPC exchange and one
     :class:`Wire` per header, frame, open and close, whichever ends were traced. ``add``
-    returns the new item, or None when the event was another view of a known one."""
+    returns the new item, or None when the event was another view of a known one (that item,
+    now completed by the second view, is then ``joined``).
 
-    def __init__(self, names: Names) -> None:
+    With a ``limit`` (following a trace that grows for as long as a system runs), the items
+    are not kept, each table that joins the views remembers its ``limit`` newest entries (the
+    second view of an exchange comes moments after the first), and of what an item holds, the
+    HTTP texts and the frame bytes past :data:`LIVE_HEAD` are left out."""
+
+    def __init__(self, names: Names, limit: Optional[int] = None) -> None:
         self.names = names
+        self.limit = limit
         self.calls: Dict[Tuple[str, str, int], Call] = {}
         self.conns: Dict[Tuple[str, str], Connection] = {}
         self.by_proc_conn: Dict[Tuple[int, int], Tuple[Connection, str]] = {}
         self.seen: Dict[Tuple[Any, ...], Wire] = {}
         self.items: List[Item] = []
+        self.joined: Optional[Item] = None
 
     def add(self, ev: Dict[str, Any]) -> Optional[Item]:
+        self.joined = None
         kind = ev["ev"]
         if kind in ("xmlrpc.call", "xmlrpc.serve"):
             item = self._call(ev)
@@ -452,9 +507,22 @@ class Merger:
             item = self._wire(ev)
         else:
             item = None
-        if item is not None:
-            self.items.append(item)
+        if self.limit is None:
+            if item is not None:
+                self.items.append(item)
+        else:
+            for table in (self.calls, self.conns, self.by_proc_conn, self.seen):
+                while len(table) > self.limit:
+                    del table[next(iter(table))]  # the oldest entry
         return item
+
+    def _http(self, text: Any) -> Optional[str]:
+        """The HTTP text of a call: not kept by a live view, which does not print it."""
+        return None if text is None or self.limit is not None else str(text)
+
+    def _head(self, text: str) -> str:
+        """A frame's first bytes (hex): a live view keeps what it prints."""
+        return text if self.limit is None else text[:LIVE_HEAD * 2]
 
     # -- XML-RPC
 
@@ -467,6 +535,7 @@ class Merger:
         known = self.calls.get(key) if client and server else None
         if known is not None and view not in known.views and known.method == ev.get("method"):
             known.views.append(view)
+            self.joined = known
             if served:
                 known.callee = str(ev.get("node", known.callee))
             else:
@@ -485,8 +554,9 @@ class Merger:
                     args=args, reply=ev.get("reply"), fault=str(ev.get("fault", "")),
                     error=str(ev.get("error", "")), caller=caller, callee=callee,
                     uri=str(ev.get("uri", "")), client=client, server=server,
-                    n=int(ev.get("n", 0)), request=str(ev.get("request", "")),
-                    request_len=int(ev.get("request_len", 0)), response=ev.get("response"),
+                    n=int(ev.get("n", 0)), request=self._http(ev.get("request")) or "",
+                    request_len=int(ev.get("request_len", 0)),
+                    response=self._http(ev.get("response")),
                     response_len=int(ev.get("response_len", 0)), views=[view])
         if client and server:
             self.calls[key] = call
@@ -545,6 +615,7 @@ class Merger:
         known = self.seen.get(key)
         if known is not None:
             known.views.append(side)
+            self.joined = known
             if known.msg is None and ev.get("msg") is not None:
                 known.msg = ev["msg"]
             if direction == "in":
@@ -554,8 +625,9 @@ class Merger:
                 known.t = min(known.t, ev["t"])
             return None
         item = Wire(t=ev["t"], what=what, conn=conn, dir=flow, off=int(ev.get("off", 0)),
-                    len=int(ev.get("len", 0)), n=int(ev.get("n", 0)), head=str(ev.get("head", "")),
-                    ok=int(ev.get("ok", -1)), msg=ev.get("msg"), node=node, views=[side])
+                    len=int(ev.get("len", 0)), n=int(ev.get("n", 0)),
+                    head=self._head(str(ev.get("head", ""))), ok=int(ev.get("ok", -1)),
+                    msg=ev.get("msg"), node=node, views=[side])
         if direction == "in":
             item.t_in = ev["t"]
         else:

@@ -24,10 +24,11 @@ import statistics
 import time
 from typing import Any, Dict, Iterable, List, Optional, Sequence, Set, Tuple
 
-from minros.tools.trace.merge import Call, Item, Names, Run, Wire, merge
+from minros.tools.trace.merge import Call, Item, Merger, Names, Run, Wire, merge
 
-__all__ = ["LEGEND", "Filter", "LiveView", "format_item", "render", "render_run", "run_heading",
-           "step_of"]
+__all__ = ["LEGEND", "LIVE_LIMIT", "Filter", "LiveView", "Row", "ends", "format_item",
+           "hex_groups", "item_rows", "plumbing", "prefix_hex", "render", "render_run",
+           "reply_text", "run_heading", "step_of", "type_of", "who_of"]
 
 LEGEND = (
     "steps, as courses number them:\n"
@@ -65,23 +66,15 @@ class Filter:
 
     def wants(self, subject: Tuple[str, str], item: Optional[Item] = None) -> bool:
         kind, name = subject
-        if self.nodes and item is not None and not self.nodes & _ends(item):
+        if self.nodes and item is not None and not self.nodes & ends(item):
             return False
         if self.narrowed:
             return (kind == "topic" and name in self.topics) or (
                 kind == "service" and name in self.services)
-        if self.show_all:
+        if self.show_all or not plumbing(subject, item):
             return True
-        if kind == "topic" and name in PLUMBING_TOPICS:
-            self.hidden["topic"].add(name)
-            return False
-        if kind == "service" and name.endswith(PLUMBING_SERVICE_SUFFIXES):
-            self.hidden["service"].add(name)
-            return False
-        if kind == "other" and isinstance(item, Call) and item.method in PLUMBING_CALLS and item.ok:
-            self.hidden["other"].add(item.method)
-            return False
-        return True
+        self.hidden[kind].add(getattr(item, "method", "") if kind == "other" else name)
+        return False
 
     def hidden_note(self) -> Optional[str]:
         parts = []
@@ -96,7 +89,18 @@ class Filter:
         return "not shown (every node has them): " + "; ".join(parts) + " (--all shows them)"
 
 
-def _ends(item: Item) -> Set[str]:
+def plumbing(subject: Tuple[str, str], item: Optional[Item] = None) -> bool:
+    """Whether this is the plumbing every rospy node has: /rosout, the logger services, the
+    master's successful getPid probes."""
+    kind, name = subject
+    if kind == "topic":
+        return name in PLUMBING_TOPICS
+    if kind == "service":
+        return name.endswith(PLUMBING_SERVICE_SUFFIXES)
+    return isinstance(item, Call) and item.method in PLUMBING_CALLS and item.ok
+
+
+def ends(item: Item) -> Set[str]:
     if isinstance(item, Call):
         return {item.caller, item.callee}
     return {item.conn.client_node, item.conn.server_node}
@@ -113,7 +117,7 @@ def _call_text(call: Call) -> str:
     return f"{call.method}({', '.join(_value(arg) for arg in call.args)})"
 
 
-def _reply_text(call: Call) -> str:
+def reply_text(call: Call) -> str:
     if call.error:
         return f"failed: {call.error}"
     if call.fault:
@@ -137,7 +141,7 @@ def _header_lines(fields: List[List[str]]) -> List[str]:
     return lines
 
 
-def _hex_groups(text: str, limit: int = HEX_SHOWN) -> str:
+def hex_groups(text: str, limit: int = HEX_SHOWN) -> str:
     raw = text[:limit * 2]
     groups = " ".join(raw[i:i + 8] for i in range(0, len(raw), 8))
     return groups + (" …" if len(text) > limit * 2 else "")
@@ -151,7 +155,7 @@ def _latency(item: Wire) -> str:
     return f", received {(item.t_in - item.t) * 1000:.2f} ms later"
 
 
-def _prefix_hex(size: int) -> str:
+def prefix_hex(size: int) -> str:
     return size.to_bytes(4, "little").hex()
 
 
@@ -218,68 +222,74 @@ def who_of(item: Item) -> str:
     return f"{item.sender()} -> {item.receiver()}"
 
 
-def format_item(item: Item, t0: float, layout: Optional[_Layout] = None,
-                label: str = "") -> List[str]:
-    """The lines of one item: time relative to ``t0``, who to whom, what (``label`` tells
-    apart the connections of one section: ``#1``, ``#2``, ...)."""
-    layout = layout or _Layout()
-    _line, _more = layout.line, layout.more
+#: one line of an item: (step, time, who -> whom, text); the time is None on the lines that
+#: continue the one before (a reply outside the sequence, header fields, a frame's bytes)
+Row = Tuple[str, Optional[float], str, str]
+
+
+def item_rows(item: Item, label: str = "") -> List[Row]:
+    """What one item says, line by line (``label`` tells apart the connections of one
+    section: ``#1``, ``#2``, ...)."""
     tag = f"{label} " if label else ""
     who = who_of(item)
     if isinstance(item, Call):
-        lines = [_line(step_of(item), item.t, t0, who, _call_text(item))]
+        rows: List[Row] = [(step_of(item), item.t, who, _call_text(item))]
         reply_step = step_of(item, reply=True)
-        reply = _reply_text(item)
-        if reply_step:
-            lines.append(_line(reply_step, item.t_reply, t0, "", reply))
-        else:
-            lines.append(_more(reply))
-        return lines
+        reply = reply_text(item)
+        rows.append((reply_step, item.t_reply, "", reply) if reply_step else ("", None, "", reply))
+        return rows
     conn = item.conn
     step = step_of(item)
     if item.what == "open":
         probe = " (a probe: is the service there?)" if conn.kind == "probe" else ""
-        return [_line(step, item.t, t0, who,
-                      f"{tag}TCP connection {conn.client} -> {conn.server}{probe}")]
+        return [(step, item.t, who, f"{tag}TCP connection {conn.client} -> {conn.server}{probe}")]
     if item.what == "header":
         fields = item.fields or []
         name = "connection header" if not any(k == "error" for k, _ in fields) else \
             "connection header (refusal)"
         count = f"{len(fields)} field" + ("s" if len(fields) != 1 else "")
-        lines = [_line(step, item.t, t0, who, f"{tag}{name}: length prefix "
-                       f"{_prefix_hex(item.len - 4)} = {item.len - 4} bytes, {count}")]
-        lines.extend(_more("  " + text) for text in _header_lines(fields))
-        return lines
+        rows = [(step, item.t, who, f"{tag}{name}: length prefix "
+                 f"{prefix_hex(item.len - 4)} = {item.len - 4} bytes, {count}")]
+        rows.extend(("", None, "", "  " + text) for text in _header_lines(fields))
+        return rows
     if item.what == "frame":
         kind = "message"
         if conn.kind == "service":
             kind = "request" if item.dir == "c2s" else "response"
         status = f" ok={item.ok}," if item.ok >= 0 else ""
-        lines = [_line(step, item.t, t0, who,
-                       f"{tag}{kind} {item.n}:{status} length prefix {_prefix_hex(item.len)} "
-                       f"= {item.len} bytes{_latency(item)}")]
+        rows = [(step, item.t, who, f"{tag}{kind} {item.n}:{status} length prefix "
+                 f"{prefix_hex(item.len)} = {item.len} bytes{_latency(item)}")]
         if item.head:
-            lines.append(_more(f"  body {_hex_groups(item.head)}"))
+            rows.append(("", None, "", f"  body {hex_groups(item.head)}"))
         if item.msg is not None:
-            lines.append(_more("  = " + _value(item.msg)))
-        return lines
+            rows.append(("", None, "", "  = " + _value(item.msg)))
+        return rows
     if item.what == "data":
-        return [_line(step, item.t, t0, who,
-                      f"{tag}{item.len} bytes that are not TCPROS: {_hex_groups(item.head, 16)}")]
+        return [(step, item.t, who,
+                 f"{tag}{item.len} bytes that are not TCPROS: {hex_groups(item.head, 16)}")]
     if item.what in ("close", "eof"):
         text = "closed the connection" if item.what == "close" else "saw the peer close"
-        return [_line("", item.t, t0, who, f"{tag}{text}")]
+        return [("", item.t, who, f"{tag}{text}")]
     return []
+
+
+def format_item(item: Item, t0: float, layout: Optional[_Layout] = None,
+                label: str = "") -> List[str]:
+    """The lines of one item: time relative to ``t0``, who to whom, what."""
+    layout = layout or _Layout()
+    return [layout.more(text) if t is None else layout.line(step, t, t0, who, text)
+            for step, t, who, text in item_rows(item, label)]
 
 
 # --------------------------------------------------------------------------- a run
 
 
-def _type_of(items: List[Item]) -> str:
+def type_of(items: List[Item]) -> str:
+    """The message type of a topic's items ("" if none names it; rostopic's "*" names none)."""
     for item in items:
-        if isinstance(item, Call) and item.method in ("registerPublisher", "registerSubscriber",
-                                                        "registerService") and len(item.args) > 2:
-            if item.method != "registerService":
+        if isinstance(item, Call) and item.method in ("registerPublisher", "registerSubscriber"
+                                                        ) and len(item.args) > 2:
+            if item.args[2] != "*":
                 return str(item.args[2])
         if isinstance(item, Wire) and item.what == "header":
             fields = dict((k, v) for k, v in item.fields or [])
@@ -417,7 +427,7 @@ def render_run(run: Run, flt: Filter) -> List[str]:
         if kind == "other":
             out.extend(_other_section(section_items, t0, layout))
             continue
-        type_name = _type_of(section_items)
+        type_name = type_of(section_items)
         out.extend(_section(f"{kind} {name}" + (f"  [{type_name}]" if type_name else ""),
                             section_items, t0, flt, layout))
     return out
@@ -467,45 +477,72 @@ def render(runs: List[Run], flt: Filter) -> Iterable[str]:
 # --------------------------------------------------------------------------- --follow
 
 
+#: exchanges a live view remembers to join their two views (see :class:`Merger`'s limit)
+LIVE_LIMIT = 2_000
+
+
 class LiveView:
-    """``show --follow``: each new item as it arrives, tagged with its topic or service."""
+    """``show --follow`` and ``minros web --trace``: each new item as it arrives, with the
+    filter and the frame limit of ``show``; its memory stays bounded however long it runs."""
 
-    def __init__(self, flt: Filter) -> None:
-        from minros.tools.trace.merge import Merger
-
+    def __init__(self, flt: Filter, limit: int = LIVE_LIMIT) -> None:
         self.flt = flt
         self.names = Names()
-        self.merger = Merger(self.names)
+        self.merger = Merger(self.names, limit)
+        self.limit = limit
         self.t0: Optional[float] = None
-        self.shown: Dict[Tuple[int, str], int] = {}
+        self.shown: Dict[Tuple[int, str], List[Any]] = {}  # (connection, dir) -> [it, frames]
+        #: items returned before that the other end's view completed during the last call
+        self.joined: List[Item] = []
 
-    def feed(self, events: Iterable[Dict[str, Any]]) -> List[str]:
-        out: List[str] = []
+    def items(self, events: Iterable[Dict[str, Any]]) -> List[Item]:
+        """The new items of ``events`` the filter wants, in order."""
+        out: List[Item] = []
+        self.joined = []
         for ev in events:
             if self.t0 is None:
                 self.t0 = ev["t"]
-                out.append(f"following since {_clock(self.t0)} (times are seconds from then)")
             self.names.learn(ev)
             item = self.merger.add(ev)
             if item is None:
+                if self.merger.joined is not None:
+                    self.joined.append(self.merger.joined)
                 continue
             subject = item.subject
             if isinstance(item, Wire):
                 if item.what == "eof" or (item.what == "close" and item.n != 1):
                     continue
-                if item.what == "frame":
-                    key = (id(item.conn), item.dir)
-                    count = self.shown.get(key, 0)
-                    self.shown[key] = count + 1
-                    if 0 <= self.flt.frames <= count:
-                        continue
+                if item.what == "frame" and not self._frame_wanted(item):
+                    continue
             if subject[0] != "other" or isinstance(item, Call) or item.what == "open":
                 if not self.flt.wants(subject, item):
                     continue
+            out.append(item)
+        return out
+
+    def _frame_wanted(self, item: Wire) -> bool:
+        key = (id(item.conn), item.dir)
+        entry = self.shown.get(key)
+        if entry is None:
+            entry = self.shown[key] = [item.conn, 0]  # the connection kept: its id stays its own
+            while len(self.shown) > self.limit:
+                del self.shown[next(iter(self.shown))]
+        entry[1] += 1
+        return not 0 <= self.flt.frames < entry[1]
+
+    def feed(self, events: Iterable[Dict[str, Any]]) -> List[str]:
+        """The lines ``show --follow`` prints for ``events``."""
+        out: List[str] = []
+        fresh = self.t0 is None
+        items = self.items(events)
+        if fresh and self.t0 is not None:
+            out.append(f"following since {_clock(self.t0)} (times are seconds from then)")
+        for item in items:
+            subject = item.subject
             tag = f"{subject[0]} {subject[1]}" if subject[1] else "(connection)"
             if subject[0] == "other" and isinstance(item, Call):
                 tag = "call"
-            lines = format_item(item, self.t0)
+            lines = format_item(item, self.t0 or item.t)
             out.append(f"{tag}: " + lines[0].lstrip())
             out.extend("    " + line.strip() for line in lines[1:])
         return out
