@@ -22,6 +22,7 @@ from minros.bag.errors import (
     ROSBagException,
     ROSBagUnindexedException,
 )
+from minros.msgs import reader_for
 from minros.names import canonicalize_name
 
 BagMessage = collections.namedtuple("BagMessage", "topic message timestamp")
@@ -269,12 +270,11 @@ class Bag:
         new_time = Time.__new__
         if not raw and not with_header:
             # the common case in one lean loop: about 8% of a read of many small messages
-            topics_classes = {cid: (conns[cid].topic, cls) for cid, cls in classes.items()}
+            readers = {cid: (conns[cid].topic, reader_for(cls)) for cid, cls in classes.items()}
             new_tuple = tuple.__new__  # BagMessage(...) runs a Python-level __new__
             for cid, t, data, _pos in source.messages(ids, start, end):
-                topic, cls = topics_classes[cid]
-                msg = cls()
-                msg.deserialize(data)
+                topic, read = readers[cid]
+                msg = read(data)
                 stamp = new_time(Time)  # filled in directly: two __init__ calls add up
                 stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
                 yield new_tuple(BagMessage, (topic, msg, stamp))

@@ -41,6 +41,7 @@ from minros.exceptions import (
     TransportInitError,
     TransportTerminated,
 )
+from minros.msgs import reader_for
 from minros.wire import admission, sockets, tcpros, trace
 from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
 
@@ -144,6 +145,7 @@ class Service:
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
+        self._read_request = reader_for(self.request_class)
         self.handler = handler
         self.error_handler = error_handler or _default_error_handler
         self.buff_size = buff_size
@@ -222,9 +224,8 @@ class Service:
                 if not persistent:
                     logerr(f"incoming connection failed: {_PEER_GONE}")
                 return
-            request = self.request_class()
             try:
-                request.deserialize(frame)
+                request = self._read_request(frame)
             except Exception as exc:
                 logerr(f"[{self.resolved_name}] error deserializing incoming request: {exc}")
                 return
@@ -378,6 +379,7 @@ class ServiceProxy:
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
+        self._read_response = reader_for(self.response_class)
         self.persistent = persistent
         self.headers: Dict[str, str] = dict(headers or {})
         if persistent:
@@ -478,9 +480,8 @@ class ServiceProxy:
             # "... responded with an error: b'...'"; the same words here keep tools identical
             text = str(bytes(data))
             raise ServiceException(f"service [{self.resolved_name}] responded with an error: {text}")
-        response = self.response_class()
         try:
-            response.deserialize(data)
+            response = self._read_response(data)
         except Exception as exc:
             raise ServiceException(f"transport error completing service call: receive_once[{self.resolved_name}]: "
                                    f"DeserializationError {exc}") from None

@@ -32,6 +32,7 @@ from minros.exceptions import (
     ROSSerializationException,
     SerializationError,
 )
+from minros.msgs import reader_for
 from minros.wire import sockets, tcpros, trace
 from minros.wire.xmlrpc import ServerProxy
 
@@ -766,7 +767,7 @@ class _SubConnection:
         reader = self.reader
         header = self.header
         latching = header.get("latching", "0") == "1"
-        data_class = impl.data_class
+        read = reader_for(impl.data_class)
         deliver = impl.deliver if impl.statistics is None else impl.statistics.wrap(self, impl.deliver)
         frames = self.pending
         recv_into = self.sock.recv_into
@@ -780,8 +781,7 @@ class _SubConnection:
                 for frame in frames:
                     self.stat_msgs += 1
                     try:
-                        msg = data_class()
-                        msg.deserialize(frame)
+                        msg = read(frame)
                     except Exception as exc:
                         log.logerr(f"[{impl.resolved_name}] error deserializing incoming message "
                                    f"from [{self.pub_uri}]: {exc}")

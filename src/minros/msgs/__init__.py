@@ -22,6 +22,7 @@ from .tval import Duration, Time, TVal
 #: name -> submodule; loaded on first use so ``import rospy`` stays light (PEP 562)
 _LAZY = {
     "Message": "message", "check_type": "message", "strify_message": "message",
+    "reader_for": "message",
     "REGISTRY": "registry", "MsgContext": "registry", "ServiceDefinition": "registry",
     "UnknownTypeError": "registry", "generate_dynamic": "registry",
     "get_message_class": "registry", "get_service_class": "registry",
@@ -33,7 +34,7 @@ __all__ = [
     "generate_dynamic", "numpy_msg", "UnknownTypeError", "MsgSpecError", "MsgContext",
     "REGISTRY", "ServiceDefinition", "install_import_hook", "write_stub_package",
     "check_type", "strify_message", "normalize_type", "DeserializationError",
-    "SerializationError",
+    "SerializationError", "reader_for",
 ]
 
 

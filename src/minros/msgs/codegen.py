@@ -510,6 +510,11 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
     de = _DeserializerGen(structs, get_spec, spec.full_name, numpy)
     de.fields(spec, "self", "", 2, reuse=True)
     de.flush(2)
+    # for a message made by __new__ (no fields yet): embedded messages and times are new
+    # objects, so receivers skip building default fields that the data replaces anyway
+    fresh = _DeserializerGen(structs, get_spec, spec.full_name, numpy)
+    fresh.fields(spec, "self", "", 2, reuse=False)
+    fresh.flush(2)
 
     out: List[str] = []
     if deps:
@@ -570,6 +575,14 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
     out.append('        """Fill this message from ``view[end:]``; returns the offset after it."""')
     out.extend(de.lines)
     out.append("        return end")
+    out.append("")
+    if fresh.lines == de.lines:
+        out.append("    _deserialize_fresh = _deserialize_from  # no embedded message or time to build")
+    else:
+        out.append("    def _deserialize_fresh(self, view, end):")
+        out.append('        """As _deserialize_from, into a message made by __new__: every field is new."""')
+        out.extend(fresh.lines)
+        out.append("        return end")
     out.append("")
     return "\n".join(_module_head(spec, "\n".join(out), bool(deps)) + out)
 

@@ -17,7 +17,7 @@ from .tval import Duration, Time, TVal
 
 __all__ = [
     "Message", "strify_message", "check_type", "DeserializationError", "SerializationError",
-    "struct_I", "isstring",
+    "struct_I", "isstring", "reader_for",
 ]
 
 #: the uint32 of every length prefix (genpy.struct_I: genpy-generated modules use it)
@@ -62,6 +62,57 @@ _INT_WIDTHS = {
 }
 _SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
                      UnicodeError, IndexError, SerializationError)
+
+
+def _as_view(data: Any, zero_copy: bool) -> Any:
+    """What a deserializer reads ``data`` (not ``bytes``) from."""
+    if zero_copy:
+        # may hold a big array: read it in place, copy only the fields
+        view = data if data.__class__ is memoryview else memoryview(data)
+        if view.format != "B" or view.ndim != 1:
+            view = view.cast("B")
+        return view
+    return bytes(data)  # small: one copy, then the faster bytes operations
+
+
+def _truncated(type_name: str, view: Any) -> DeserializationError:
+    return DeserializationError(
+        f"{type_name}: message truncated ({len(view)} bytes do not hold a whole message)")
+
+
+def _trailing(type_name: str, view: Any, end: int) -> DeserializationError:
+    return DeserializationError(
+        f"{type_name}: {len(view) - end} unexpected bytes after the message "
+        f"({end} of {len(view)} bytes used)")
+
+
+def reader_for(cls: type) -> Callable[[Any], Any]:
+    """A function from serialized bytes to a new ``cls`` message: ``cls().deserialize(data)``,
+    but for a generated class without first building default fields that the data replaces
+    (a message with embedded messages reads 1.5-2x faster). Subscribers and bag readers
+    take one per class."""
+    fresh = cls.__dict__.get("_deserialize_fresh")
+    if fresh is None or cls.deserialize is not Message.deserialize:
+        def read_any(data: Any) -> Any:  # hand-written, subclassed or genpy-generated classes
+            msg = cls()
+            msg.deserialize(data)
+            return msg
+        return read_any
+    zero_copy = cls._zero_copy
+    type_name = cls._type
+    new = object.__new__
+
+    def read(data: Any) -> Any:
+        view = data if data.__class__ is bytes else _as_view(data, zero_copy)
+        msg = new(cls)
+        try:
+            end = fresh(msg, view, 0)
+        except struct.error:
+            raise _truncated(type_name, view) from None
+        if end != len(view):
+            raise _trailing(type_name, view, end)
+        return msg
+    return read
 
 
 class Message:
@@ -132,13 +183,7 @@ class Message:
         view = data
         if data.__class__ is not bytes:
             try:
-                if self._zero_copy:
-                    # may hold a big array: read it in place, copy only the fields
-                    view = data if data.__class__ is memoryview else memoryview(data)
-                    if view.format != "B" or view.ndim != 1:
-                        view = view.cast("B")
-                else:
-                    view = bytes(data)  # small: one copy, then the faster bytes operations
+                view = _as_view(data, self._zero_copy)
             except TypeError:
                 if type(self)._deserialize_from is Message._deserialize_from:
                     return None  # genpy's base Message reads nothing, whatever it is given
@@ -155,13 +200,9 @@ class Message:
                 raise
             return None  # genpy's base Message reads nothing
         except struct.error:
-            raise DeserializationError(
-                f"{self._type}: message truncated ({len(view)} bytes do not hold a whole message)"
-            ) from None
+            raise _truncated(self._type, view) from None
         if end != len(view):
-            raise DeserializationError(
-                f"{self._type}: {len(view) - end} unexpected bytes after the message "
-                f"({end} of {len(view)} bytes used)")
+            raise _trailing(self._type, view, end)
         return self
 
     # genpy's numpy variants (rospy.numpy_msg and rosbag call these)
