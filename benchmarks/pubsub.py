@@ -317,6 +317,10 @@ def role_cpu_sub(args) -> None:
     rospy.signal_shutdown("done")
 
 
+#: seconds a ring node waits for its connections before it reports the ones missing
+RING_TIMEOUT = 60.0
+
+
 def role_ring_node(args) -> None:
     """Node ``index`` of a ring: publishes ``--topics`` topics and subscribes to those of the
     next node; says when every one of its connections is made, then waits to be stopped."""
@@ -330,11 +334,17 @@ def role_ring_node(args) -> None:
     nxt = (args.index + 1) % args.nodes
     pubs = [rospy.Publisher(f"/ring{args.index}/t{k}", Empty, queue_size=1) for k in range(args.topics)]
     subs = [rospy.Subscriber(f"/ring{nxt}/t{k}", Empty) for k in range(args.topics)]
+    deadline = time.monotonic() + RING_TIMEOUT
     while not all(p.get_num_connections() for p in pubs) or not all(s.get_num_connections() for s in subs):
         if rospy.is_shutdown():
             return
+        if time.monotonic() > deadline:  # a connection the client library never made
+            missing = sum(1 for e in pubs + subs if not e.get_num_connections())
+            print(json.dumps({"missing": missing}), flush=True)
+            break
         time.sleep(0.02)
-    print(json.dumps({"connected": time.time()}), flush=True)
+    else:
+        print(json.dumps({"connected": time.time()}), flush=True)
     sys.stdin.read()  # until the driver closes our stdin
     rospy.signal_shutdown("done")
 
@@ -943,11 +953,17 @@ class Runner:
                                               stderr=subprocess.DEVNULL, stdin=subprocess.PIPE,
                                               text=True))
             done = []
+            missing = 0
             for proc in procs:
                 line = proc.stdout.readline()
                 if not line.startswith("{"):
                     raise RuntimeError(f"{who}: a ring node failed")
-                done.append(json.loads(line)["connected"])
+                report = json.loads(line)
+                missing += report.get("missing", 0)
+                done.append(report.get("connected", 0.0))
+            if missing:
+                raise RuntimeError(f"{missing} of {2 * nodes * topics} connections never made "
+                                   f"within {RING_TIMEOUT:.0f} s")
             return max(done) - start
         finally:
             for proc in procs:
@@ -1093,6 +1109,7 @@ def main(argv=None) -> int:
         contenders = runner.contenders()
         scenarios = [s for s in SCENARIOS if not args.scenarios or s[1] in args.scenarios.split(",")]
         results = {(s[1], c): [] for s in scenarios for c in contenders}
+        failures: list = []  # runs that gave no figure: listed under the table
         for rnd in range(args.rounds):
             for _title, key, fn, _better in scenarios:
                 for who in contenders:  # interleaved: every contender once per round
@@ -1100,6 +1117,7 @@ def main(argv=None) -> int:
                         value = fn(runner, who)
                     except Exception as exc:  # one failed run must not lose the table
                         print(f"  {who} {key}: failed: {exc}", file=sys.stderr)
+                        failures.append(f"round {rnd + 1}, {key}, {who}: {exc}")
                         value = None
                     if value is not None:
                         results[(key, who)].append(value)
@@ -1148,6 +1166,10 @@ def main(argv=None) -> int:
         print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
         for row in rows:
             print("| " + " | ".join(str(c).ljust(w) for c, w in zip(row, widths)) + " |")
+        if failures:
+            print("\nruns without a figure (the medians above are of the other rounds):")
+            for line in failures:
+                print(f"  {line}")
     finally:
         runner.close()
     return 0
