@@ -99,7 +99,11 @@ def _safe_printer(stream: TextIO) -> Print:
 
     def emit(line: str) -> None:
         try:
-            print(line, file=stream, flush=True)
+            # one write() per line: nodes with output="screen" share the terminal, and under
+            # PYTHONUNBUFFERED print() writes a line and its newline in two system calls, between
+            # which a node's own line could land ("...pid [42]PROBE ...")
+            stream.write(line + "\n")
+            stream.flush()
         except (OSError, ValueError):
             pass
 
