@@ -84,6 +84,8 @@ TCPROS_LIMITS = admission.Limits(max_connections=1024, head_timeout=HEADER_TIMEO
 XMLRPC_TIMEOUT = 10.0
 #: a registration the master did not answer is retried this often
 REGISTER_RETRY = 0.2
+#: seconds close() waits for a registration in flight before it unregisters everything
+CLOSE_REGISTRATION_WAIT = 2.0
 
 _logger = logging.getLogger("minros.node")
 #: what the user sees (console and /rosout once the client library's logging is up)
@@ -692,6 +694,8 @@ class Node:
         """Run one registration call; on a master failure the probe thread redoes all later."""
         try:
             with self._reg_lock:
+                if self._closed.is_set():
+                    return  # close() has unregistered what it found: this would outlive the node
                 call()
         except Exception as exc:
             self._master_lost = True
@@ -792,16 +796,24 @@ class Node:
         self._closed.set()
         if not self._started:
             return
-        calls = self._unregistration_calls()
-        if calls:
-            # tried even when the probe lost the master: a master that was only slow for a
-            # moment would otherwise keep our registrations forever; one that is gone costs
-            # a short wait
-            try:
-                ServerProxy(self.master_uri, timeout=0.5 if self._master_lost else 2.0
-                            ).system.multicall(calls)
-            except Exception as exc:
-                _logger.warning("unregistration from the master failed: %s", exc)
+        # after any registration in flight (a Ctrl-C in the middle of rospy.Subscriber(...)):
+        # the master must see it before the unregistration, or it outlives the node there.
+        # Bounded: a registration stuck on a frozen master must not hold up the shutdown.
+        locked = self._reg_lock.acquire(timeout=CLOSE_REGISTRATION_WAIT)
+        try:
+            calls = self._unregistration_calls()
+            if calls:
+                # tried even when the probe lost the master: a master that was only slow for a
+                # moment would otherwise keep our registrations forever; one that is gone costs
+                # a short wait
+                try:
+                    ServerProxy(self.master_uri, timeout=0.5 if self._master_lost else 2.0
+                                ).system.multicall(calls)
+                except Exception as exc:
+                    _logger.warning("unregistration from the master failed: %s", exc)
+        finally:
+            if locked:
+                self._reg_lock.release()
         with self._registry_lock:
             endpoints = [*self.publications.values(), *self.subscriptions.values()]
         for endpoint in endpoints:

@@ -143,6 +143,39 @@ def test_shutdown_runs_hooks_then_unregisters_and_closes(master):
     node.signal_shutdown("again")  # idempotent
 
 
+def test_shutdown_during_a_registration_leaves_nothing_registered(master):
+    """Ctrl-C while rospy.Subscriber(...) waits for the master: the registration in flight
+    reaches the master first and the shutdown's unregistration after it, never the reverse
+    (the master would keep a subscriber of a node that is gone)."""
+    node = make_node(master)
+    entered, release = threading.Event(), threading.Event()
+    original = master.handler.registerSubscriber
+
+    def slow_register(*args):
+        entered.set()
+        assert release.wait(TIMEOUT)
+        return original(*args)
+
+    master.handler.registerSubscriber = slow_register
+    sub = FakeSubscription("/late")
+    adding = threading.Thread(target=node.add_subscription, args=(sub,))
+    adding.start()
+    try:
+        assert entered.wait(TIMEOUT)  # the registration is at the master, unanswered
+        closing = threading.Thread(target=node.signal_shutdown, args=("ctrl-c",))
+        closing.start()
+        closing.join(0.3)
+        assert closing.is_alive()  # the shutdown waits for the answer before unregistering
+        release.set()
+        closing.join(TIMEOUT)
+        adding.join(TIMEOUT)
+        assert not closing.is_alive() and not adding.is_alive()
+        assert "/late" not in system_state(master)["sub"]
+    finally:
+        release.set()
+        node.signal_shutdown("test over")
+
+
 def test_remote_shutdown_answers_before_the_servers_close(master):
     node = make_node(master)
     try:
