@@ -266,14 +266,15 @@ class Bag:
         from minros import Time
 
         classes = {cid: self._class_for(c) for cid, c in conns.items()}
+        readers = {cid: reader_for(cls) for cid, cls in classes.items()}
         ids = None if len(conns) == len(source.connections) else list(conns)
         new_time = Time.__new__
         if not raw and not with_header:
             # the common case in one lean loop: about 8% of a read of many small messages
-            readers = {cid: (conns[cid].topic, reader_for(cls)) for cid, cls in classes.items()}
+            topic_readers = {cid: (conns[cid].topic, read) for cid, read in readers.items()}
             new_tuple = tuple.__new__  # BagMessage(...) runs a Python-level __new__
             for cid, t, data, _pos in source.messages(ids, start, end):
-                topic, read = readers[cid]
+                topic, read = topic_readers[cid]
                 msg = read(data)
                 stamp = new_time(Time)  # filled in directly: two __init__ calls add up
                 stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
@@ -286,8 +287,7 @@ class Bag:
             if raw:
                 msg: Any = (conn.datatype, bytes(data), conn.md5sum, pos, cls)
             else:
-                msg = cls()
-                msg.deserialize(data)
+                msg = readers[cid](data)
             stamp = new_time(Time)  # filled in directly: two __init__ calls per message add up
             stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
             if with_header:

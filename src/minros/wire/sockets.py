@@ -143,7 +143,6 @@ class FrameSource:
         self.guard = guard
         self.pending: collections.deque = collections.deque()
         self._poll = sock.gettimeout()  # paces the checks of stop()
-        self._timeout = self._poll  # the socket's timeout now: settimeout() is a system call
         self._started: float | None = None  # when the frame in progress began to arrive
 
     def next(self, wait_until: float | None = None) -> Any:
@@ -188,12 +187,10 @@ class FrameSource:
             deadline = self._started + self.guard.limits.transfer_time(self.reader.announced() or 0)
             what = "the request did not arrive"
         if deadline is None:
-            if self._timeout != self._poll:
-                self._timeout = self._poll
+            if self.sock.gettimeout() != self._poll:  # settimeout() is a system call
                 self.sock.settimeout(self._poll)
             return
         remaining = deadline - time.monotonic()
         if remaining <= 0:
             raise TransportTerminated(f"{what} within the deadline")
-        self._timeout = remaining if self._poll is None else min(self._poll, remaining)
-        self.sock.settimeout(self._timeout)
+        self.sock.settimeout(remaining if self._poll is None else min(self._poll, remaining))
