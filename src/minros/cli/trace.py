@@ -126,6 +126,27 @@ def _frames_arg(text: str) -> int:
     return int(text)
 
 
+def _load(paths: List[str], prog: str) -> list | None:
+    """The trace files, or None after one line naming the first that cannot be read."""
+    from minros.tools.trace import merge
+
+    files = []
+    for path in paths:
+        try:
+            files.append(merge.load(path))
+        except merge.TraceError as exc:
+            print(f"{prog}: {exc}", file=sys.stderr)
+            return None
+    return files
+
+
+def _report_stops(files: list, prog: str) -> None:
+    """One line per file whose trace ended early (cut mid-line, a bad record)."""
+    for trace_file in files:
+        if trace_file.stop:
+            print(f"{prog}: {trace_file.stop}", file=sys.stderr)
+
+
 def _show(argv: List[str], prog: str) -> int:
     from minros.tools.trace import merge, show
 
@@ -150,18 +171,12 @@ def _show(argv: List[str], prog: str) -> int:
     flt = show.Filter(args.topic, args.service, args.show_all, args.frames, args.node)
     if args.follow:
         return _follow(args.files, flt)
-    files = []
-    for path in args.files:
-        try:
-            files.append(merge.load(path))
-        except merge.TraceError as exc:
-            print(f"{prog}: {exc}", file=sys.stderr)
-            return 1
+    files = _load(args.files, prog)
+    if files is None:
+        return 1
     for line in show.render(merge.split_runs(files), flt):
         print(line)
-    for trace_file in files:
-        if trace_file.stop:
-            print(f"{prog}: {trace_file.stop}", file=sys.stderr)
+    _report_stops(files, prog)
     return 0
 
 
@@ -193,18 +208,15 @@ def _pcap(argv: List[str], prog: str) -> int:
     parser = argparse.ArgumentParser(
         prog=prog, description="Write a libpcap capture of the traced TCP connections (no root "
                                "needed): XML-RPC shows as HTTP, TCPROS decodes with Wireshark's "
-                               "tcpros_tcp heuristic (tshark --enable-heuristic tcpros_tcp).")
+                               "TCPROS dissector once its ports are set to it (Decode As; the "
+                               "tshark command is printed after writing).")
     parser.add_argument("files", nargs="+", metavar="FILE", help="trace files (JSON lines)")
     parser.add_argument("-o", "--output", default="trace.pcap", metavar="OUT",
                         help="the capture file to write (default trace.pcap)")
     args = parser.parse_args(argv)
-    files = []
-    for path in args.files:
-        try:
-            files.append(merge.load(path))
-        except merge.TraceError as exc:
-            print(f"{prog}: {exc}", file=sys.stderr)
-            return 1
+    files = _load(args.files, prog)
+    if files is None:
+        return 1
     items: list = []
     for run in merge.split_runs(files):
         items.extend(merge.merge(run)[0])
@@ -215,9 +227,7 @@ def _pcap(argv: List[str], prog: str) -> int:
     except OSError as exc:
         print(f"{prog}: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
         return 1
-    for trace_file in files:
-        if trace_file.stop:
-            print(f"{prog}: {trace_file.stop}", file=sys.stderr)
+    _report_stops(files, prog)
     print(f"wrote {len(packets)} packets of {connections} TCP connections to {args.output}")
     if ports:
         print(f"TCPROS servers listen on port{'s' if len(ports) > 1 else ''} "
