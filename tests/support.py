@@ -27,6 +27,24 @@ PYTHON = sys.executable
 #: The system interpreter that sees Debian's ROS 1.
 REFERENCE_PYTHON = "/usr/bin/python3"
 IN_CI = bool(os.environ.get("CI"))
+#: Debian's chromium, the browser the page and web tests drive with Playwright
+CHROMIUM = "/usr/bin/chromium"
+
+
+def need(condition: bool, what: str, installer: str = "scripts/test.sh") -> None:
+    """Skip locally, fail in CI, when something a test needs is missing."""
+    if condition:
+        return
+    if IN_CI:
+        pytest.fail(f"{what} ({installer} installs it)")
+    pytest.skip(what)
+
+
+def launch_chromium(playwright, *extra_args: str):
+    """Debian's chromium, headless and quiet (no background network, updates or sync)."""
+    return playwright.chromium.launch(executable_path=CHROMIUM, args=[
+        "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run", *extra_args])
 
 
 @functools.cache
@@ -231,17 +249,13 @@ def build_roscpp(source_text: str, name: str, build_dir: Path, pkgs: Sequence[st
 
     require_reference()
 
-    def missing(what: str) -> None:
-        if IN_CI:
-            pytest.fail(f"{what} (scripts/install-ros-reference.sh installs it)")
-        pytest.skip(what)
-
-    if shutil.which("g++") is None or shutil.which("pkg-config") is None:
-        missing("g++/pkg-config missing")
+    need(shutil.which("g++") is not None and shutil.which("pkg-config") is not None,
+         "g++/pkg-config missing", "scripts/install-ros-reference.sh")
     flags = subprocess.run(["pkg-config", "--cflags", "--libs", *pkgs], capture_output=True,
                            text=True, timeout=30)
-    if flags.returncode != 0 or not all(Path(h).exists() for h in required_headers):
-        missing(f"roscpp development files missing: {flags.stderr.strip()}")
+    need(flags.returncode == 0 and all(Path(h).exists() for h in required_headers),
+         f"roscpp development files missing: {flags.stderr.strip()}",
+         "scripts/install-ros-reference.sh")
     source = build_dir / f"{name}.cpp"
     source.write_text(source_text)
     binary = build_dir / name

@@ -22,10 +22,20 @@ from pathlib import Path
 
 import pytest
 
-from support import IN_CI, PYTHON, REPO, Proc, free_port, ros_env, wait_for_master, wait_until
+from support import (
+    CHROMIUM,
+    PYTHON,
+    REPO,
+    Proc,
+    free_port,
+    launch_chromium,
+    need,
+    ros_env,
+    wait_for_master,
+    wait_until,
+)
 
 WEB = REPO / "tests" / "web"
-CHROMIUM = "/usr/bin/chromium"
 TUTORIALS = REPO / "tests" / "examples" / "library_tutorials"
 SOAK_SECONDS = float(os.environ.get("MINROS_PAGE_SOAK", "20"))
 
@@ -33,14 +43,6 @@ try:
     from playwright import sync_api as playwright_api
 except ImportError:
     playwright_api = None
-
-
-def need(condition: bool, what: str) -> None:
-    if condition:
-        return
-    if IN_CI:
-        pytest.fail(f"{what} (scripts/test.sh installs it)")
-    pytest.skip(what)
 
 
 class System:
@@ -111,10 +113,7 @@ def system(tmp_path_factory):
 @pytest.fixture(scope="module")
 def browser(system):
     with playwright_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=[
-            "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", "--no-first-run",
-            "--enable-precise-memory-info"])
+        browser = launch_chromium(p, "--enable-precise-memory-info")
         try:
             yield browser
         finally:

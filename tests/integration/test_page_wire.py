@@ -15,9 +15,20 @@ import shutil
 from pathlib import Path
 
 import pytest
-from test_page import CHROMIUM, Page, need, playwright_api
+from test_page import Page, playwright_api
 
-from support import EXAMPLES, PYTHON, Proc, free_port, ros_env, wait_for_master, wait_until
+from support import (
+    CHROMIUM,
+    EXAMPLES,
+    PYTHON,
+    Proc,
+    free_port,
+    launch_chromium,
+    need,
+    ros_env,
+    wait_for_master,
+    wait_until,
+)
 
 STRING_MD5 = "992ce8a1687cec8c8bd883ec73ca41d1"
 
@@ -78,9 +89,7 @@ def run(tmp_path_factory):
 @pytest.fixture(scope="module")
 def browser(run):
     with playwright_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=[
-            "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", "--no-first-run"])
+        browser = launch_chromium(p)
         try:
             yield browser
         finally:

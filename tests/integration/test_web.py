@@ -23,22 +23,23 @@ import cv2
 import numpy as np
 import pytest
 
-from support import EXAMPLES, IN_CI, PYTHON, Proc, free_port, ros_env, wait_for_master
+from support import (
+    CHROMIUM,
+    EXAMPLES,
+    PYTHON,
+    Proc,
+    free_port,
+    launch_chromium,
+    need,
+    ros_env,
+    wait_for_master,
+)
 
 WEB = Path(__file__).resolve().parent.parent / "web"
 JS = WEB / "js"
 VIDEO = EXAMPLES / "video"
 #: the test-only fake webcam shim (a synthetic camera for video_pub.py)
 FAKECAM = Path(__file__).resolve().parent.parent / "examples" / "fakecam"
-CHROMIUM = "/usr/bin/chromium"
-
-
-def need(condition: bool, what: str) -> None:
-    if condition:
-        return
-    if IN_CI:
-        pytest.fail(f"{what} (scripts/test.sh installs it)")
-    pytest.skip(what)
 
 
 def start_web(port: int, home: Path, *args: str, web_port: int | None = None) -> tuple:
@@ -201,9 +202,7 @@ def test_roslib_in_headless_chromium(graph):
     threading.Thread(target=pages.serve_forever, name="test-pages", daemon=True).start()
     base = f"http://127.0.0.1:{pages.server_address[1]}/"
     with playwright.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=[
-            "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", "--no-first-run"])
+        browser = launch_chromium(p)
         try:
             page = browser.new_page()
             console: list = []
