@@ -1,10 +1,23 @@
 #!/usr/bin/env bash
 # Install Debian's ROS 1 (ros_comm 1.15.15, Noetic) for /usr/bin/python3: the reference
-# implementation that minros's interoperability tests and benchmarks run against.
-# Idempotent; needs root (CI runs as root). See ../shared/spec/ros1-reference.md.
+# implementation that minros's interoperability tests and benchmarks run against, with the
+# Python surface of a full desktop install (ros-desktop-full-python-dev and friends), and the
+# tools the tests drive. Idempotent; needs root (CI runs as root).
+# See ../shared/spec/ros1-reference.md.
+#
+# Installs only what is missing: a package already installed is not asked for again, and a
+# tool the machine already has from elsewhere is never asked of apt (this image ships Node.js
+# from NodeSource, whose nodejs bundles npm and conflicts with Debian's npm package).
+#
+#   bash scripts/install-ros-reference.sh                   install what is missing
+#   bash scripts/install-ros-reference.sh --print-packages  print every apt package this
+#       script may install on this machine, one per line, and exit (tests/unit/
+#       test_install_script.py simulates installing all of them with apt-get -s)
 set -euo pipefail
 if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
-PKGS="ros-core python3-rosmaster python3-roslaunch rosout
+
+# ROS 1 core, the message packages and the libraries the interop tests compare against.
+ROS_CORE="ros-core python3-rosmaster python3-roslaunch rosout
   python3-rospy python3-rostopic python3-rosnode python3-rosparam python3-rosservice
   python3-rosbag python3-roslz4 python3-rosmsg python3-genpy python3-genmsg
   ros-std-msgs python3-std-msgs libstd-msgs-dev ros-std-srvs python3-std-srvs libstd-srvs-dev
@@ -20,34 +33,72 @@ PKGS="ros-core python3-rosmaster python3-roslaunch rosout
   python3-actionlib python3-message-filters python3-diagnostic-updater
   python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
   python3-roslib python3-rosgraph python3-rostest python3-rosunit"
+# The Python surface of a full desktop install: what scripts/surface.py compares minros
+# against, and the libraries (PyKDL, interactive_markers, ...) the interop tests check.
+ROS_DESKTOP_FULL="ros-desktop-full-python-dev python3-pykdl python3-tf2-sensor-msgs
+  python3-interactive-markers python3-laser-geometry python3-image-geometry
+  python3-tf-conversions python3-tf2-kdl python3-bondpy python3-nodelet python3-topic-tools
+  python3-resource-retriever python3-smclib python3-actionlib-tools 
+  python3-camera-calibration-parsers python3-map-msgs
+  python3-pcl-msgs python3-polled-camera python3-roswtf
+  python3-rosclean python3-rosmake python3-rospkg"
 # Tools the tests drive besides ROS: a virtual display for turtlesim's window, zsh for
 # devel/setup.zsh; python3-venv and python3-tk so that minros's own venv can be built on the
 # same interpreter as the reference (scripts/test.sh), turtlesim's Tk window included;
 # graphviz for view_frames' frames.pdf; iproute2 for the two-host tests' network namespaces;
 # tshark opens the capture files `minros trace pcap` writes.
 TEST_TOOLS="xvfb zsh python3-venv python3-tk graphviz iproute2 tshark"
-# minros web's tests: Debian's Chromium for roslib in a real browser (Playwright drives it),
-# node and npm for Foxglove's and roslib's own client libraries (tests/web/js, npm ci).
-WEB_TEST_TOOLS="chromium nodejs npm"
-if /usr/bin/python3 -c 'import rospy, rosmaster, genpy, std_msgs.msg, sensor_msgs.msg, tf2_msgs.msg' 2>/dev/null \
-   && /usr/bin/python3 -c 'import rosbag, roslz4' 2>/dev/null && [ -x /usr/lib/rosbag/record ] \
-   && /usr/bin/python3 -c 'import actionlib, message_filters, diagnostic_updater, dynamic_reconfigure.client' 2>/dev/null \
-   && /usr/bin/python3 -c 'import roslib, rosgraph, rostest, rosunit, genmsg, sensor_msgs.point_cloud2' 2>/dev/null \
-   && [ -x /usr/lib/genpy/genmsg_py.py ] \
-   && [ -f /usr/share/dynamic_reconfigure/package.xml ] \
-   && command -v rostopic >/dev/null && command -v catkin_create_pkg >/dev/null \
-   && pkg-config --exists roscpp std_msgs && command -v Xvfb >/dev/null && command -v zsh >/dev/null \
-   && /usr/bin/python3 -c 'import ensurepip, tkinter' 2>/dev/null \
-   && /usr/bin/python3 -c 'import tf2_py, tf2_ros, tf, tf2_geometry_msgs' 2>/dev/null \
-   && [ -x /usr/lib/tf/tf_echo ] && [ -x /usr/lib/tf2_tools/view_frames.py ] && command -v dot >/dev/null \
-   && [ -x /usr/bin/chromium ] && command -v node >/dev/null && command -v npm >/dev/null \
-   && command -v ip >/dev/null && command -v tshark >/dev/null; then
+
+# On a machine whose package lists were never fetched, apt knows no package at all.
+if ! apt-cache show ros-core >/dev/null 2>&1; then $SUDO apt-get update -q >&2; fi
+# A package name is kept only when apt knows it (the archive may drop one); an unknown name
+# would make the whole install fail.
+KNOWN=$(apt-cache pkgnames)
+known() { grep -qxF "$1" <<<"$KNOWN"; }
+
+# Every package this script may install on this machine, one per line.
+candidates() {
+  local p
+  for p in $ROS_CORE $ROS_DESKTOP_FULL $TEST_TOOLS; do
+    known "$p" && echo "$p"
+  done
+  # minros web's tests: Debian's Chromium for roslib in a real browser (Playwright drives
+  # it), node and npm for Foxglove's and roslib's own client libraries (tests/web/js). Only
+  # asked of apt when the machine has no such command: NodeSource's nodejs carries npm and
+  # conflicts with Debian's npm package.
+  [ -x /usr/bin/chromium ] || echo chromium
+  if ! command -v node >/dev/null; then
+    echo nodejs
+    command -v npm >/dev/null || echo npm
+  elif ! command -v npm >/dev/null; then
+    echo "warning: node is installed without npm (and Debian's npm would conflict with a" \
+      "NodeSource nodejs); install npm with your Node.js distribution" >&2
+  fi
+}
+
+installed() {
+  [ "$(dpkg-query -W -f='${db:Status-Status}' "$1" 2>/dev/null)" = installed ]
+}
+
+if [ "${1:-}" = "--print-packages" ]; then
+  candidates
+  exit 0
+elif [ -n "${1:-}" ]; then
+  echo "usage: $0 [--print-packages]" >&2
+  exit 2
+fi
+
+missing=()
+while read -r p; do
+  installed "$p" || missing+=("$p")
+done < <(candidates)
+if [ "${#missing[@]}" -eq 0 ]; then
   echo "ROS 1 reference already installed"
   exit 0
 fi
+echo "installing ${#missing[@]} packages: ${missing[*]}"
 $SUDO apt-get update -q
 # tshark's package asks whether non-root users may capture: no (and no question)
 echo "wireshark-common wireshark-common/install-setuid boolean false" | $SUDO debconf-set-selections
-# shellcheck disable=SC2086
-DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $PKGS $TEST_TOOLS $WEB_TEST_TOOLS
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 /usr/bin/python3 -c 'import rospy, rosmaster, genpy' && echo "ROS 1 reference installed"
