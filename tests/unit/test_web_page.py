@@ -332,7 +332,10 @@ def test_page_files_load_offline_and_ship_in_the_wheel():
     import re
     from pathlib import Path
 
-    import tomllib
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10: the same parser, from PyPI
+        import tomli as tomllib
 
     import minros.web
 
