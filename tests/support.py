@@ -63,6 +63,17 @@ def reference_available() -> bool:
             and os.path.exists("/usr/bin/rostopic"))
 
 
+#: where Debian's python3-*-msgs packages install the classes genpy generated
+DEBIAN_DIST_PACKAGES = Path("/usr/lib/python3/dist-packages")
+
+
+def debian_has_messages(package: str) -> bool:
+    """Whether Debian's Python has ``package``'s generated message or service classes (the
+    bundled packages Debian lacks are checked against genpy run on the same files instead)."""
+    return any((DEBIAN_DIST_PACKAGES / package / kind / "__init__.py").is_file()
+               for kind in ("msg", "srv"))
+
+
 def require_reference() -> None:
     """Skip when the reference is absent locally; in CI its absence is a failure."""
     if reference_available():

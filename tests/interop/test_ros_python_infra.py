@@ -18,14 +18,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from minros.msgs.testing import bundled_services, bundled_types
-from support import PYTHON, REFERENCE_PYTHON, reference_env, require_reference
+from support import PYTHON, REFERENCE_PYTHON, debian_has_messages, reference_env, require_reference
 
 pytestmark = pytest.mark.interop
 
-NOT_IN_DEBIAN = ("turtlesim/", "rospy_tutorials/", "rosapi/")
-DEBIAN_TYPES = [t for t in bundled_types() if not t.startswith(NOT_IN_DEBIAN)
+DEBIAN_TYPES = [t for t in bundled_types() if debian_has_messages(t.split("/")[0])
                 and not t.endswith(("Request", "Response"))]
-DEBIAN_SERVICES = [t for t in bundled_services() if not t.startswith(NOT_IN_DEBIAN)]
+DEBIAN_SERVICES = [t for t in bundled_services() if debian_has_messages(t.split("/")[0])]
 
 # One long-lived /usr/bin/python3 answering calls into Debian's packages; minros answers the
 # same requests in-process through its stand-ins (the same code, run twice).
