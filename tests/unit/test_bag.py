@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import os
+import struct
 import time
 from pathlib import Path
 
@@ -270,3 +271,51 @@ def test_time_translator():
     assert tr.real(12_000_000_000) == 51.0
     tr.shift(0.25)
     assert tr.real(12_000_000_000) == 51.25
+
+
+def _lz4_frame_blocks(frame: bytes) -> tuple:
+    """(FLG byte, block-size id, [(stored uncompressed, block bytes)]) of one LZ4 frame."""
+    assert frame[:4] == b"\x04\x22\x4d\x18"  # LZ4 frame magic
+    flg, bd = frame[4], frame[5]
+    pos = 7  # magic, FLG, BD, header checksum (no content size: checked by the caller)
+    blocks = []
+    while True:
+        (size,) = struct.unpack_from("<I", frame, pos)
+        pos += 4
+        if size == 0:
+            break
+        n = size & 0x7FFFFFFF
+        blocks.append((bool(size >> 31), frame[pos:pos + n]))
+        pos += n
+    assert len(frame) == pos + 4  # the content checksum ends the frame
+    return flg, (bd >> 4) & 7, blocks
+
+
+def test_lz4_chunks_are_frames_roslz4_reads(tmp_path):
+    """roslz4 (ROS's LZ4 reader) accepts only frames of independent blocks, with a content
+    checksum and without a content size; chunks over one block (every image bag) need it."""
+    import lz4.block
+
+    from sensor_msgs.msg import Image
+
+    pattern = os.urandom(200_000)  # repeated: a linked block would refer to the one before
+    img = Image(height=1, width=3 * len(pattern), encoding="mono8", step=3 * len(pattern),
+                data=pattern * 3)
+    path = tmp_path / "img.bag"
+    with Bag(str(path), "w", compression="lz4", chunk_threshold=3 * 1024 * 1024) as b:
+        for i in range(5):
+            b.write("/img", img, minros.Time(1, i))
+    raw = path.read_bytes()
+    scan = bag1.scan_chunks(path)
+    (chunk,) = scan.chunks
+    datapos, size = scan.datapos[chunk.pos]
+    flg, block_id, blocks = _lz4_frame_blocks(raw[datapos:datapos + size])
+    assert flg >> 6 == 1 and flg & 0x20, "blocks must be independent (FLG bit 5)"
+    assert not flg & 0x10 and not flg & 0x08 and flg & 0x04 and not flg & 0x01  # no block checksum,
+    assert 4 <= block_id <= 7 and len(blocks) >= 3  # no content size, a content checksum
+    # each block decodes on its own: nothing refers to the block before
+    out = b"".join(data if stored else lz4.block.decompress(data, uncompressed_size=1 << (8 + 2 * block_id))
+                   for stored, data in blocks)
+    assert len(out) == chunk.uncompressed_size
+    with Bag(str(path)) as b:
+        assert [bytes(m.message.data) == img.data for m in b.read_messages()] == [True] * 5

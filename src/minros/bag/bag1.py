@@ -453,11 +453,14 @@ _COMPRESSION_FORMATS = {Compression.BZ2: _rb_writer.Writer.CompressionFormat.BZ2
 
 
 def _roslz4_compress(data: bytes) -> bytes:
-    """An LZ4 frame ROS's roslz4 can read: rosbags' frames store the content size, a header
-    field roslz4 rejects ("malformed data"), so the frame is written without it."""
+    """An LZ4 frame ROS's roslz4 can read. roslz4 rejects ("malformed data") frames that store
+    the content size (as rosbags' do), have block checksums, or link each block to the one
+    before (lz4's default), so the frame has none of these; its blocks are 1 MB, as roslz4's."""
     import lz4.frame
 
-    return lz4.frame.compress(data, compression_level=0, content_checksum=True, store_size=False)
+    return lz4.frame.compress(data, compression_level=0, content_checksum=True, store_size=False,
+                              block_linked=False, block_checksum=False,
+                              block_size=lz4.frame.BLOCKSIZE_MAX1MB)
 
 
 def _set_compression(w: _rb_writer.Writer, compression: str) -> None:
