@@ -410,3 +410,34 @@ def test_lz4_bag_api_multi_block_chunks_read_by_debian(tmp_path):
     messages = debian_read_images(tmp_path / "api.bag")
     assert messages == [[4096 * 400, 10 + i] for i in range(6)]
 
+
+
+def test_debian_appends_to_and_reindexes_minros_bags(tmp_path):
+    """Debian's rosbag rewrites the file header of a bag it appends to or reindexes, in its
+    own size (4104 bytes): minros's bags have that layout, so their first chunk survives."""
+    require_reference()
+    for name in ("a.bag", "cut.bag"):
+        _write_bag(tmp_path / name, (
+            "import sys\nfrom std_msgs.msg import String\n"
+            "with Bag(sys.argv[1], 'w', chunk_threshold=1000) as b:\n"
+            "    for i in range(200):\n"
+            "        b.write('/s', String('m%03d' % i + 'x' * 40), minros.Time(100 + i, 0))\n"))
+    code = ("import sys, rospy, rosbag\nfrom std_msgs.msg import String\n"
+            "with rosbag.Bag(sys.argv[1], 'a') as b:\n"
+            "    b.write('/s', String('m200'), rospy.Time(300, 0))\n")
+    appended = subprocess.run([REFERENCE_PYTHON, "-c", code, str(tmp_path / "a.bag")],
+                              env=reference_env({}), capture_output=True, text=True, timeout=60)
+    assert appended.returncode == 0, appended.stderr
+    assert [m[2][:4] for m in debian_read(tmp_path / "a.bag")] == [f"m{i:03d}" for i in range(201)]
+    data = (tmp_path / "cut.bag").read_bytes()
+    (tmp_path / "cut.bag").write_bytes(data[:len(data) // 2])
+    reindex = debian_rosbag(0, tmp_path, tmp_path, "reindex", "-q", "cut.bag")
+    assert reindex.returncode == 0, reindex.stderr
+    messages = debian_read(tmp_path / "cut.bag")
+    assert len(messages) >= 60 and [m[2][:4] for m in messages] == [f"m{i:03d}" for i in range(len(messages))]
+    for name in ("a.bag", "cut.bag"):  # and minros reads both
+        code = ("import sys\nfrom minros.bag import Bag\n"
+                "print(len(list(Bag(sys.argv[1]).read_messages())))\n")
+        ours = subprocess.run([PYTHON, "-c", code, str(tmp_path / name)], capture_output=True,
+                              text=True, timeout=60)
+        assert ours.returncode == 0 and int(ours.stdout) == (201 if name == "a.bag" else len(messages)), ours.stderr

@@ -19,9 +19,12 @@ from minros.bag.bag1 import ConnInfo
 from minros.bag.errors import (
     COMPRESSIONS,
     Compression,
+    ROSBagDeserializationException,
     ROSBagException,
+    ROSBagFormatException,
     ROSBagUnindexedException,
 )
+from minros.bag.scan import rebuild
 from minros.msgs import reader_for
 from minros.names import canonicalize_name
 
@@ -155,7 +158,10 @@ class Bag:
     def _set_compression(self, compression: str) -> None:
         if compression not in COMPRESSIONS:
             raise ValueError("compression must be one of: " + ", ".join(COMPRESSIONS))
-        if self._writer is not None and compression != self._compression:
+        if isinstance(self._writer, bag1.Bag1Writer):
+            self._writer.flush_chunk()  # as rosbag: the chunks after this one use the new one
+            self._writer.set_compression(compression)
+        elif self._writer is not None and compression != self._compression:  # MCAP
             if self._writer.connections:
                 raise ROSBagException("set the compression before writing the first message")
             self._writer.abort()
@@ -238,6 +244,9 @@ class Bag:
                 cls = load_class(conn.datatype, conn.md5sum, conn.msg_def)
             except DecodeError as exc:
                 raise ROSBagException(str(exc)) from None
+            except Exception as exc:  # noqa: BLE001 - a definition damaged in the bag
+                raise ROSBagFormatException(f"the message definition of {conn.datatype} on "
+                                            f"{conn.topic} does not parse: {exc}") from None
             if conn.md5sum not in ("", "*") and cls._md5sum != conn.md5sum:
                 print(f"WARNING: For type [{conn.datatype}] stored md5sum [{conn.md5sum}] does not "
                       f"match message definition [{cls._md5sum}].", file=sys.stderr)
@@ -269,31 +278,44 @@ class Bag:
         readers = {cid: reader_for(cls) for cid, cls in classes.items()}
         ids = None if len(conns) == len(source.connections) else list(conns)
         new_time = Time.__new__
-        if not raw and not with_header:
-            # the common case in one lean loop: about 8% of a read of many small messages
-            topic_readers = {cid: (conns[cid].topic, read) for cid, read in readers.items()}
-            new_tuple = tuple.__new__  # BagMessage(...) runs a Python-level __new__
-            for cid, t, data, _pos in source.messages(ids, start, end):
-                topic, read = topic_readers[cid]
-                msg = read(data)
-                stamp = new_time(Time)  # filled in directly: two __init__ calls add up
+        cid = t = -1
+        try:
+            if not raw and not with_header:
+                # the common case in one lean loop: about 8% of a read of many small messages
+                topic_readers = {cid: (conns[cid].topic, read) for cid, read in readers.items()}
+                new_tuple = tuple.__new__  # BagMessage(...) runs a Python-level __new__
+                for cid, t, data, _pos in source.messages(ids, start, end):
+                    topic, read = topic_readers[cid]
+                    msg = read(data)
+                    stamp = new_time(Time)  # filled in directly: two __init__ calls add up
+                    stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
+                    yield new_tuple(BagMessage, (topic, msg, stamp))
+                return
+            headers = {cid: c.header for cid, c in conns.items()} if with_header else {}
+            for cid, t, data, pos in source.messages(ids, start, end):
+                conn = conns[cid]
+                cls = classes[cid]
+                if raw:
+                    msg: Any = (conn.datatype, bytes(data), conn.md5sum, pos, cls)
+                else:
+                    msg = readers[cid](data)
+                stamp = new_time(Time)  # filled in directly: two __init__ calls per message add up
                 stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
-                yield new_tuple(BagMessage, (topic, msg, stamp))
-            return
-        headers = {cid: c.header for cid, c in conns.items()} if with_header else {}
-        for cid, t, data, pos in source.messages(ids, start, end):
+                if with_header:
+                    yield BagMessageWithConnectionHeader(conn.topic, msg, stamp, headers[cid])
+                else:
+                    yield BagMessage(conn.topic, msg, stamp)
+        except ROSBagException:
+            raise
+        except Exception as exc:  # noqa: BLE001 - whatever a damaged message makes a reader raise
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            if cid not in conns:
+                raise ROSBagFormatException(f"the bag could not be read: {reason}") from None
             conn = conns[cid]
-            cls = classes[cid]
-            if raw:
-                msg: Any = (conn.datatype, bytes(data), conn.md5sum, pos, cls)
-            else:
-                msg = readers[cid](data)
-            stamp = new_time(Time)  # filled in directly: two __init__ calls per message add up
-            stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
-            if with_header:
-                yield BagMessageWithConnectionHeader(conn.topic, msg, stamp, headers[cid])
-            else:
-                yield BagMessage(conn.topic, msg, stamp)
+            raise ROSBagDeserializationException(
+                f"the {conn.datatype} message of {conn.topic} at {t // 1_000_000_000}."
+                f"{t % 1_000_000_000:09d} does not deserialize ({reason}): the bag is damaged "
+                "there, or its message definition is wrong") from None
 
     def get_message_count(self, topic_filters: Any = None) -> int:
         counts = self._counts()
@@ -448,14 +470,14 @@ class Bag:
         return self._reindex_for_append()
 
     def _reindex_for_append(self) -> Iterator[int]:
-        from pathlib import Path
-
-        scan = bag1.ScanResult()
-        yield from bag1.iter_scan(Path(self._filename), scan)
         if self._writer is not None:
             self._writer.abort()
-        self._writer = bag1.Bag1Writer.append(self._filename, self._compression,
-                                              self._chunk_threshold, scan)
+            self._writer = None
+        with open(self._filename, "r+b") as f:
+            scan = bag1.ScanResult()
+            yield from bag1.iter_scan(f, scan)
+            rebuild(f, scan)
+        self._writer = bag1.Bag1Writer.append(self._filename, self._compression, self._chunk_threshold)
         self._topic_conn = {c.topic: c.id for c in self._writer.connections.values()}
         self._pending_scan = False
 
