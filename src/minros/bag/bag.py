@@ -12,7 +12,7 @@ import io
 import os
 import sys
 import time
-from typing import Any, Callable, Dict, Iterator, List, Optional, Union
+from typing import Any, BinaryIO, Callable, Dict, Iterator, List, Optional, Union
 
 from minros.bag import bag1
 from minros.bag.bag1 import ConnInfo
@@ -59,7 +59,7 @@ def _str(value: Any) -> str:
 class Bag:
     """A bag file opened for reading ('r'), writing ('w') or appending ('a')."""
 
-    def __init__(self, f: Union[str, os.PathLike], mode: str = "r",
+    def __init__(self, f: Union[str, os.PathLike, BinaryIO], mode: str = "r",
                  compression: str = Compression.NONE, chunk_threshold: int = 768 * 1024,
                  allow_unindexed: bool = False, options: Optional[dict] = None,
                  skip_index: bool = False) -> None:
@@ -74,11 +74,17 @@ class Bag:
             raise ValueError("chunk_threshold must be greater than or equal to zero")
         if not f:
             raise ValueError("filename (or stream) is invalid")
-        if isinstance(f, io.IOBase):
-            raise ValueError("minros's Bag opens files by name: pass the path, not a stream")
         if mode not in ("r", "w", "a"):
             raise ValueError(f'mode "{mode}" is invalid')
-        self._filename = os.fspath(f)
+        #: a file object the bag was given (rosbag reads and writes those as it does files,
+        #: and closes them on close(); but not an io.BytesIO, which rosbag does not take and
+        #: which would lose the bag just written); None when it was given a file name
+        self._stream: Optional[BinaryIO] = None
+        if isinstance(f, (str, os.PathLike)):
+            self._filename: Optional[str] = os.fspath(f)
+        else:
+            _check_stream(f, mode)
+            self._stream, self._filename = f, None
         self._mode = mode
         self._compression = compression
         self._chunk_threshold = chunk_threshold
@@ -89,24 +95,37 @@ class Bag:
         self._classes: Dict[int, Any] = {}
         self._topic_conn: Dict[str, int] = {}
         self._closed = False
+        target = self._target
         if mode == "r":
-            self._reader = open_reader(self._filename, allow_unindexed)
+            self._reader = open_reader(target, allow_unindexed, self._keep_open)
             self._version = self._reader.version
         elif mode == "w":
             self._version = 200
-            self._writer = open_writer(self._filename, compression, chunk_threshold)
+            self._writer = open_writer(target, compression, chunk_threshold, self._keep_open)
         else:
             self._version = 200
             self._open_append(allow_unindexed)
 
+    @property
+    def _keep_open(self) -> bool:
+        return isinstance(self._stream, io.BytesIO)
+
+    @property
+    def _target(self) -> Union[str, BinaryIO]:
+        """What the bag reads and writes: its file object, else its file name."""
+        return self._stream if self._stream is not None else self._filename  # type: ignore[return-value]
+
     def _open_append(self, allow_unindexed: bool) -> None:
-        if not os.path.exists(self._filename):
-            self._writer = bag1.Bag1Writer(self._filename, self._compression, self._chunk_threshold)
+        target = self._target
+        if (not os.path.exists(target) if self._stream is None
+                else self._stream.seek(0, os.SEEK_END) == 0):
+            self._writer = bag1.Bag1Writer(target, self._compression, self._chunk_threshold,
+                                           keep_open=self._keep_open)
             return
-        if is_mcap(self._filename):
+        if is_mcap(target):
             raise ROSBagException("appending to MCAP files is not supported")
         try:
-            scan = bag1.summary_scan(self._filename)
+            scan = bag1.summary_scan(target)
         except ROSBagUnindexedException:
             if not allow_unindexed:
                 raise
@@ -114,8 +133,8 @@ class Bag:
             return
         except OSError as exc:
             raise ROSBagException(str(exc.strerror or exc)) from None
-        self._writer = bag1.Bag1Writer.append(self._filename, self._compression,
-                                              self._chunk_threshold, scan)
+        self._writer = bag1.Bag1Writer.append(target, self._compression, self._chunk_threshold, scan,
+                                              self._keep_open)
         self._topic_conn = {c.topic: c.id for c in self._writer.connections.values()}
 
     # -- context manager, properties ------------------------------------------------------
@@ -134,7 +153,8 @@ class Bag:
         return {"compression": self._compression, "chunk_threshold": self._chunk_threshold}
 
     @property
-    def filename(self) -> str:
+    def filename(self) -> Optional[str]:
+        """The file name (None for a bag opened on a file object, as in rosbag)."""
         return self._filename
 
     @property
@@ -150,7 +170,12 @@ class Bag:
         self._check_open()
         if self._writer is not None:
             return self._writer.tell()
-        return os.path.getsize(self._filename)
+        if self._stream is not None:
+            pos = self._stream.tell()
+            size = self._stream.seek(0, os.SEEK_END)
+            self._stream.seek(pos)
+            return size
+        return os.path.getsize(self._filename)  # type: ignore[arg-type]
 
     def _get_compression(self) -> str:
         return self._compression
@@ -165,7 +190,7 @@ class Bag:
             if self._writer.connections:
                 raise ROSBagException("set the compression before writing the first message")
             self._writer.abort()
-            self._writer = open_writer(self._filename, compression, self._chunk_threshold)
+            self._writer = open_writer(self._target, compression, self._chunk_threshold)
         self._compression = compression
 
     compression = property(_get_compression, _set_compression)
@@ -473,11 +498,17 @@ class Bag:
         if self._writer is not None:
             self._writer.abort()
             self._writer = None
-        with open(self._filename, "r+b") as f:
+        if self._stream is not None:
             scan = bag1.ScanResult()
-            yield from bag1.iter_scan(f, scan)
-            rebuild(f, scan)
-        self._writer = bag1.Bag1Writer.append(self._filename, self._compression, self._chunk_threshold)
+            yield from bag1.iter_scan(self._stream, scan)
+            rebuild(self._stream, scan)
+        else:
+            with open(self._filename, "r+b") as f:  # type: ignore[arg-type]
+                scan = bag1.ScanResult()
+                yield from bag1.iter_scan(f, scan)
+                rebuild(f, scan)
+        self._writer = bag1.Bag1Writer.append(self._target, self._compression, self._chunk_threshold,
+                                              keep_open=self._keep_open)
         self._topic_conn = {c.topic: c.id for c in self._writer.connections.values()}
         self._pending_scan = False
 
@@ -509,30 +540,47 @@ class Bag:
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
-def is_mcap(path: str) -> bool:
-    """Whether ``path`` starts with MCAP's magic bytes (else it is taken for a bag)."""
+def is_mcap(source: Union[str, BinaryIO]) -> bool:
+    """Whether ``source`` starts with MCAP's magic bytes (else it is taken for a bag)."""
     try:
-        with open(path, "rb") as f:
+        if not isinstance(source, str):
+            source.seek(0)
+            return source.read(len(MCAP_MAGIC)) == MCAP_MAGIC
+        with open(source, "rb") as f:
             return f.read(len(MCAP_MAGIC)) == MCAP_MAGIC
     except OSError:
         return False
 
 
-def open_reader(path: str, allow_unindexed: bool) -> Any:
+def _check_stream(f: Any, mode: str) -> None:
+    """A file object to read or write a bag in: binary, and able to seek (rosbag's demands)."""
+    if isinstance(f, io.TextIOBase) or "b" not in getattr(f, "mode", "b"):
+        raise ROSBagException("In Python 3 the bag file must be opened in binary mode")
+    if not all(hasattr(f, name) for name in ("read", "write", "seek", "tell")):
+        raise ValueError("filename (or stream) is invalid")
+    if getattr(f, "closed", False):
+        raise ValueError("I/O operation on closed file")
+
+
+def open_reader(source: Union[str, BinaryIO], allow_unindexed: bool, keep_open: bool = False) -> Any:
     """The reader of a bag v2.0 or MCAP file (by its first bytes)."""
-    if not os.path.exists(path):
-        raise ROSBagException(f"[Errno 2] No such file or directory: '{path}'")
-    if is_mcap(path):
+    if isinstance(source, str) and not os.path.exists(source):
+        raise ROSBagException(f"[Errno 2] No such file or directory: '{source}'")
+    if is_mcap(source):
+        if not isinstance(source, str):
+            raise ROSBagException("minros reads MCAP files by name: pass the file's name, not a file object")
         from minros.bag import mcapfile  # imported only for MCAP files: rosbag info starts faster
 
-        return mcapfile.McapReader(path, allow_unindexed)
-    return bag1.Bag1Reader(path, allow_unindexed)
+        return mcapfile.McapReader(source, allow_unindexed)
+    return bag1.Bag1Reader(source, allow_unindexed, keep_open)
 
 
-def open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
-    """A new file's writer: MCAP when the name ends in .mcap (or .mcap.active), else bag v2.0."""
-    if path.endswith(".mcap") or path.endswith(".mcap.active"):
+def open_writer(path: Union[str, BinaryIO], compression: str, chunk_threshold: int,
+                keep_open: bool = False) -> Any:
+    """A new file's writer: MCAP when the name ends in .mcap (or .mcap.active), else bag v2.0
+    (always for a file object)."""
+    if isinstance(path, str) and (path.endswith(".mcap") or path.endswith(".mcap.active")):
         from minros.bag import mcapfile
 
         return mcapfile.McapWriter(path, compression, chunk_threshold)
-    return bag1.Bag1Writer(path, compression, chunk_threshold)
+    return bag1.Bag1Writer(path, compression, chunk_threshold, keep_open=keep_open)
