@@ -286,3 +286,26 @@ def test_reindex_keeps_all_but_the_damaged_chunk(corpus, tmp_path):
         if n < d.keepable:
             short.append((d.name, n, d.keepable))
     assert not short, short
+
+
+def test_damaged_mcap_files_raise_only_rosbag_exceptions(tmp_path):
+    """The same for MCAP files (read through the mcap library): 90 seeded flips and cuts."""
+    path = tmp_path / "base.mcap"
+    with Bag(str(path), "w", chunk_threshold=1000) as b:
+        for i in range(200):
+            b.write("/s", String(f"m{i:03d}"), minros.Time(1 + i))
+    raw = path.read_bytes()
+    rng = random.Random(SEED)
+    damaged = tmp_path / "damaged.mcap"
+    for k in range(90):
+        data = bytearray(raw)
+        if k % 3 == 0:
+            data = data[:rng.randrange(len(data))]
+        else:
+            data[rng.randrange(len(data))] ^= 1 << rng.randrange(8)
+        damaged.write_bytes(bytes(data))
+        for allow_unindexed in (False, True):
+            _n, exc = read_all(damaged, allow_unindexed)
+            if exc is not None:
+                assert isinstance(exc, ROS_FAMILY), f"case {k}: {exc!r}"
+                one_line(str(exc), f"case {k}")
