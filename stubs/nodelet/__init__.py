@@ -1,0 +1,1 @@
+"""nodelet: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""topic_tools: message package stand-in provided by minros."""
