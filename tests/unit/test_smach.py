@@ -84,7 +84,7 @@ def test_input_only_keys_are_read_only_and_undeclared_keys_are_refused(quiet_log
         ud.out = 7
         ud.not_declared = 8  # refused with an error log, not written
         with pytest.raises(smach.InvalidUserCodeError):
-            ud.secret
+            _ = ud.secret
         return "ok"
 
     sm = smach.StateMachine(outcomes=["ok"])
@@ -106,7 +106,7 @@ def test_missing_userdata_key_is_a_key_error_and_hasattr_works() -> None:
         ud["nope"]
     assert not hasattr(ud, "nope")
     ud.yes = 1
-    assert getattr(ud, "yes") == 1 and ud.keys() == ["yes"]
+    assert ud.yes == 1 and ud.keys() == ["yes"]
 
 
 def test_constants_are_written_when_the_state_is_entered() -> None:
