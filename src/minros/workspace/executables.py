@@ -78,6 +78,7 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosmsg": {"rosmsg": "minros.cli.msg", "rossrv": "minros.cli.srv"},
     "rosconsole": {"rosconsole": "minros.cli.console"},
     "rostest": {"rostest": "minros.cli.rostest"},
+    "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
     # topic_tools' programs (minros.topic_tools; ROS ships C++ relay/throttle/drop/mux)
     "topic_tools": {name: f"minros.nodes.topic_tools.{name}" for name in (
         "relay", "throttle", "drop", "mux", "transform", "mux_select", "mux_add",
