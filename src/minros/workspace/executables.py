@@ -79,6 +79,9 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosconsole": {"rosconsole": "minros.cli.console"},
     "rostest": {"rostest": "minros.cli.rostest"},
     "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
+    # headless: ROS's axclient is a wxPython window
+    "actionlib_tools": {"axclient.py": "minros.nodes.actionlib_tools.axclient",
+                        "axclient": "minros.nodes.actionlib_tools.axclient"},
     # topic_tools' programs (minros.topic_tools; ROS ships C++ relay/throttle/drop/mux)
     "topic_tools": {name: f"minros.nodes.topic_tools.{name}" for name in (
         "relay", "throttle", "drop", "mux", "transform", "mux_select", "mux_add",
