@@ -49,6 +49,7 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     # tf's tools (minros.tf): names as Debian's tf-tools and tf2-tools install them
     "tf2_ros": {
         "static_transform_publisher": "minros.tf.static_transform_publisher",
+        "buffer_server": "minros.nodes.tf2_ros.buffer_server",
     },
     "tf": {
         "static_transform_publisher": "minros.tf.tf_static_transform_publisher",
