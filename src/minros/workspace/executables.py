@@ -80,6 +80,8 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosconsole": {"rosconsole": "minros.cli.console"},
     "rostest": {"rostest": "minros.cli.rostest"},
     "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
+    "tf2_web_republisher": {
+        "tf2_web_republisher": "minros.nodes.tf2_web_republisher.tf2_web_republisher"},
     # headless: ROS's axclient is a wxPython window
     "actionlib_tools": {"axclient.py": "minros.nodes.actionlib_tools.axclient",
                         "axclient": "minros.nodes.actionlib_tools.axclient"},
