@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -163,3 +164,33 @@ def test_mux_driven_by_the_other_sides_tools(tmp_path: Path, debian_rosmaster: i
         if probe is not None:
             probe.stop()
         mux.stop()
+
+
+LAUNCH = """<launch>
+  <node pkg="topic_tools" type="relay" name="chatter_relay" args="/chatter /chatter_relayed"/>
+  <node pkg="topic_tools" type="throttle" name="chatter_throttle"
+        args="messages /chatter 2.0 /chatter_slow"/>
+</launch>
+"""
+
+
+def test_programs_start_from_a_launch_file(tmp_path: Path, debian_rosmaster: int,
+                                           ros_home: Path) -> None:
+    launch = tmp_path / "relay.launch"
+    launch.write_text(LAUNCH)
+    env = ros_env(debian_rosmaster, ros_home)
+    denv = reference_env(env)
+    roslaunch = Proc([str(Path(PYTHON).parent / "roslaunch"), str(launch)], env)
+    talker = Proc(["/usr/bin/rostopic", "pub", "-r", "20", "/chatter", "std_msgs/String",
+                   "data: hi"], denv)
+    try:
+        for topic in ("/chatter_relayed", "/chatter_slow"):
+            echo = subprocess.run(["/usr/bin/rostopic", "echo", "-n", "1", topic], env=denv,
+                                  capture_output=True, text=True, timeout=60)
+            assert echo.stdout.startswith('data: "hi"'), echo
+        info = subprocess.run(["/usr/bin/rosnode", "list"], env=denv, capture_output=True,
+                              text=True, timeout=30).stdout
+        assert "/chatter_relay" in info and "/chatter_throttle" in info, info
+    finally:
+        talker.stop()
+        roslaunch.stop()
