@@ -80,6 +80,14 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosconsole": {"rosconsole": "minros.cli.console"},
     "rostest": {"rostest": "minros.cli.rostest"},
     "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
+    "robot_state_publisher": {
+        "robot_state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher",
+        "state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher"},
+    "joint_state_publisher": {
+        "joint_state_publisher": "minros.nodes.joint_state_publisher.joint_state_publisher"},
+    # PyPI's xacro with minros's package lookup (the package folder holds the same program
+    # for <param command="$(find xacro)/xacro ...">)
+    "xacro": {"xacro": "minros.nodes.xacro.xacro", "xacro.py": "minros.nodes.xacro.xacro"},
     "tf2_web_republisher": {
         "tf2_web_republisher": "minros.nodes.tf2_web_republisher.tf2_web_republisher"},
     # headless: ROS's axclient is a wxPython window
