@@ -80,6 +80,7 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosconsole": {"rosconsole": "minros.cli.console"},
     "rostest": {"rostest": "minros.cli.rostest"},
     "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
+    "image_transport": {"republish": "minros.nodes.image_transport.republish"},
     "robot_state_publisher": {
         "robot_state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher",
         "state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher"},
