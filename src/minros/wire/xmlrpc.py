@@ -354,6 +354,7 @@ class XmlRpcServer:
         # the hard bound on connection threads; evicted ones release it as they exit
         self._slots = threading.BoundedSemaphore(limits.max_connections)
         self._conns: Dict[int, socket.socket] = {}
+        self._conn_threads: Dict[int, threading.Thread] = {}
         self._conns_lock = threading.Lock()
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
@@ -390,10 +391,16 @@ class XmlRpcServer:
             sock.close()
         with self._conns_lock:
             conns = list(self._conns.values())
+            threads = list(self._conn_threads.values())
         for conn in conns:
             _shut(conn)
-        if self._thread is not None and self._thread is not threading.current_thread():
-            self._thread.join(2.0)
+        # joined, so that what a connection does after its last reply (an after-reply hook,
+        # its trace event) is done when shutdown returns; bounded, and never this thread
+        # (shutdown may run in a connection's after-reply hook)
+        deadline = time.monotonic() + 2.0
+        for thread in [self._thread, *threads]:
+            if thread is not None and thread is not threading.current_thread():
+                thread.join(max(0.0, deadline - time.monotonic()))
 
     def connection_count(self) -> int:
         with self._conns_lock:
@@ -446,13 +453,16 @@ class XmlRpcServer:
             return
         try:
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            thread = threading.Thread(target=self._serve_connection, args=(conn, key),
+                                      daemon=True, name=f"xmlrpc-conn:{self.port}")
             with self._conns_lock:
                 self._conns[key] = conn
-            threading.Thread(target=self._serve_connection, args=(conn, key), daemon=True,
-                             name=f"xmlrpc-conn:{self.port}").start()
+                self._conn_threads[key] = thread
+            thread.start()
         except BaseException:  # noqa: BLE001 - e.g. cannot start a thread: drop this client
             with self._conns_lock:
                 self._conns.pop(key, None)
+                self._conn_threads.pop(key, None)
             self.admission.leave(key)
             conn.close()
             self._slots.release()
@@ -524,6 +534,7 @@ class XmlRpcServer:
                 pass
             with self._conns_lock:
                 self._conns.pop(key, None)
+                self._conn_threads.pop(key, None)
             self.admission.leave(key)
             self._slots.release()
 
