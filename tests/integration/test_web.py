@@ -10,6 +10,7 @@ The node clients need ``npm ci`` in tests/web/js and Chromium needs Debian's ``c
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import socket
 import subprocess
@@ -42,9 +43,11 @@ VIDEO = EXAMPLES / "video"
 FAKECAM = Path(__file__).resolve().parent.parent / "examples" / "fakecam"
 
 
-def start_web(port: int, home: Path, *args: str, web_port: int | None = None) -> tuple:
+def start_web(port: int, home: Path, *args: str, web_port: int | None = None,
+              env: dict | None = None) -> tuple:
     web_port = web_port or free_port()
-    proc = Proc([PYTHON, "-m", "minros", "web", "--port", str(web_port), *args], ros_env(port, home))
+    proc = Proc([PYTHON, "-m", "minros", "web", "--port", str(web_port), *args],
+                ros_env(port, home, env))
     proc.read_until("listening on", timeout=20)
     return proc, web_port
 
@@ -94,13 +97,14 @@ def graph(tmp_path_factory):
         g.stop()
 
 
-def node_client(*args: str, timeout: float = 30) -> list:
+def node_client(*args: str, timeout: float = 30, env: dict | None = None,
+                check: bool = True) -> list:
     need(shutil.which("node") is not None and (JS / "node_modules" / "@foxglove").is_dir(),
          "node and tests/web/js/node_modules (npm ci) are needed for the Foxglove client")
     done = subprocess.run(["node", str(JS / "foxglove_client.mjs"), *args], capture_output=True,
-                          text=True, timeout=timeout)
+                          text=True, timeout=timeout, env={**os.environ, **(env or {})})
     lines = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
-    assert done.returncode == 0, f"{done.stdout}\n{done.stderr}"
+    assert done.returncode == 0 or not check, f"{done.stdout}\n{done.stderr}"
     return lines
 
 
@@ -307,8 +311,121 @@ def test_video_endpoints_report_bad_requests(graph):
     assert code == 400 and "width='abc' is not an integer" in text
     code, text = status("/no/such/page")
     assert code == 404
+    code, text = status("/%00")  # was a 500 (ValueError: embedded null byte)
+    assert code == 400 and "control character" in text
+    code, text = status("/" + "a" * 5000)
+    assert code == 404 and "Traceback" not in text
     code, text = status("/")
     assert code == 200 and "minros web" in text
+
+
+# -- pages of other sites ---------------------------------------------------------------------
+
+def refusal(url: str, **kwargs) -> tuple:
+    """(status, body) of a WebSocket upgrade the server refuses."""
+    from websockets.exceptions import InvalidStatus
+
+    with pytest.raises(InvalidStatus) as refused:
+        raw_client(url, **kwargs).close()
+    return refused.value.response.status_code, bytes(refused.value.response.body).decode()
+
+
+def upgrade_head(port: int, *headers: str) -> bytes:
+    """What the server answers a WebSocket upgrade sent with exactly these headers."""
+    with socket.create_connection(("127.0.0.1", port), timeout=10) as sock:
+        sock.sendall(("GET / HTTP/1.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                      "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+                      + "".join(h + "\r\n" for h in headers) + "\r\n").encode())
+        return sock.recv(65536)
+
+
+def http_status(url: str, headers: dict) -> tuple:
+    request = urllib.request.Request(url, headers=headers)
+    try:
+        with urllib.request.urlopen(request, timeout=10) as r:
+            return r.status, r.read().decode(errors="replace"), dict(r.headers)
+    except urllib.error.HTTPError as exc:
+        return exc.code, exc.read().decode(), dict(exc.headers)
+
+
+def test_pages_of_other_sites_and_foreign_host_names_are_refused(graph):
+    """A page on any site used to drive the server (rosapi set_param, publish, services), and
+    a name of the attacker's resolving to 127.0.0.1 (DNS rebinding) was served."""
+    code, body = refusal(graph.ws, origin="http://evil.example")
+    assert code == 403 and body.count("\n") == 1
+    assert "refused a page of http://evil.example" in body
+    assert "--allow-origin http://evil.example" in body
+    code, body = refusal(graph.ws, origin="null")  # sandboxed frames: any site makes them
+    assert code == 403 and "--allow-origin null" in body
+    head = upgrade_head(graph.web_port, f"Host: evil.example:{graph.web_port}")
+    assert head.startswith(b"HTTP/1.1 403") and b"refused the host name 'evil.example'" in head
+    code, body, _ = http_status(graph.http + "/", {"Host": f"rebind.evil.example:{graph.web_port}"})
+    assert code == 403 and f"--allow-origin http://rebind.evil.example:{graph.web_port}" in body
+    assert http_status(graph.http + "/", {"Origin": "not an origin"})[0] == 403
+    # nothing of the refused clients reached ROS
+    assert "evil" not in json.dumps(call_rosapi(graph.ws, "/rosapi/get_param_names"))
+
+    # a script (no Origin), the server's own page, a page on localhost: served
+    for kwargs in ({}, {"origin": f"http://127.0.0.1:{graph.web_port}"},
+                   {"origin": "http://localhost:3000"}, {"origin": "http://[::1]:8080"}):
+        with raw_client(graph.ws, **kwargs) as ws:
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t"}))
+            assert json.loads(ws.recv(timeout=10))["result"] is True, kwargs
+    for host in (f"localhost:{graph.web_port}", f"127.0.0.1:{graph.web_port}",
+                 f"[::1]:{graph.web_port}", f"{socket.gethostname()}:{graph.web_port}"):
+        assert http_status(graph.http + "/", {"Host": host})[0] == 200, host
+    # the video endpoints no longer tell every site it may read them
+    _, _, headers = http_status(graph.http + "/snapshot?topic=/chatter", {})
+    assert "Access-Control-Allow-Origin" not in headers
+    _, _, headers = http_status(graph.http + "/snapshot?topic=/chatter",
+                                {"Origin": "http://localhost:3000"})
+    assert headers.get("Access-Control-Allow-Origin") == "http://localhost:3000"
+
+
+def call_rosapi(url: str, service: str, **args) -> dict:
+    with raw_client(url) as ws:
+        ws.send(json.dumps({"op": "call_service", "service": service, "args": args, "id": "r"}))
+        reply = json.loads(ws.recv(timeout=10))
+    assert reply["result"] is True, reply
+    return reply["values"]
+
+
+def test_allow_origin_lets_a_foxglove_app_hosted_elsewhere_in(graph):
+    """Foxglove's and Lichtblick's web apps are pages of their own sites: --allow-origin (and
+    MINROS_WEB_ALLOW_ORIGIN) let them in, and only them."""
+    web, port = start_web(graph.port, graph.home, "--allow-origin", "https://app.foxglove.dev",
+                          "__name:=web_allow_origin",
+                          env={"MINROS_WEB_ALLOW_ORIGIN": "https://lichtblick.example:8443, null"})
+    url = f"ws://127.0.0.1:{port}"
+    try:
+        for origin in ("https://app.foxglove.dev", "https://lichtblick.example:8443"):
+            lines = node_client("echo", url, "/turtle1/pose", "1",
+                                env={"FOXGLOVE_CLIENT_ORIGIN": origin})
+            assert lines[0]["serverInfo"]["supportedEncodings"] == ["ros1"], origin
+            assert "x" in lines[-1]["message"], origin
+        done = node_client("echo", url, "/turtle1/pose", "1", check=False,
+                           env={"FOXGLOVE_CLIENT_ORIGIN": "https://app.foxglove.dev.evil.example"})
+        assert done[-1]["error"] == "Unexpected server response: 403"
+        with raw_client(url, origin="null") as ws:  # allowed by name
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t"}))
+            assert json.loads(ws.recv(timeout=10))["result"] is True
+        code, _, headers = http_status(f"http://127.0.0.1:{port}/snapshot?topic=/chatter",
+                                       {"Origin": "https://app.foxglove.dev"})
+        assert headers.get("Access-Control-Allow-Origin") == "https://app.foxglove.dev"
+    finally:
+        out = web.stop()
+    assert "refused a page of https://app.foxglove.dev.evil.example" in out
+    assert "Traceback" not in out
+
+
+def test_a_malformed_allow_origin_is_one_line(graph):
+    done = subprocess.run([PYTHON, "-m", "minros", "web", "--port", str(free_port()),
+                           "--allow-origin", "app.foxglove.dev/path"], env=graph.env(),
+                          capture_output=True, text=True, timeout=30)
+    assert done.returncode == 2
+    assert done.stderr.strip() == ("minros web: error: --allow-origin 'app.foxglove.dev/path' "
+                                   "is not an origin: give scheme://host[:port] (no path), e.g. "
+                                   "https://app.foxglove.dev, or * for any")
 
 
 # -- bad input ------------------------------------------------------------------------------
@@ -414,7 +531,7 @@ def test_client_that_never_reads_is_closed_and_others_keep_receiving(minros_core
     try:
         stalled = socket.create_connection(("127.0.0.1", port))
         stalled.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-        stalled.sendall(b"GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+        stalled.sendall(b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
                         b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n")
         assert b"101 Switching Protocols" in stalled.recv(4096)
         frame = json.dumps({"op": "subscribe", "topic": "/blob", "type": "std_msgs/String"}).encode()
@@ -443,11 +560,12 @@ def test_client_that_never_reads_is_closed_and_others_keep_receiving(minros_core
 ])
 def test_launch_files_start_the_server(minros_core, ros_home, package, launch_file, needle):
     port = free_port()
-    launch = Proc([PYTHON, "-m", "minros", "launch", package, launch_file, f"port:={port}"],
-                  ros_env(minros_core, ros_home))
+    launch = Proc([PYTHON, "-m", "minros", "launch", package, launch_file, f"port:={port}",
+                   "allow_origin:=https://app.foxglove.dev"], ros_env(minros_core, ros_home))
     try:
         launch.read_until("listening on", timeout=30)
-        with raw_client(f"ws://127.0.0.1:{port}") as ws:
+        assert refusal(f"ws://127.0.0.1:{port}", origin="https://evil.example")[0] == 403
+        with raw_client(f"ws://127.0.0.1:{port}", origin="https://app.foxglove.dev") as ws:
             ws.send(json.dumps({"op": "call_service", "service": "/rosapi/nodes", "id": "n"}))
             reply = json.loads(ws.recv(timeout=10))
         assert f"/{needle}" in reply["values"]["nodes"]

@@ -12,7 +12,9 @@ minros). A connection is told apart by:
 Each WebSocket client has an :class:`~minros.web.outbox.Outbox` and a writer thread: ROS
 callbacks only queue, the writer encodes and sends. A watchdog closes a client whose send has
 been blocked for ``send_timeout`` seconds (a client that stopped reading); MJPEG viewers write
-with the same bound. With a token, every request (WebSocket or HTTP) must carry it, as
+with the same bound. Every request first passes the Host and Origin checks of
+:mod:`minros.web.origin` (no page of another site may drive the server; ``--allow-origin``
+opens it to named ones). With a token, every request (WebSocket or HTTP) must carry it, as
 ``?token=`` in the URL or an ``Authorization: Bearer`` header, except the page's scripts and
 styles (:data:`PUBLIC_ASSETS`), which hold nothing of the ROS system.
 
@@ -37,13 +39,14 @@ import time
 import traceback
 import urllib.parse
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import minros
 from minros import rosenv
 from minros.web import foxglove_protocol as fp
 from minros.web import video
 from minros.web.foxglove import FoxgloveSession
+from minros.web.origin import OriginPolicy
 from minros.web.outbox import Outbox
 from minros.web.page import SUBPROTOCOL as PAGE_SUBPROTOCOL
 from minros.web.page import PageHub, PageSession
@@ -210,6 +213,28 @@ class _Guard:
             self.admission.set_state(key, admission.BUSY)
 
 
+def _header(request: Any, name: str) -> Optional[str]:
+    """The one value of header ``name`` (None when absent); ValueError when repeated."""
+    values = request.headers.get_all(name)
+    if len(values) > 1:
+        raise ValueError(f"the request has {len(values)} {name} headers: send one")
+    return values[0] if values else None
+
+
+def _local_names(bound: str) -> List[str]:
+    """The names this machine answers to in a Host header, besides its addresses and
+    localhost: its host name (and the mDNS ``.local`` one), ROS_HOSTNAME / ROS_IP, and the
+    address ``--host`` names."""
+    names = [bound, rosenv.get_address_override() or ""]
+    try:
+        hostname = socket.gethostname()
+    except OSError:
+        hostname = ""
+    if hostname:
+        names += [hostname, hostname.split(".")[0] + ".local"]
+    return [n for n in names if n]
+
+
 def _refuse(sock: socket.socket, status: int, reason: str) -> None:
     body = (reason + "\n").encode("utf-8", "replace")
     try:
@@ -229,7 +254,8 @@ class WebServer:
                  token: Optional[str] = None, name: str = "minros web", rosapi: Any = None,
                  send_timeout: float = DEFAULT_SEND_TIMEOUT,
                  max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE, compression: bool = False,
-                 static_dir: Path = STATIC_DIR, trace: Sequence[str] = ()) -> None:
+                 static_dir: Path = STATIC_DIR, trace: Sequence[str] = (),
+                 allow_origins: Sequence[str] = ()) -> None:
         self.state = state
         self.host = host
         self.port = port
@@ -252,6 +278,9 @@ class WebServer:
         self._guard: Any = None
         self._threads: List[threading.Thread] = []
         self.allowed = rosenv.allowed_hosts()  # ValueError naming a malformed entry
+        #: the Host and Origin checks (OriginError naming a malformed --allow-origin)
+        self.origins = OriginPolicy(allow_origins, _local_names(host))
+        self._refusals_logged: Dict[str, float] = {}
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -315,7 +344,7 @@ class WebServer:
         if self.token is None:
             return True
         given = urllib.parse.parse_qs(query).get("token", [""])[0]
-        auth = request.headers.get("Authorization", "")
+        auth = _header(request, "Authorization") or ""
         if not given and auth.lower().startswith("bearer "):
             given = auth[7:].strip()
         return hmac.compare_digest(given.encode(), self.token.encode())
@@ -339,26 +368,59 @@ class WebServer:
     def _text(self, status: int, text: str) -> Any:
         return self._response(status, (text + "\n").encode("utf-8"))
 
+    def _refused_page(self, connection: Any, status: int, text: str) -> Any:
+        """A 403 (or 400) of the Host and Origin checks, logged at most once a minute per
+        reason (a page may retry every second)."""
+        now = time.monotonic()
+        if now - self._refusals_logged.get(text, -60.0) >= 60.0:
+            if len(self._refusals_logged) > 256:
+                self._refusals_logged.clear()
+            self._refusals_logged[text] = now
+            peer = connection.remote_address
+            reason = text.removeprefix("minros web: ")
+            minros.logwarn(f"[web] {peer[0] if peer else '?'}: {reason}")
+        return self._text(status, text)
+
     def _process_request(self, connection: Any, request: Any) -> Any:
         self._guard.served(connection.socket)
+        try:
+            host = _header(request, "Host")
+            origin = _header(request, "Origin")
+            upgrade = (_header(request, "Upgrade") or "").lower() == "websocket"
+        except ValueError as exc:
+            return self._refused_page(connection, 400, f"minros web: {exc}")
+        refusal = self.origins.host_error(host) or self.origins.origin_error(origin, host)
+        if refusal is not None:
+            return self._refused_page(connection, 403, refusal)
         path, _, query = request.path.partition("?")
-        upgrade = request.headers.get("Upgrade", "").lower() == "websocket"
+        if any(ord(c) < 0x20 or ord(c) == 0x7F for c in urllib.parse.unquote(path)):
+            return self._text(400, "minros web: the path holds a control character (such as "
+                                   "%00): no page or endpoint has one")
         if not upgrade and posixpath.normpath(urllib.parse.unquote(path)).startswith(PUBLIC_ASSETS):
             # the page's code is the same in every install: a browser fetches it without the
             # token (a module's imports carry no query); the page itself and every piece of
             # data (WebSocket, video) still need the token
             return self._static(path)
-        if not self._token_ok(request, query):
+        try:
+            token_ok = self._token_ok(request, query)
+        except ValueError as exc:
+            return self._refused_page(connection, 400, f"minros web: {exc}")
+        if not token_ok:
             peer = connection.remote_address
             minros.logwarn(f"[web] refused {peer[0] if peer else '?'}: wrong or missing token")
             return self._text(401, "minros web: wrong or missing token. Add ?token=TOKEN to the "
                                    "URL (the token `minros web --token` was started with).")
         if upgrade:
             return None
+        cors = self.origins.cors_origin(origin, host)
         try:
-            return self._http(connection, path, query)
+            response = self._http(connection, path, query, cors)
         except video.VideoError as exc:
-            return self._text(exc.status, f"minros web: {exc}")
+            response = self._text(exc.status, f"minros web: {exc}")
+        if cors is not None:  # a page that may use the server may read its answers
+            response.headers["Access-Control-Allow-Origin"] = cors
+            response.headers["Vary"] = "Origin"
+        return response
 
     # -- plain HTTP ------------------------------------------------------------------------
 
@@ -366,9 +428,12 @@ class WebServer:
         token = urllib.parse.parse_qs(query).get("token", [""])[0]
         return "&token=" + urllib.parse.quote(token) if token else ""
 
-    def _http(self, connection: Any, path: str, query: str) -> Any:
+    def _http(self, connection: Any, path: str, query: str, cors: Optional[str]) -> Any:
+        """``cors``: the origin of a page allowed to read the answer, for the stream (whose
+        head is written here); a page of another site may show the images, not read them."""
         if path == "/stream":
-            return self._stream(connection, self._video_params(query))
+            cors_headers = [("Access-Control-Allow-Origin", cors), ("Vary", "Origin")] if cors else []
+            return self._stream(connection, self._video_params(query), cors_headers)
         if path == "/snapshot":
             params = self._video_params(query)
             feed = self._feed(params.topic)
@@ -395,9 +460,13 @@ class WebServer:
     def _static(self, path: str) -> Any:
         relative = urllib.parse.unquote(path).lstrip("/") or "index.html"
         root = self.static_dir.resolve()
-        target = (root / relative).resolve()
-        if root not in target.parents or not target.is_file():
-            return self._text(404, f"minros web: no such page {path}")
+        try:
+            target = (root / relative).resolve()
+            found = root in target.parents and target.is_file()
+        except (OSError, ValueError):  # a name too long for the file system, say
+            found = False
+        if not found:
+            return self._text(404, f"minros web: no such page {path[:200]}")
         content_type = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
         if content_type.startswith("text/") or content_type.endswith("javascript"):
             content_type += "; charset=utf-8"
@@ -439,7 +508,8 @@ class WebServer:
                 del self.state.feeds[topic]
                 self.state.untap(topic, ("video", topic))
 
-    def _stream(self, connection: Any, params: video.StreamParams) -> Any:
+    def _stream(self, connection: Any, params: video.StreamParams,
+                extra_headers: Sequence[Tuple[str, str]] = ()) -> Any:
         """Write an MJPEG stream on the connection's socket until the viewer goes away (this
         runs in the connection's own thread; the websockets handshake is never completed)."""
         feed = self._feed(params.topic)
@@ -448,7 +518,7 @@ class WebServer:
         with self._lock:
             self.viewers += 1
         try:
-            send_with_timeout(sock, [video.stream_head()], self.send_timeout)
+            send_with_timeout(sock, [video.stream_head(extra_headers)], self.send_timeout)
             seq = 0
             while not self._stop.is_set():
                 newest = feed.wait(seq, 1.0)

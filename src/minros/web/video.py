@@ -18,7 +18,7 @@ import html
 import threading
 import urllib.parse
 from dataclasses import dataclass
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -238,12 +238,13 @@ STREAM_HEADERS = [
     ("Cache-Control", "no-cache, no-store, must-revalidate, pre-check=0, post-check=0, max-age=0"),
     ("Pragma", "no-cache"),
     ("Content-type", f"multipart/x-mixed-replace;boundary={BOUNDARY}"),
-    ("Access-Control-Allow-Origin", "*"),
 ]
 
 
-def stream_head() -> bytes:
-    lines = ["HTTP/1.1 200 OK"] + [f"{k}: {v}" for k, v in STREAM_HEADERS]
+def stream_head(extra: Sequence[Tuple[str, str]] = ()) -> bytes:
+    """The response head of an MJPEG stream (web_video_server's headers, without its
+    ``Access-Control-Allow-Origin: *``: the server adds the origin of a page it trusts)."""
+    lines = ["HTTP/1.1 200 OK"] + [f"{k}: {v}" for k, v in [*STREAM_HEADERS, *extra]]
     return ("\r\n".join(lines) + "\r\n\r\n" + f"--{BOUNDARY}\r\n").encode("ascii")
 
 
@@ -256,8 +257,7 @@ def stream_part(jpeg: bytes, stamp: float) -> List[bytes]:
 def snapshot_headers(stamp: float) -> List[Tuple[str, str]]:
     return [("Cache-Control", "no-cache, no-store, must-revalidate, "
             "pre-check=0, post-check=0, max-age=0"), ("X-Timestamp", f"{stamp:.6f}"),
-            ("Pragma", "no-cache"), ("Content-Type", "image/jpeg"),
-            ("Access-Control-Allow-Origin", "*")]
+            ("Pragma", "no-cache"), ("Content-Type", "image/jpeg")]
 
 
 def viewer_page(params: StreamParams, query_string: str) -> str:
