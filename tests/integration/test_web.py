@@ -552,6 +552,52 @@ def test_client_that_never_reads_is_closed_and_others_keep_receiving(minros_core
     assert "Traceback" not in out
 
 
+def test_idle_sessions_of_one_peer_do_not_lock_others_out(minros_core, ros_home):
+    """512 idle WebSocket sessions from one address used to fill the server for good (503 on
+    / and on every upgrade): sessions count as idle now, so the idlest make room, and one
+    address keeps at most its share."""
+    web, port = start_web(minros_core, ros_home)
+    idle = []
+    try:
+        for _ in range(512):
+            sock = socket.create_connection(("127.0.0.1", port), timeout=10)
+            idle.append(sock)
+            sock.sendall(b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
+                         b"Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                         b"Sec-WebSocket-Version: 13\r\n\r\n")
+            assert sock.recv(4096).startswith(b"HTTP/1.1 101")
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10) as r:
+            assert r.status == 200
+        with raw_client(f"ws://127.0.0.1:{port}") as ws:
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t"}))
+            assert json.loads(ws.recv(timeout=10))["result"] is True
+        roslibpy = subprocess.run([PYTHON, str(WEB / "roslibpy_client.py"),
+                                   f"ws://127.0.0.1:{port}", "connect"], capture_output=True,
+                                  text=True, timeout=60, env=ros_env(minros_core, ros_home))
+        result = json.loads(roslibpy.stdout.split("RESULT ", 1)[1])
+        assert result["connected"] is True and result["time"]["secs"] > 0
+        closed = 0
+        for sock in idle:  # the oldest were closed to make room: 384 (3/4) at most are left
+            sock.setblocking(False)
+            try:
+                closed += sock.recv(1 << 16) == b""
+            except BlockingIOError:
+                pass
+            except OSError:
+                closed += 1
+        assert closed >= 512 - WEB_PEER_SHARE
+        out = web.read_until("the idlest, to make room", timeout=10)
+    finally:
+        for sock in idle:
+            sock.close()
+        out = web.stop()
+    assert "Traceback" not in out
+
+
+#: the connections one address may hold (3/4 of minros web's 512)
+WEB_PEER_SHARE = 384
+
+
 # -- launch files ---------------------------------------------------------------------------
 
 @pytest.mark.parametrize("package, launch_file, needle", [

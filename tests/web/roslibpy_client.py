@@ -2,6 +2,7 @@
 tests/integration/test_web.py: one scenario, one ``RESULT {json}`` line.
 
     python roslibpy_client.py WS_URL   (turtlesim must be running on the graph)
+    python roslibpy_client.py WS_URL connect   (connects and asks rosapi the time)
 """
 
 from __future__ import annotations
@@ -79,5 +80,15 @@ def main(url: str) -> int:
     return 0
 
 
+def connect(url: str) -> int:
+    ros = roslibpy.Ros(url)
+    ros.run(timeout=10)
+    out = {"connected": ros.is_connected, "time": ros.get_time()}
+    ros.terminate()
+    print("RESULT " + json.dumps(out, default=dict), flush=True)
+    return 0
+
+
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1]))
+    scenario = sys.argv[2] if len(sys.argv) > 2 else "turtlesim"
+    sys.exit({"turtlesim": main, "connect": connect}[scenario](sys.argv[1]))

@@ -19,8 +19,11 @@ opens it to named ones). With a token, every request (WebSocket or HTTP) must ca
 styles (:data:`PUBLIC_ASSETS`), which hold nothing of the ROS system.
 
 Connections are admitted as in every minros server (:mod:`minros.wire.admission`), by a small
-guard around the websockets handler: ROS_ALLOWED_HOSTS, a cap that closes the oldest
-connection still sending its request when full, a per-peer share. websockets' own options do
+guard around the websockets handler: ROS_ALLOWED_HOSTS, a cap that closes the idlest
+connection when full, a per-peer share. A request counts as busy while it is answered; a
+WebSocket session or an MJPEG stream counts as idle between messages, each message in either
+direction renewing it, so at the cap (or over a peer's share) the session that has done
+nothing for longest is closed and a new client always gets in. websockets' own options do
 the rest: ``open_timeout`` is a deadline for the whole opening handshake, ``max_size`` refuses
 a frame from its announced length, and frames are buffered as their bytes arrive.
 """
@@ -63,6 +66,8 @@ DEFAULT_MAX_MESSAGE_SIZE = 64 << 20
 DEFAULT_SEND_TIMEOUT = 10.0
 #: browsers and Foxglove open a few connections each; the handshake of each must end in 10 s
 WEB_LIMITS = admission.Limits(max_connections=512, head_timeout=10.0)
+#: seconds between two renewals of a session's activity (admission's idleness)
+ACTIVITY_INTERVAL = 0.5
 
 
 class _OneLine(logging.Filter):
@@ -113,8 +118,18 @@ class _Client:
         self.send_started: Optional[float] = None
         self.closing: Optional[str] = None
         self.session: Any = None
+        #: the connection's admission key and when it last told admission it was active
+        self.key: Optional[int] = None
+        self.touched = 0.0
         self.writer = threading.Thread(target=self._write_loop, name=f"minros-web-writer:{client_id}",
                                        daemon=True)
+
+    def touch(self) -> None:
+        """Something went in or out: renew the session's activity (at most twice a second)."""
+        now = time.monotonic()
+        if now - self.touched >= ACTIVITY_INTERVAL:
+            self.touched = now
+            self.server.guard_active(self.key)
 
     def close(self, reason: str) -> None:
         """Drop the client (from any thread): one log line, the socket shut down."""
@@ -154,12 +169,14 @@ class _Client:
             except (ConnectionClosed, OSError):
                 self.send_started = None
                 return
+            self.touch()
 
 
 class _Guard:
     """Admission in front of websockets' per-connection handler: the allow-list, the cap and
-    the per-peer share of :class:`minros.wire.admission.Admission`. A connection counts as
-    evictable until its request has been read (``served``), then as a session."""
+    the per-peer share of :class:`minros.wire.admission.Admission`. A connection is evictable
+    while its request arrives, busy while it is answered (``served``), then, as a session or
+    a stream, idle since its last message (``active``): the idlest goes first."""
 
     def __init__(self, inner: Any, server: Any, allowed: Any) -> None:
         self.inner = inner
@@ -205,12 +222,24 @@ class _Guard:
                 self._keys.pop(sock, None)
             adm.leave(key)
 
-    def served(self, sock: socket.socket) -> None:
-        """The connection's request is in: a session or a stream now, never evicted."""
+    def key_of(self, sock: socket.socket) -> Optional[int]:
         with self._lock:
-            key = self._keys.get(sock)
+            return self._keys.get(sock)
+
+    def served(self, sock: socket.socket) -> None:
+        """The connection's request is in and being answered: not evicted meanwhile."""
+        key = self.key_of(sock)
         if key is not None:
             self.admission.set_state(key, admission.BUSY)
+
+    def active(self, key: Optional[int]) -> None:
+        """An established session or stream did something now: idle from now on, so it is
+        evicted after every connection that has been quiet for longer."""
+        if key is not None:
+            self.admission.set_state(key, admission.IDLE)
+
+    def evicted(self, key: Optional[int]) -> bool:
+        return key is not None and self.admission.evicted(key)
 
 
 def _header(request: Any, name: str) -> Optional[str]:
@@ -277,6 +306,8 @@ class WebServer:
         self._server: Any = None
         self._guard: Any = None
         self._threads: List[threading.Thread] = []
+        self._evicted = 0
+        self._evicted_logged = -10.0
         self.allowed = rosenv.allowed_hosts()  # ValueError naming a malformed entry
         #: the Host and Origin checks (OriginError naming a malformed --allow-origin)
         self.origins = OriginPolicy(allow_origins, _local_names(host))
@@ -322,6 +353,24 @@ class WebServer:
         if host in ("0.0.0.0", "", "::"):
             host = socket.gethostname()
         return f"http://{host}:{self.port}"
+
+    def guard_active(self, key: Optional[int]) -> None:
+        if self._guard is not None:
+            self._guard.active(key)
+
+    def _note_eviction(self, what: str) -> None:
+        """One log line for the first session closed to make room, then at most one every 10 s
+        with the count (a flood of connections must not flood the log)."""
+        with self._lock:
+            self._evicted += 1
+            now = time.monotonic()
+            if now - self._evicted_logged < 10.0:
+                return
+            count, self._evicted, self._evicted_logged = self._evicted, 0, now
+        more = f" ({count} since the last report)" if count > 1 else ""
+        minros.logwarn(f"[web] closed {what}, the idlest, to make room for a new connection "
+                       f"(at most {WEB_LIMITS.max_connections}, "
+                       f"{WEB_LIMITS.peer_connections} from one address){more}")
 
     def _watchdog(self) -> None:
         while not self._stop.wait(0.5):
@@ -515,19 +564,25 @@ class WebServer:
         feed = self._feed(params.topic)
         sock = connection.socket
         reader = getattr(connection, "recv_events_thread", None)
+        key = self._guard.key_of(sock)
         with self._lock:
             self.viewers += 1
         try:
             send_with_timeout(sock, [video.stream_head(extra_headers)], self.send_timeout)
+            self._guard.active(key)
             seq = 0
+            touched = time.monotonic()
             while not self._stop.is_set():
                 newest = feed.wait(seq, 1.0)
                 if reader is not None and not reader.is_alive():
-                    break  # the viewer closed its end
+                    break  # the viewer closed its end (or was closed to make room)
                 if newest == seq:
                     continue
                 seq, jpeg, stamp = feed.jpeg(params)
                 send_with_timeout(sock, video.stream_part(jpeg, stamp), self.send_timeout)
+                if time.monotonic() - touched >= ACTIVITY_INTERVAL:
+                    touched = time.monotonic()
+                    self._guard.active(key)
         except TimeoutError as exc:
             minros.logwarn(f"[web] closing the stream of {params.topic}: {exc}")
         except video.VideoError as exc:
@@ -535,6 +590,8 @@ class WebServer:
         except OSError:
             pass  # the viewer went away
         finally:
+            if self._guard.evicted(key):
+                self._note_eviction(f"the stream of {params.topic} to {connection.remote_address}")
             with self._lock:
                 self.viewers -= 1
             self._release_feed(params.topic)
@@ -564,6 +621,8 @@ class WebServer:
         else:
             client.session = RosbridgeSession(client_id, self.state, client.outbox, client.close,
                                               rosapi=self.rosapi)
+        client.key = self._guard.key_of(connection.socket)
+        client.touch()
         with self._lock:
             self.clients[client_id] = client
         minros.loginfo(f"[web] {kind} client {client_id} connected")
@@ -573,6 +632,7 @@ class WebServer:
                 client.session.start()
             while True:
                 data = connection.recv()
+                client.touch()
                 try:
                     client.session.receive(data)
                 except Exception:
@@ -584,6 +644,8 @@ class WebServer:
             if sent is not None and sent.code == 1009:  # websockets refused a frame over max_size
                 minros.logwarn(f"[web] closed client {client_id}: it sent a message larger than "
                                f"{self.max_message_size} bytes (raise --max-message-size)")
+            if self._guard.evicted(client.key):
+                self._note_eviction(f"{kind} client {client_id}")
             with self._lock:
                 self.clients.pop(client_id, None)
             client.outbox.close()
