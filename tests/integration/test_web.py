@@ -272,6 +272,7 @@ def test_seed_video_subscriber_frames_appear_at_stream(graph, tmp_path):
         assert "/stream_viewer?topic=/imshow/camera" in notice
         parts, headers = read_mjpeg_parts(f"{graph.http}/stream?topic=/imshow/camera", 3)
         assert headers["content-type"].startswith("multipart/x-mixed-replace;boundary=")
+        assert "access-control-allow-origin" not in headers  # was *: any site could read them
         assert len(parts) == 3
         frame = cv2.imdecode(np.frombuffer(parts[-1], np.uint8), cv2.IMREAD_COLOR)
         assert frame.shape == (480, 640, 3)
@@ -281,6 +282,11 @@ def test_seed_video_subscriber_frames_appear_at_stream(graph, tmp_path):
         with urllib.request.urlopen(f"{graph.http}/snapshot?topic=/imshow/camera", timeout=20) as r:
             assert r.headers["Content-Type"] == "image/jpeg"
             assert cv2.imdecode(np.frombuffer(r.read(), np.uint8), cv2.IMREAD_COLOR).shape == (480, 640, 3)
+        # a viewer's size is capped (was ~900 MB for one snapshot at 16384 x 16384)
+        huge = f"{graph.http}/snapshot?topic=/imshow/camera&width=16384&height=16384"
+        with urllib.request.urlopen(huge, timeout=30) as r:
+            shape = cv2.imdecode(np.frombuffer(r.read(), np.uint8), cv2.IMREAD_COLOR).shape
+        assert shape == (2880, 2880, 3)
         small, _ = read_mjpeg_parts(f"{graph.http}/stream?topic=/video_frames&width=320&height=240&quality=50", 1)
         assert cv2.imdecode(np.frombuffer(small[0], np.uint8), cv2.IMREAD_COLOR).shape == (240, 320, 3)
         with urllib.request.urlopen(f"{graph.http}/stream_viewer?topic=/imshow/camera", timeout=10) as r:

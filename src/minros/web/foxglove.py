@@ -14,6 +14,7 @@ import threading
 from typing import Any, Callable, Dict, List, Optional, Set, Tuple
 
 import minros
+from minros.msgs import reader_for
 from minros.web import foxglove_protocol as fp
 from minros.web.outbox import Outbox
 from minros.web.rosapi import Graph
@@ -318,8 +319,10 @@ class FoxgloveSession:
         topic, cls = entry
         payload = bytes(frame.payload)
         try:  # a malformed payload stops here instead of breaking every subscriber
-            msg = cls()
-            msg.deserialize(payload)
+            # read from the bytes (every length checked against them before anything is built),
+            # never cls() first: a schema the client chose ("float64[100000000] a") would make
+            # the default instance take 800 MB before a 13-byte message was found short
+            msg = reader_for(cls)(payload)
         except Exception as exc:
             self.error(f"Dropping a message on {topic}: the payload is not a valid "
                        f"{cls._type}: {exc}")

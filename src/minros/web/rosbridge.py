@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import itertools
 import json
+import sys
 import threading
 import time
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Tuple
 
 import minros
 from minros.web import cbor
@@ -30,14 +31,31 @@ LEVELS = {"info": 0, "warning": 1, "error": 2, "none": 3}
 DEFAULT_QUEUE_LENGTH = 100
 MAX_QUEUE_BYTES = 32 << 20
 MAX_CALLS_IN_FLIGHT = 16
+#: the largest publisher queue a client may ask for
+MAX_PUBLISH_QUEUE = 1000
 #: how long a ROS caller waits for a client that advertised a service
 SERVICE_RESPONSE_TIMEOUT = 60.0
 MAX_FRAGMENTED_MESSAGES = 64
+#: bytes a received fragment is charged beyond its text (its string and table entry)
+FRAGMENT_OVERHEAD = 100
 FRAGMENT_TIMEOUT = 600.0
+
+
+#: roughly how deep json.loads can nest (it counts against the interpreter's recursion limit)
+MAX_JSON_DEPTH = sys.getrecursionlimit()
 
 
 class OpError(Exception):
     """A client op that cannot be carried out; the text is what rosbridge would log."""
+
+
+def _queue_size(msg: Dict[str, Any]) -> int:
+    """A client's publisher queue_size, kept to 1..MAX_PUBLISH_QUEUE: the queue holds the
+    client's messages while a subscriber is slow, and 0 would make it unbounded in rospy."""
+    value = msg.get("queue_size", 100)
+    if type(value) is not int:
+        raise OpError(f"Expected field queue_size to be an int. Invalid value: {str(value)[:80]}")
+    return min(max(value, 1), MAX_PUBLISH_QUEUE)
 
 
 def _check(msg: Dict[str, Any], fields: List[Tuple[bool, str, tuple]]) -> None:
@@ -142,6 +160,10 @@ class RosbridgeSession:
             self.log("error", f"Received a message that is not valid JSON ({exc}): {excerpt}; "
                               "send one JSON object per message")
             return
+        except RecursionError:  # json's C parser counts its depth against the recursion limit
+            self.log("error", "Received JSON nested too deeply to read (more than "
+                              f"{MAX_JSON_DEPTH} levels); rosbridge ops are a few levels deep")
+            return
         if not isinstance(msg, dict):
             self.log("error", f"Received JSON that is not an object: {str(data)[:80]}")
             return
@@ -198,7 +220,7 @@ class RosbridgeSession:
         self._allowed(topic)
         cls = self._established_class(topic, msg["type"])
         self.state.acquire_publisher(self, topic, cls, latch=bool(msg.get("latch", False)),
-                                     queue_size=int(msg.get("queue_size", 100)))
+                                     queue_size=_queue_size(msg))
         self.advertised.setdefault(topic, set()).add(msg.get("id"))
 
     def unadvertise(self, msg: Dict[str, Any]) -> None:
@@ -224,7 +246,7 @@ class RosbridgeSession:
         if pub is None or self not in pub.clients:
             cls = self._established_class(topic, None) if pub is None else pub.data_class
             pub = self.state.acquire_publisher(self, topic, cls, latch=bool(msg.get("latch", False)),
-                                               queue_size=int(msg.get("queue_size", 100)))
+                                               queue_size=_queue_size(msg))
             self.published.add(topic)
         cls = pub.data_class
         if issubclass(cls, minros.AnyMsg):  # set up by a Foxglove client: bytes publisher
@@ -277,7 +299,7 @@ class RosbridgeSession:
             put(key, incoming, incoming.size)
         return listener
 
-    def _renderer(self, topic: str, params: Dict[str, Any]) -> Callable[[Incoming], List[Any]]:
+    def _renderer(self, topic: str, params: Dict[str, Any]) -> Callable[[Incoming], Iterable[Any]]:
         compression = params["compression"]
         fragment_size = params["fragment_size"]
         if compression == "cbor":
@@ -294,7 +316,7 @@ class RosbridgeSession:
                      "msg": {"secs": secs, "nsecs": nsecs, "bytes": bytes(incoming.data)}}))]
             return render_raw
 
-        def render_json(incoming: Incoming) -> List[Any]:
+        def render_json(incoming: Incoming) -> Iterable[Any]:
             text = incoming.cached(("rosbridge-json", topic), lambda: json.dumps(
                 {"op": "publish", "topic": topic, "msg": message_to_json(incoming.decoded())}))
             if fragment_size is not None and len(text) > fragment_size > 0:
@@ -471,11 +493,15 @@ class RosbridgeSession:
         if msg["total"] != total or not 0 <= msg["num"] < total or msg["num"] in entry["parts"]:
             raise OpError(f"error while trying to append fragment {msg['num']}")
         entry["parts"][msg["num"]] = msg["data"]
-        entry["size"] += len(msg["data"])
+        # a part costs its text and its place in the table: 32 MB of 1-character parts would
+        # otherwise hold 3 GB; and the messages in progress share the bound
+        entry["size"] += len(msg["data"]) + FRAGMENT_OVERHEAD
         entry["time"] = now
-        if entry["size"] > MAX_QUEUE_BYTES:
+        if sum(e["size"] for e in self.fragments.values()) > MAX_QUEUE_BYTES:
             del self.fragments[msg["id"]]
-            raise OpError(f"fragmented message {msg['id']} is larger than {MAX_QUEUE_BYTES} bytes")
+            raise OpError(f"fragmented message {msg['id']} does not fit: the fragments in progress "
+                          f"would hold more than {MAX_QUEUE_BYTES} bytes (send larger fragments, "
+                          "or fewer messages at once)")
         if len(entry["parts"]) == total:
             del self.fragments[msg["id"]]
             self.receive("".join(entry["parts"][i] for i in range(total)))
@@ -504,8 +530,11 @@ class RosbridgeSession:
 _fragment_ids = itertools.count()
 
 
-def fragment(text: str, size: int, message_id: Any) -> List[str]:
-    """rosbridge's fragmentation of an outgoing JSON text into ``fragment`` ops."""
-    parts = [text[i:i + size] for i in range(0, len(text), size)]
-    return [json.dumps({"op": "fragment", "id": message_id, "data": part, "num": n,
-                        "total": len(parts)}) for n, part in enumerate(parts)]
+def fragment(text: str, size: int, message_id: Any) -> Iterator[str]:
+    """rosbridge's fragmentation of an outgoing JSON text into ``fragment`` ops, made one at a
+    time as the writer sends them: the client picks ``fragment_size`` (1 byte would make a
+    1080p image's 8 MB of JSON into 8 million texts at once)."""
+    total = -(-len(text) // size)
+    for n in range(total):
+        yield json.dumps({"op": "fragment", "id": message_id, "data": text[n * size:(n + 1) * size],
+                          "num": n, "total": total})

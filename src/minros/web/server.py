@@ -154,8 +154,9 @@ class _Client:
                 return
             slot, item = got
             try:
+                # a frame, or an iterable of them: rosbridge's fragments are made one at a time
                 frames = item if slot is None else slot.render(item)
-                if not isinstance(frames, list):
+                if isinstance(frames, (str, bytes, bytearray, memoryview)):
                     frames = [frames]
             except Exception as exc:
                 minros.logerr(f"[web] client {self.id}: cannot encode a message for "

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Hashable, List, Optional, Set, Tuple
 
 import minros
+from minros.msgs import reader_for
 from minros.tools.services import probe_service
 from minros.web.rosapi import Graph
 
@@ -115,10 +116,19 @@ class Incoming:
         return self.cached("decoded", self._decode)
 
     def _decode(self) -> Any:
-        cls = self.tap.state.decoder.class_for_header(self.header)
-        msg = cls()
-        msg.deserialize(self.data)
-        return msg
+        # from the bytes, without a default instance first (the publisher chose the type's
+        # definition: its fixed-size arrays may be huge where the message is short)
+        return _reader(self.tap.state.decoder.class_for_header(self.header))(self.data)
+
+
+_READERS: Dict[type, Callable[[Any], Any]] = {}
+
+
+def _reader(cls: type) -> Callable[[Any], Any]:
+    read = _READERS.get(cls)
+    if read is None:
+        read = _READERS[cls] = reader_for(cls)
+    return read
 
 
 class TopicTap:
