@@ -18,6 +18,7 @@ import threading
 import time
 import urllib.error
 import urllib.request
+import xmlrpc.client
 from pathlib import Path
 
 import cv2
@@ -604,6 +605,33 @@ def test_idle_sessions_of_one_peer_do_not_lock_others_out(minros_core, ros_home)
 WEB_PEER_SHARE = 384
 
 
+def test_a_service_response_with_result_false_answers_as_rosbridge_does(graph):
+    """rosbridge_suite's ROS 1 server hands the client's values to the ROS caller whatever
+    `result` says; minros answered 'client went away'. Values that do not fit fail the call
+    at once (rosbridge leaves the caller waiting for good)."""
+    done = subprocess.run([PYTHON, str(WEB / "roslibpy_client.py"), graph.ws, "refusing_service"],
+                          capture_output=True, text=True, timeout=60, env=graph.env())
+    result = json.loads(done.stdout.split("RESULT ", 1)[1])
+    assert result == {"response": {"sum": 42}}, done.stderr[-2000:]
+
+    with raw_client(graph.ws) as server:
+        server.send(json.dumps({"op": "advertise_service", "service": "/web_bad_answer",
+                                "type": "rospy_tutorials/AddTwoInts"}))
+        caller = Proc([PYTHON, "-m", "minros", "service", "call", "/web_bad_answer",
+                       "{a: 1, b: 2}"], graph.env())
+        request = json.loads(server.recv(timeout=20))
+        assert request["op"] == "call_service" and request["args"] == {"a": 1, "b": 2}
+        started = time.monotonic()
+        server.send(json.dumps({"op": "service_response", "service": "/web_bad_answer",
+                                "id": request["id"], "values": "no can do", "result": False}))
+        status = next_status(server)
+        assert "Expected field values to be one of" in status["msg"]
+        out = caller.read_until("does not fit", timeout=20)
+        assert time.monotonic() - started < 10
+        assert "went away" not in out
+        caller.stop()
+
+
 # -- launch files ---------------------------------------------------------------------------
 
 @pytest.mark.parametrize("package, launch_file, needle", [
@@ -621,6 +649,22 @@ def test_launch_files_start_the_server(minros_core, ros_home, package, launch_fi
             ws.send(json.dumps({"op": "call_service", "service": "/rosapi/nodes", "id": "n"}))
             reply = json.loads(ws.recv(timeout=10))
         assert f"/{needle}" in reply["values"]["nodes"]
+    finally:
+        launch.stop()
+
+
+def test_rosbridge_websocket_sets_actual_port(minros_core, ros_home):
+    """As rosbridge_websocket does: port 0 picks a free port, ~actual_port tells which."""
+    launch = Proc([PYTHON, "-m", "minros", "launch", "rosbridge_server",
+                   "rosbridge_websocket.launch", "port:=0"], ros_env(minros_core, ros_home))
+    try:
+        launch.read_until("listening on", timeout=30)
+        master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{minros_core}/")
+        code, _, port = master.getParam("/test", "/rosbridge_websocket/actual_port")
+        assert code == 1 and isinstance(port, int) and port > 0
+        with raw_client(f"ws://127.0.0.1:{port}") as ws:
+            ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t"}))
+            assert json.loads(ws.recv(timeout=10))["result"] is True
     finally:
         launch.stop()
 

@@ -6,7 +6,8 @@ Used by ``minros web`` (minros.cli.web) and by the executables that roslaunch an
 server reads its settings from private parameters, with rosbridge's and foxglove_bridge's
 names: ``~port``, ``~address``, ``~topics_glob``, ``~services_glob``, ``~params_glob``,
 ``~max_message_size``, ``~unregister_timeout``, ``~use_compression``, plus ``~token`` and
-``~allow_origin`` (``--allow-origin``: one origin, or a list).
+``~allow_origin`` (``--allow-origin``: one origin, or a list). Once listening, the node sets
+``~actual_port`` to the port it got, as rosbridge_websocket does (``~port`` 0 picks a free one).
 """
 
 from __future__ import annotations
@@ -41,6 +42,8 @@ class Settings:
     trace: List[str] = field(default_factory=list)  # wire traces for the page's Wire view
     #: origins of pages from other sites allowed to use the server (--allow-origin)
     allow_origins: List[str] = field(default_factory=list)
+    #: set ~actual_port once listening (the launch-file nodes, as rosbridge_websocket does)
+    set_actual_port: bool = False
 
 
 def parse_globs(value: Any) -> List[str]:
@@ -125,6 +128,8 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
                   "with --port.", file=sys.stderr)
             minros.signal_shutdown("port unavailable")
             return 1
+        if settings.set_actual_port:
+            minros.set_param("~actual_port", server.port)
     state.start()
     if server is not None:
         announce(_banner(server, settings))
@@ -193,5 +198,5 @@ def run_node(default_name: str, default_port: int, server_name: str, serve: bool
         max_message_size=int(max_size) if str(max_size).isdigit() else 64 << 20,
         unregister_timeout=float(param("unregister_timeout", DEFAULT_UNREGISTER_TIMEOUT)),
         compression=bool(param("use_compression", False)), server_name=server_name,
-        server=serve, allow_origins=_origins(allow))
+        server=serve, allow_origins=_origins(allow), set_actual_port=serve)
     return run(settings, announce=minros.loginfo)

@@ -65,7 +65,8 @@ def _check(msg: Dict[str, Any], fields: List[Tuple[bool, str, tuple]]) -> None:
             raise OpError(f"Expected a {name} field but none was found.")
         if name in msg and not isinstance(msg[name], types):
             names = tuple(t.__name__ for t in types)
-            raise OpError(f"Expected field {name} to be one of {names}. Invalid value: {msg[name]}")
+            raise OpError(f"Expected field {name} to be one of {names}. Invalid value: "
+                          f"{str(msg[name])[:200]}")
 
 
 class _Subscription:
@@ -435,10 +436,18 @@ class RosbridgeSession:
                     self.pending.pop(request_id, None)
             if not box:
                 raise minros.ServiceException(f"the rosbridge client serving {name} went away")
+            if isinstance(box[0], Exception):
+                raise minros.ServiceException(f"the rosbridge client serving {name} answered "
+                                              f"with a response that does not fit: {box[0]}")
             return box[0]
         return handle
 
     def service_response(self, msg: Dict[str, Any]) -> None:
+        """The answer of a client serving a ROS service. As rosbridge_suite's ROS 1 server, the
+        ``values`` are the ROS caller's response whatever ``result`` says (its capability never
+        reads ``result``; roslibjs and roslibpy send ``false`` when the handler returned false,
+        with the values it filled). Values that do not fit fail the ROS call at once, naming
+        why, where rosbridge leaves the caller waiting for good."""
         _check(msg, [(True, "service", (str,)), (True, "result", (bool,))])
         name = msg["service"]
         entry = self.services.get(name)
@@ -449,14 +458,15 @@ class RosbridgeSession:
         if waiting is None:
             raise OpError(f"no call of {name} is waiting for a response with id {msg.get('id')!r}")
         done, box = waiting
-        if msg["result"]:
-            response = entry[1]._response_class()
-            try:
-                populate_message(msg.get("values") or {}, response, self.state.now)
-            except ConversionError:
-                done.set()
-                raise
-            box.append(response)
+        response = entry[1]._response_class()
+        try:
+            _check(msg, [(False, "values", (dict, type(None)))])
+            populate_message(msg.get("values") or {}, response, self.state.now)
+        except (OpError, ConversionError) as exc:
+            box.append(exc)
+            done.set()
+            raise
+        box.append(response)
         done.set()
 
     def unadvertise_service(self, msg: Dict[str, Any]) -> None:
