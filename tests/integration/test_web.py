@@ -632,6 +632,100 @@ def test_a_service_response_with_result_false_answers_as_rosbridge_does(graph):
         caller.stop()
 
 
+MANY_TOPICS_PUBLISHER = """
+import sys, time, minros
+from std_msgs.msg import String
+minros.init_node("many_topics", anonymous=True)
+pubs = [minros.Publisher(f"/many/t{i}", String, queue_size=2) for i in range(int(sys.argv[1]))]
+print("ready", flush=True)
+while not minros.is_shutdown():
+    for i, pub in enumerate(pubs):
+        pub.publish(String(f"{sys.argv[2]}:t{i}"))
+    time.sleep(0.2)
+"""
+
+
+def server_threads(pid: int) -> int:
+    with open(f"/proc/{pid}/status") as f:
+        return int(next(line for line in f if line.startswith("Threads:")).split()[1])
+
+
+def test_many_subscriptions_take_no_thread_each(minros_core, ros_home):
+    """A client subscribed to 2,000 topics drove the server to 2,017 threads (one per
+    publisher connection): the web node's subscriptions share one receive thread now. The
+    publisher restarting (a new URI) and dropping its connections are picked up again."""
+    env = ros_env(minros_core, ros_home)
+    count = 120
+    web, port = start_web(minros_core, ros_home)
+    pub = Proc([PYTHON, "-c", MANY_TOPICS_PUBLISHER, str(count), "first"], env)
+    topics = [f"/many/t{i}" for i in range(count)]
+
+    def all_deliver(ws, marker: str) -> None:
+        seen: set = set()
+        deadline = time.monotonic() + 60
+        while len(seen) < count and time.monotonic() < deadline:
+            msg = json.loads(ws.recv(timeout=10))
+            name = msg.get("topic", "").rsplit("/", 1)[-1]
+            if msg.get("op") == "publish" and msg["msg"] == {"data": f"{marker}:{name}"}:
+                seen.add(msg["topic"])
+        assert len(seen) == count, f"{len(seen)} of {count} topics delivered"
+
+    try:
+        pub.read_until("ready", timeout=30)
+        with raw_client(f"ws://127.0.0.1:{port}", max_size=None) as ws:
+            for topic in topics:
+                ws.send(json.dumps({"op": "subscribe", "topic": topic, "type": "std_msgs/String"}))
+            all_deliver(ws, "first")
+            threads = server_threads(web.pid)
+            assert threads < 40, threads  # was one a publisher connection: count + 17
+            info = subprocess.run([PYTHON, "-m", "minros", "node", "info", "/minros_web"],
+                                  env=env, capture_output=True, text=True, timeout=30).stdout
+            assert "/many/t7 [std_msgs/String]" in info and info.count("TCPROS") >= count
+            pub.stop()
+            pub = Proc([PYTHON, "-c", MANY_TOPICS_PUBLISHER, str(count), "second"], env)
+            pub.read_until("ready", timeout=30)
+            all_deliver(ws, "second")
+            assert server_threads(web.pid) < 40
+    finally:
+        pub.stop()
+        out = web.stop()
+    assert "Traceback" not in out
+
+
+def test_foxglove_gets_sim_time_from_the_clock_the_node_itself_follows(minros_core, ros_home):
+    """On simulated time the web node subscribes to /clock itself (as every node), and the
+    Foxglove session's tap shares that Subscriber: it got Clock messages, not bytes, and
+    failed on each ('bad callback'), sending no time."""
+    env = ros_env(minros_core, ros_home)
+    subprocess.run([PYTHON, "-m", "minros", "param", "set", "/use_sim_time", "true"], env=env,
+                   check=True, timeout=30)
+    clock = Proc([PYTHON, "-c", "import time, minros\n"
+                  "from rosgraph_msgs.msg import Clock\n"
+                  "minros.init_node('fake_clock')\n"
+                  "pub = minros.Publisher('/clock', Clock, queue_size=1)\n"
+                  "t = 1000\n"
+                  "while not minros.is_shutdown():\n"
+                  "    t += 1; pub.publish(Clock(clock=minros.Time(t, 5))); time.sleep(0.05)\n"],
+                 env)
+    web, port = start_web(minros_core, ros_home)
+    try:
+        with raw_client(f"ws://127.0.0.1:{port}", subprotocols=["foxglove.websocket.v1"]) as ws:
+            info = json.loads(ws.recv(timeout=10))
+            assert "time" in info["capabilities"]
+            deadline = time.monotonic() + 20
+            stamps = []
+            while len(stamps) < 3 and time.monotonic() < deadline:
+                frame = ws.recv(timeout=10)
+                if isinstance(frame, bytes) and frame[0] == 0x02:
+                    stamps.append(int.from_bytes(frame[1:9], "little"))
+            assert len(stamps) == 3 and all(s % 1_000_000_000 == 5 for s in stamps)
+            assert stamps[0] // 1_000_000_000 > 1000
+    finally:
+        clock.stop()
+        out = web.stop()
+    assert "bad callback" not in out and "Traceback" not in out
+
+
 # -- launch files ---------------------------------------------------------------------------
 
 @pytest.mark.parametrize("package, launch_file, needle", [
