@@ -270,3 +270,38 @@ def test_rosbridge_publisher_queue_is_kept_bounded():
     session.receive(json.dumps({"op": "advertise", "topic": "/u", "type": "std_msgs/String",
                                 "queue_size": "x"}))
     assert "queue_size" in json.loads(frames(outbox)[-1])["msg"]
+
+
+def test_what_one_client_may_hold_is_bounded(monkeypatch):
+    """Subscriptions, advertisements and their ids each cost memory and a master
+    registration: a client asking for a million was served."""
+    from minros.web import foxglove as fx
+    from minros.web import rosbridge as rb
+
+    monkeypatch.setattr(rb, "MAX_PER_CLIENT", 5)
+    monkeypatch.setattr(rb, "MAX_IDS_PER_TOPIC", 3)
+    session, outbox, state = rosbridge()
+    for i in range(6):
+        session.receive(json.dumps({"op": "subscribe", "topic": f"/s{i}", "type": "std_msgs/String"}))
+    assert len(session.subscriptions) == 5
+    assert "the most one client may have" in json.loads(frames(outbox)[-1])["msg"]
+    for i in range(5):
+        session.receive(json.dumps({"op": "subscribe", "topic": "/s0", "id": i,
+                                    "type": "std_msgs/String"}))
+    assert len(session.subscriptions["/s0"].ids) == 3
+    for i in range(6):
+        session.receive(json.dumps({"op": "advertise", "topic": f"/a{i}", "type": "std_msgs/String"}))
+    assert len(session.advertised) == 5
+    assert "advertised topics" in json.loads(frames(outbox)[-1])["msg"]
+
+    monkeypatch.setattr(fx, "MAX_PER_CLIENT", 2)
+    fox, out, _ = foxglove()
+    fox.channels = {1: ("/chatter", "std_msgs/String")}
+    fox.receive(json.dumps({"op": "subscribe", "subscriptions": [
+        {"id": i, "channelId": 1} for i in range(4)]}))
+    assert len(fox.subscriptions) == 2
+    fox.receive(json.dumps({"op": "advertise", "channels": [
+        {"id": i, "topic": f"/c{i}", "encoding": "ros1", "schemaName": "std_msgs/String"}
+        for i in range(3)]}))
+    assert len(fox.client_channels) == 2
+    assert sum("the most one client may" in f for f in frames(out)) == 3

@@ -26,6 +26,9 @@ CAPABILITIES = ["clientPublish", "parameters", "parametersSubscribe", "services"
 QUEUE_LENGTH = 10
 QUEUE_BYTES = 32 << 20
 MAX_CALLS_IN_FLIGHT = 16
+#: subscriptions and advertised channels one client may hold (each costs memory; a channel
+#: a publisher and a master registration)
+MAX_PER_CLIENT = 10_000
 
 
 def _graph_maps(graph: Graph) -> Tuple[Dict[str, Set[str]], ...]:
@@ -224,6 +227,10 @@ class FoxgloveSession:
                 if sub_id in self.subscriptions:
                     self.error(f"Client subscription id {sub_id} was already used; ignoring subscription")
                     continue
+                if len(self.subscriptions) >= MAX_PER_CLIENT:
+                    self.error(f"this client has {MAX_PER_CLIENT} subscriptions already, the "
+                               f"most one client may have; ignoring subscription {sub_id}")
+                    continue
                 channel = self.channels.get(channel_id)
                 if channel is None:
                     self.error(f"Channel {channel_id} is not available; ignoring subscription")
@@ -274,6 +281,10 @@ class FoxgloveSession:
                 continue
             if channel_id in self.client_channels:
                 self.error(f"Client channel {channel_id} was already advertised")
+                continue
+            if len(self.client_channels) >= MAX_PER_CLIENT:
+                self.error(f"this client advertised {MAX_PER_CLIENT} channels already, the most "
+                           f"one client may; ignoring channel {channel_id}")
                 continue
             if not self.state.topic_allowed(topic):
                 self.error(f"topic {topic} is not in the server's topics_glob")

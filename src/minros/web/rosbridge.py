@@ -33,6 +33,11 @@ MAX_QUEUE_BYTES = 32 << 20
 MAX_CALLS_IN_FLIGHT = 16
 #: the largest publisher queue a client may ask for
 MAX_PUBLISH_QUEUE = 1000
+#: topics one client may subscribe to, topics and services it may advertise (2,000 is a
+#: busy robot; each costs memory and a master registration)
+MAX_PER_CLIENT = 10_000
+#: ids of one client's subscriptions or advertisements of one topic
+MAX_IDS_PER_TOPIC = 1_000
 #: how long a ROS caller waits for a client that advertised a service
 SERVICE_RESPONSE_TIMEOUT = 60.0
 MAX_FRAGMENTED_MESSAGES = 64
@@ -47,6 +52,15 @@ MAX_JSON_DEPTH = sys.getrecursionlimit()
 
 class OpError(Exception):
     """A client op that cannot be carried out; the text is what rosbridge would log."""
+
+
+def _bounded(what: str, held: Any, key: Any, limit: int = 0) -> None:
+    """OpError when a client adding ``key`` to ``held`` would hold more than ``limit`` (each
+    costs the server memory, and a registration with the master)."""
+    limit = limit or MAX_PER_CLIENT
+    if key not in held and len(held) >= limit:
+        raise OpError(f"this client has {len(held)} {what} already, the most one client may "
+                      "have: remove some first")
 
 
 def _queue_size(msg: Dict[str, Any]) -> int:
@@ -220,6 +234,9 @@ class RosbridgeSession:
         topic = minros.resolve_name(msg["topic"])
         self._allowed(topic)
         cls = self._established_class(topic, msg["type"])
+        ids = self.advertised.get(topic, set())
+        _bounded("advertised topics", self.advertised, topic)
+        _bounded(f"advertisements of {topic}", ids, msg.get("id"), MAX_IDS_PER_TOPIC)
         self.state.acquire_publisher(self, topic, cls, latch=bool(msg.get("latch", False)),
                                      queue_size=_queue_size(msg))
         self.advertised.setdefault(topic, set()).add(msg.get("id"))
@@ -273,6 +290,9 @@ class RosbridgeSession:
             self.log("warning", "png compression is not supported; sending plain JSON", msg.get("id"))
         sub = self.subscriptions.get(topic)
         first = sub is None
+        _bounded("subscribed topics", self.subscriptions, topic)
+        if not first:
+            _bounded(f"subscriptions to {topic}", sub.ids, msg.get("id"), MAX_IDS_PER_TOPIC)
         if first:
             sub = self.subscriptions[topic] = _Subscription()
         sub.ids[msg.get("id")] = {
@@ -410,6 +430,7 @@ class RosbridgeSession:
             srv = get_service_class(msg["type"])
         except Exception as exc:
             raise OpError(f"Unable to load the service type {msg['type']}: {exc}") from None
+        _bounded("advertised services", self.services, name)
         if name in self.services:
             self.log("warning", f"Duplicate service advertised. Overwriting {name}.")
             self.services.pop(name)[0].shutdown("Duplicate advertiser.")
