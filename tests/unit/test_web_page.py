@@ -266,7 +266,7 @@ def replies(outbox: Outbox) -> list:
             return out
         slot, item = got
         frames = item if slot is None else slot.render(item)
-        for frame in frames if isinstance(frames, list) else [frames]:
+        for frame in [frames] if isinstance(frames, (str, bytes)) else frames:
             out.append(json.loads(frame))
 
 
