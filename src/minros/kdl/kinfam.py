@@ -439,7 +439,16 @@ def _pose_kernel(joint: Joint, tip: Tuple[float, ...]) -> Callable[[float], Tupl
     ux, uy, uz = joint._axis
     if kind == 0:
         def rot_axis(q: float) -> Tuple[float, ...]:
-            a0, a1, a2, a3, a4, a5, a6, a7, a8 = _rot2((ux, uy, uz), scale * q + offset)
+            # Rot2(axis, angle) written out (frames._rot2, the same operations)
+            angle = scale * q + offset
+            ct, st = _cos(angle), _sin(angle)
+            vt = 1 - ct
+            vx, vy, vz = vt * ux, vt * uy, vt * uz
+            sx, sy, sz = ux * st, uy * st, uz * st
+            vxy, vxz, vyz = vx * uy, vx * uz, vy * uz
+            a0, a1, a2 = ct + vx * ux, -sz + vxy, sy + vxz
+            a3, a4, a5 = sz + vxy, ct + vy * uy, -sx + vyz
+            a6, a7, a8 = -sy + vxz, sx + vyz, ct + vz * uz
             return (a0 * t0 + a1 * t3 + a2 * t6, a0 * t1 + a1 * t4 + a2 * t7,
                     a0 * t2 + a1 * t5 + a2 * t8, a3 * t0 + a4 * t3 + a5 * t6,
                     a3 * t1 + a4 * t4 + a5 * t7, a3 * t2 + a4 * t5 + a5 * t8,
