@@ -596,9 +596,13 @@ class Chain:
     def getSegment(self, nr: int) -> Segment:  # noqa: N802
         """A copy of segment ``nr``."""
         n = len(self._segments)
-        if not isinstance(nr, int) or not 0 <= nr < n:
+        try:
+            i = nr.__index__()
+        except AttributeError:
+            raise TypeError(f"getSegment takes a segment number, got {type(nr).__name__}") from None
+        if not 0 <= i < n:
             raise IndexError(f"getSegment({nr!r}): the chain has {n} segments (0..{n - 1})")
-        return _copy_segment(self._segments[nr])
+        return _copy_segment(self._segments[i])
 
     def __repr__(self) -> str:
         return "[" + "".join(f"{s!r}\n" for s in self._segments) + "]"
