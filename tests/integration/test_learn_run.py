@@ -321,3 +321,22 @@ def test_the_zenoh_variant_is_refused_in_one_line(tmp_path):
     assert done.returncode == 1 and done.stderr.count("\n") == 1
     assert "minros zenoh does not exist yet" in done.stderr and "--via relay" in done.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_a_process_that_fails_to_start_is_named_and_the_others_are_stopped(tmp_path):
+    from minros.learn.model import Exercise, Process
+    from minros.learn.session import LearnError, Runner
+
+    broken = Exercise(
+        99, "broken", "A broken exercise", 1, "nothing", task="", answer_form="",
+        check=lambda attempt: None,
+        variants={"": (Process("master", ("minros", "core", "-p", "{port}"), ready=("master",)),
+                       Process("talker", ("minros.learn.actors", "no_such_role"),
+                               ready=("registerPublisher", "/chatter")))})
+    runner = Runner(broken, tmp_path)
+    with pytest.raises(LearnError, match=r"talker ended \(status 2\) before it was ready: .*"
+                                         r"invalid choice: 'no_such_role'"):
+        runner.start()
+    master = runner.procs["master"]
+    assert master.poll() is not None  # stopped, not left behind
+    assert json.loads((runner.folder / "state.json").read_text())["running"] is False

@@ -398,3 +398,14 @@ def test_the_command_lists_and_refuses_in_one_line(tmp_path, capsys):
     assert "there is no exercise 42" in capsys.readouterr().err
     assert learn_cli.main(["check", "one"]) == 1
     assert "not an exercise number" in capsys.readouterr().err
+
+
+def test_an_exercise_left_running_stops_by_itself(tmp_path):
+    import threading
+
+    from minros.learn.session import Runner
+
+    said: List[str] = []
+    runner = Runner(learn.exercise(1), tmp_path, say=said.append)
+    runner.wait(threading.Event(), poll=0.01, limit=0.05)
+    assert len(said) == 1 and "stopping after" in said[0]

@@ -35,6 +35,9 @@ __all__ = ["LearnError", "Runner", "default_base", "folder_for", "load_attempt",
 STATE = "state.json"
 #: how long one process may take to be ready (a cold start imports the message system)
 READY_TIMEOUT = 30.0
+#: an exercise left running stops after this long (its nodes' traces keep growing: every
+#: node probes its master once a second)
+RUN_LIMIT = 3600.0
 STOP_GRACE = (("SIGINT", 5.0), ("SIGTERM", 3.0), ("SIGKILL", 3.0))
 
 
@@ -273,10 +276,15 @@ class Runner:
 
     # -- while it runs
 
-    def wait(self, stop: threading.Event, poll: float = 0.5) -> None:
-        """Until ``stop`` is set, saying once when a process ends (the learner may end one
-        on purpose: exercise 10 kills the master)."""
+    def wait(self, stop: threading.Event, poll: float = 0.5, limit: float = RUN_LIMIT) -> None:
+        """Until ``stop`` is set or ``limit`` seconds have passed, saying once when a process
+        ends (the learner may end one on purpose: exercise 10 kills the master)."""
+        deadline = time.monotonic() + limit
         while not stop.wait(poll):
+            if time.monotonic() > deadline:
+                self.say(f"minros learn: stopping after {limit / 60:g} minutes (an exercise "
+                         "takes five; start it again with the same command)")
+                return
             for name, proc in self.procs.items():
                 if name not in self.reported and proc.poll() is not None:
                     self.reported.add(name)

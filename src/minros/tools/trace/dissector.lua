@@ -414,12 +414,18 @@ function proto.init()
   definitions = {}
 end
 
+local tcp_stream = Field.new("tcp.stream")
+
 local function endpoint(address, port) return tostring(address) .. ":" .. port end
 
+--- the state of this packet's connection (Wireshark's TCP stream: a port pair used again
+--- later is another stream), and which side sent the packet
 local function conn_of(pinfo)
   local a = endpoint(pinfo.src, pinfo.src_port)
   local b = endpoint(pinfo.dst, pinfo.dst_port)
-  local key = a < b and (a .. " " .. b) or (b .. " " .. a)
+  local stream = tcp_stream()
+  local key = (stream and tostring(stream.value) or "") .. " "
+    .. (a < b and (a .. " " .. b) or (b .. " " .. a))
   local conn = conns[key]
   if conn == nil then
     conn = {sides = {}, client = nil}
@@ -651,7 +657,7 @@ local function looks_like_header(tvb)
   return count > 0 and (pos == stop or pos >= captured)
 end
 
-local tcp_seq = Field.new("tcp.seq")
+local tcp_seq = Field.new("tcp.seq")  -- relative: 1 is a stream's first byte
 
 local function heuristic(tvb, pinfo, tree)
   local seq = tcp_seq()
