@@ -143,29 +143,51 @@ class Outlet:
 
 class Inlet:
     """A topic carried from Zenoh to ROS: a Zenoh subscriber and a local publisher with the
-    remote type, md5sum and (when a minros bridge told it) definition and latching."""
+    remote type, md5sum and (when a minros bridge told it) definition and latching.
 
-    def __init__(self, bridge: Bridge, topic: Topic, record: Optional[meta.TopicMeta]) -> None:
+    The Zenoh subscriber comes first and keeps the last sample that arrives before the
+    publisher exists, then the publishing bridge is asked for its record: a latched message
+    sent while this inlet was being made is not lost either way."""
+
+    def __init__(self, bridge: Bridge, topic: Topic) -> None:
         name, type_name, md5 = topic
         self.bridge = bridge
         self.topic = topic
         self.key = keys.data_key(name, type_name, md5, bridge.options.namespace)
-        self.record = record
-        definition = (record.definition if record and record.definition
-                      else bridge.graph.installed_definition(type_name, md5))
-        self.definition = definition
-        self.latching = bool(record and record.latching)
-        self.cls = raw_class(type_name, md5, definition)
-        self.check = bridge.checker(type_name, md5, definition, name)
-        self.publisher = minros.Publisher(name, self.cls, latch=self.latching,
-                                          queue_size=QUEUE_SIZE, tcp_nodelay=True)
-        if record is not None and record.latching and record.latched is not None:
-            self._publish(record.latched)
+        self.publisher: Any = None
+        self._early: Optional[Tuple[bytes, str]] = None
+        self._lock = threading.Lock()
         self.subscriber = bridge.session.declare_subscriber(
             self.key, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
+        try:
+            self.record = record = bridge.ask_meta(topic)
+            definition = (record.definition if record and record.definition
+                          else bridge.graph.installed_definition(type_name, md5))
+            self.definition = definition
+            self.latching = bool(record and record.latching)
+            self.cls = raw_class(type_name, md5, definition)
+            self.check = bridge.checker(type_name, md5, definition, name)
+            publisher = minros.Publisher(name, self.cls, latch=self.latching,
+                                         queue_size=QUEUE_SIZE, tcp_nodelay=True)
+        except BaseException:
+            self.subscriber.undeclare()
+            raise
+        if record is not None and record.latching and record.latched is not None:
+            self._send(publisher, record.latched)
+        with self._lock:
+            self.publisher = publisher
+            early, self._early = self._early, None
+        if early is not None:
+            self._publish(*early)
 
     def _on_sample(self, sample: Any) -> None:
-        self._publish(sample.payload.to_bytes(), str(sample.key_expr))
+        data = sample.payload.to_bytes()
+        if self.publisher is None:
+            with self._lock:
+                if self.publisher is None:
+                    self._early = (data, str(sample.key_expr))
+                    return
+        self._publish(data, str(sample.key_expr))
 
     def _publish(self, data: bytes, key: str = "") -> None:
         check = self.check
@@ -177,8 +199,11 @@ class Inlet:
                                  f"dropping samples on {key or self.key} that are not one "
                                  f"{self.topic[1]} ({exc}); this is said once")
                 return
+        self._send(self.publisher, data)
+
+    def _send(self, publisher: Any, data: bytes) -> None:
         try:
-            self.publisher.publish(self.cls(data))
+            publisher.publish(self.cls(data))
         except minros.ROSException:  # unregistered meanwhile (the bridge is removing it)
             pass
 
@@ -440,7 +465,7 @@ class Bridge:
         self._sync("outlet", self.outlets, wanted.outlets, now,
                    lambda t: Outlet(self, t, publishers.get(t)), "ROS -> Zenoh")
         self._sync("inlet", self.inlets, wanted.inlets, now,
-                   lambda t: Inlet(self, t, self._ask_meta(t)), "Zenoh -> ROS")
+                   lambda t: Inlet(self, t), "Zenoh -> ROS")
         self._upgrade_inlets(remote)
         self._sync("queryable", self.queryables, wanted.queryables, now,
                    lambda t: Queryable(self, t), "service ROS -> Zenoh")
@@ -472,7 +497,7 @@ class Bridge:
             self._retry.pop((kind, topic), None)
             self.info(f"bridging {topic[0]} ({topic[1]}) {direction}")
 
-    def _ask_meta(self, topic: Topic) -> Optional[meta.TopicMeta]:
+    def ask_meta(self, topic: Topic) -> Optional[meta.TopicMeta]:
         """The record a minros bridge publishing ``topic`` answers with, or None (no minros
         bridge publishes it, or only zenoh-bridge-ros1 does)."""
         name, type_name, md5 = topic
@@ -502,13 +527,17 @@ class Bridge:
         for topic, inlet in list(self.inlets.items()):
             if inlet.record is not None or topic not in published:
                 continue
-            record = self._ask_meta(topic)
+            record = self.ask_meta(topic)
             if record is None:
                 inlet.record = meta.TopicMeta(topic[1], topic[2])  # asked: no minros peer
                 continue
             if record.latching or (record.definition and not inlet.definition):
+                del self.inlets[topic]
                 inlet.close()
-                self.inlets[topic] = Inlet(self, topic, record)
+                try:
+                    self.inlets[topic] = Inlet(self, topic)
+                except Exception as exc:  # noqa: BLE001 - the next step makes it again
+                    self.once(f"remake {topic} {exc}", f"cannot bridge {topic[0]}: {exc}")
             else:
                 inlet.record = record
 
