@@ -4,6 +4,10 @@ The bridge never deserializes: a subscriber with one of these classes registers 
 type and md5sum (so the master lists them and publishers of another md5sum are refused) and
 keeps each message's bytes in ``_buff``; a publisher with one sends ``_buff`` as it is and
 tells subscribers the definition it was given.
+
+``_keeps_buffer = False``: the bridge is done with a message's bytes when its callback returns
+(Zenoh copies what it is given to put), so a subscriber may receive the next big frame into
+the same buffer instead of allocating one per image.
 """
 
 from __future__ import annotations
@@ -27,7 +31,8 @@ def raw_class(type_name: str, md5sum: str, definition: str = "") -> type:
         if cls is None:
             cls = type("Raw_" + type_name.replace("/", "_"), (minros.AnyMsg,),
                        {"__slots__": (), "_type": type_name, "_md5sum": md5sum,
-                        "_full_text": definition, "_has_header": False})
+                        "_full_text": definition, "_has_header": False,
+                        "_keeps_buffer": False})
             _classes[key] = cls
         return cls
 
