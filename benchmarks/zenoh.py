@@ -399,8 +399,9 @@ def main(argv=None) -> int:
             ("1920x1080 rgb8 frames/s received", "hd", ">= 300"),
             ("new remote topic listed after (s)", "discovery", "<= 1.5"),
             ("remote loss noticed after (s)", "loss", "<= 3.5")]
+    load = os.getloadavg()[0]
     print(f"\nminros zenoh vs TCPROS, median of {args.rounds} interleaved rounds "
-          f"(python {sys.version.split()[0]}, {os.cpu_count()} CPUs)\n")
+          f"(python {sys.version.split()[0]}, {os.cpu_count()} CPUs, load average {load:.1f})\n")
     print(f"{'measure':36} {'TCPROS':>10} {'2 bridges':>10} {'Zenoh floor':>12} {'target':>8}")
     for title, kind, target in rows:
         cells = []

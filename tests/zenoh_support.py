@@ -85,6 +85,7 @@ class Site:
         wait_for_master(self.port)
         self.bridge_args = bridge_args
         self.bridge: Optional[Proc] = None
+        self.banner = ""
         self.start_bridge()
 
     def start(self, argv: List[str], env: Optional[Dict[str, str]] = None) -> Proc:
@@ -95,7 +96,7 @@ class Site:
     def start_bridge(self) -> Proc:
         self.bridge = self.start([PYTHON, "-m", "minros", "zenoh", "--no-multicast-scouting",
                                   *self.bridge_args])
-        self.bridge.read_until("minros zenoh: bridging the master", 20)
+        self.banner = self.bridge.read_until("minros zenoh: bridging the master", 20)
         return self.bridge
 
     def python(self, code: str, *args: str) -> Proc:

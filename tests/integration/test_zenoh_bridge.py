@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from support import PYTHON, ros_env
+from support import PYTHON, ros_env, wait_until
 from zenoh_support import (
     LISTENER,
     SETBOOL_MD5,
@@ -73,7 +73,8 @@ def test_a_talker_is_heard_behind_the_other_bridge_with_its_wire_format(pair, se
         listener = pair.b.python(LISTENER, "chatter_1")
         listener.read_until("I heard hello", 20)
         # what went over Zenoh: String bodies without TCPROS's length prefix
-        assert samples and all(s[4:].startswith(b"hello ") and len(s) == 4 + len(s[4:])
+        wait_until(lambda: len(samples) >= 5, 20, what="5 samples seen by a plain Zenoh app")
+        assert all(s[4:].startswith(b"hello ") and len(s) == 4 + len(s[4:])
                                for s in samples[:5])
         assert _string("hello 3") in samples or any(s == _string(s[4:].decode()) for s in samples)
         # and its beacons: empty samples on the bridge's discovery key, once a second
@@ -277,6 +278,18 @@ def test_emulated_zenoh_bridge_ros1_peer_topics_services_and_loss(pair, session)
         pair.b.bridge.read_until("lost remote pub /rt_6 (std_msgs/String)", 5)
     finally:
         peer.close()
+
+
+def test_a_bridge_in_client_mode_goes_through_the_peer_it_connects_to(pair, tmp_path):
+    from zenoh_support import Site
+
+    client = Site("c", tmp_path, ["--mode", "client", "--connect", pair.endpoint])
+    try:
+        assert "(mode client, namespace *, connecting to" in client.banner
+        pair.a.python(TALKER, "via_client_7", "20")
+        client.python(LISTENER, "via_client_7").read_until("I heard hello", 30)
+    finally:
+        client.close()
 
 
 def test_without_the_extra_the_bridge_says_how_to_get_it_and_keys_still_work(tmp_path):

@@ -185,19 +185,19 @@ class Inlet:
         if self.publisher is None:
             with self._lock:
                 if self.publisher is None:
-                    self._early = (data, str(sample.key_expr))
+                    self._early = (data, sample)
                     return
-        self._publish(data, str(sample.key_expr))
+        self._publish(data, sample)
 
-    def _publish(self, data: bytes, key: str = "") -> None:
+    def _publish(self, data: bytes, sample: Any = None) -> None:
         check = self.check
         if check is not None:
             try:
                 check(data)
             except layout.Malformed as exc:
-                self.bridge.once(f"malformed {key or self.key}",
-                                 f"dropping samples on {key or self.key} that are not one "
-                                 f"{self.topic[1]} ({exc}); this is said once")
+                key = str(sample.key_expr) if sample is not None else self.key
+                self.bridge.once(f"malformed {key}", f"dropping samples on {key} that are not "
+                                 f"one {self.topic[1]} ({exc}); this is said once")
                 return
         self._send(self.publisher, data)
 
