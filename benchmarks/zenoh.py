@@ -375,6 +375,7 @@ def main(argv=None) -> int:
     if args.role:
         ROLES[args.role](args)
         return 0
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # stopped: the finally below cleans up
     home = tempfile.mkdtemp(prefix="zenoh-bench-")
     a, b = Site("a", home), Site("b", home)
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
