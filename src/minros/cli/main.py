@@ -32,6 +32,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
     "learn": ("minros.cli.learn", "exercises on the ROS wire that check themselves"),
+    "zenoh": ("minros.cli.zenoh", "bridge topics and services with Zenoh (zenoh-bridge-ros1's wire)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
