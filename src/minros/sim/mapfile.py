@@ -134,7 +134,7 @@ def read_image(path: str) -> np.ndarray:
         raise MapError(f'failed to open image file "{path}": no such file')
     if os.path.isdir(path):
         raise MapError(f'failed to open image file "{path}": it is a folder')
-    pixels = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    pixels = _quiet_imread(cv2, path)
     if pixels is None or pixels.size == 0:
         raise MapError(f'failed to open image file "{path}": not an image OpenCV can read '
                        "(PGM, PNG, BMP, JPEG, ...) or damaged")
@@ -145,6 +145,19 @@ def read_image(path: str) -> np.ndarray:
     if pixels.shape[0] * pixels.shape[1] > MAX_CELLS:
         raise MapError(f'image file "{path}" is too large ({pixels.shape[1]} x {pixels.shape[0]})')
     return pixels
+
+
+def _quiet_imread(cv2, path: str):
+    """cv2.imread without OpenCV's own log lines on stderr (the MapError says it once)."""
+    logging = getattr(getattr(cv2, "utils", None), "logging", None)
+    if logging is None:
+        return cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    level = logging.getLogLevel()
+    logging.setLogLevel(logging.LOG_LEVEL_SILENT)
+    try:
+        return cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    finally:
+        logging.setLogLevel(level)
 
 
 def occupancy_from_pixels(pixels: np.ndarray, negate: bool, occupied_thresh: float,
