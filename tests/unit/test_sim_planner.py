@@ -149,6 +149,20 @@ def test_the_follower_stops_for_what_the_laser_sees():
     assert not r.stalled and r.x < 1.0 - 0.21 - 0.02  # stopped short of touching
 
 
+def test_a_goal_close_to_a_wall_ahead_is_reached():
+    grid = corridor(20)
+    data = grid.data.copy()
+    data[:, 36:] = 100  # a wall across the corridor at x = 1.8
+    grid = GridMap(data, 0.05)
+    world = World(grid)
+    robot = world.add_robot(Robot("r", 0.3, 0.5, 0.0))
+    goal = (1.8 - 0.105 - 0.04, 0.5)  # the robot's front 4 cm short of the wall
+    follower = planner.Follower(planner.plan(grid, planner.inflate(grid, planner.CostmapParams()),
+                                             (0.3, 0.5), goal), 0.0)
+    assert drive(world, "r", follower, 20.0) == "done"
+    assert math.hypot(robot.x - goal[0], robot.y - goal[1]) <= 0.1 and not robot.stalled
+
+
 @pytest.mark.parametrize("q, problem", [
     ((0.0, 0.0, 0.0, 1.0), None),
     ((0.0, 0.0, 0.7071, 0.7071), None),

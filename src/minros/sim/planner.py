@@ -286,7 +286,7 @@ class Follower:
         v = min(v, max(0.05, 1.2 * goal_distance), self.last_v + p.acc_lim_x * dt)
         w = 2.0 * v * math.sin(alpha) / max(distance, 1e-3)
         w = max(-p.max_vel_theta, min(p.max_vel_theta, w))
-        if obstacles is not None and self._blocked(obstacles, v):
+        if obstacles is not None and self._blocked(obstacles, v, goal_distance):
             self.last_v = 0.0
             return 0.0, 0.0, "blocked"
         self.last_v = v
@@ -325,13 +325,16 @@ class Follower:
         speed = max(p.min_in_place_vel_theta, min(p.max_vel_theta, 1.5 * abs(error)))
         return math.copysign(speed, error)
 
-    def _blocked(self, points: np.ndarray, v: float) -> bool:
-        """Whether a laser point lies in the corridor swept by driving ahead for stop_time."""
+    def _blocked(self, points: np.ndarray, v: float, goal_distance: float) -> bool:
+        """Whether a laser point lies in the corridor swept by driving ahead for stop_time
+        (but not beyond where the robot's front will be at the goal: a wall behind the goal
+        is not in the way)."""
         p = self.params
         if len(points) == 0:
             return False
         half = p.robot_radius + p.safety_margin
         reach = p.robot_radius + p.safety_margin + max(v, 0.05) * p.stop_time
+        reach = min(reach, goal_distance + p.robot_radius + 0.01)
         ahead = (points[:, 0] > 0.0) & (points[:, 0] < reach) & (np.abs(points[:, 1]) < half)
         return bool(ahead.any())
 
