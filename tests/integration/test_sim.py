@@ -9,61 +9,13 @@ from __future__ import annotations
 import json
 import math
 import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from support import EXAMPLES, PYTHON, Proc, free_port, ros_env
-
-HERE = Path(__file__).resolve().parent
-PROBE = str(HERE / "sim_probe.py")
-WATCH = str(HERE / "sim_watch.py")
-SEND_GOAL = str(EXAMPLES / "sim" / "send_goal.py")
-READY = "(minros's teaching version) is ready"
-
-
-class Sim:
-    """A running ``minros sim`` and the environment its clients use."""
-
-    def __init__(self, home: Path, *args: str, env_extra: dict | None = None,
-                 port: int | None = None, wait_for: tuple = ()) -> None:
-        self.port = port or free_port()
-        self.home = home
-        self.env = ros_env(self.port, home, env_extra)
-        self.proc = Proc([PYTHON, "-m", "minros", "sim", *args], self.env)
-        self.startup = ""
-        # the nodes start in parallel: their lines come in any order
-        wanted = list(wait_for or ("Hz steps", READY))
-        deadline = time.monotonic() + 45
-        while any(self.startup.count(n) < wanted.count(n) for n in wanted):
-            self.startup += self.proc.read_until("\n", timeout=max(0.1, deadline - time.monotonic()))
-
-    def run(self, argv, timeout: float = 60, env: dict | None = None,
-            ns: str = "") -> subprocess.CompletedProcess:
-        run_env = dict(env or self.env)
-        if ns:
-            run_env["ROS_NAMESPACE"] = ns
-        return subprocess.run(argv, env=run_env, capture_output=True, text=True, timeout=timeout)
-
-    def python(self, *args: str, timeout: float = 60, ns: str = "") -> subprocess.CompletedProcess:
-        return self.run([PYTHON, *args], timeout=timeout, ns=ns)
-
-    def tool(self, *args: str, timeout: float = 30) -> subprocess.CompletedProcess:
-        return self.run([PYTHON, "-m", "minros", *args], timeout=timeout)
-
-    def ground_truth(self, ns: str = "") -> tuple:
-        prefix = f"/{ns}" if ns else ""
-        out = self.tool("topic", "echo", "-n", "1", f"{prefix}/base_pose_ground_truth/pose/pose/position")
-        values = dict(line.split(": ") for line in out.stdout.splitlines() if ": " in line)
-        return float(values["x"]), float(values["y"])
-
-    def reset(self) -> None:
-        assert self.tool("service", "call", "/reset_positions").returncode == 0
-
-    def stop(self) -> str:
-        return self.proc.stop(timeout=10)
+from sim_support import READY, SEND_GOAL, WATCH, Sim, check_probe, probe
+from support import PYTHON, Proc, free_port, ros_env
 
 
 @pytest.fixture(scope="module")
@@ -75,27 +27,6 @@ def sim(tmp_path_factory):
         yield running
     finally:
         running.stop()
-
-
-def probe(sim: Sim, ns: str = "", python: str = PYTHON, env: dict | None = None) -> dict:
-    result = sim.run([python, PROBE, ns], timeout=60, env=env)
-    assert result.returncode == 0, result.stdout + result.stderr
-    return json.loads(result.stdout.strip().splitlines()[-1])
-
-
-def check_probe(seen: dict, prefix: str = "") -> None:
-    scan = seen["scan"]
-    assert scan["beams"] == 360 and scan["frame"] == prefix + "base_scan"
-    assert scan["angle_min"] == 0.0
-    assert scan["angle_increment"] == pytest.approx(2 * math.pi / 360)
-    assert (scan["range_min"], scan["range_max"]) == pytest.approx((0.12, 3.5))
-    assert seen["odom"] == {"frame": prefix + "odom", "child": prefix + "base_footprint"}
-    assert seen["odom_chain"] == prefix + "odom->" + prefix + "base_footprint"
-    grid = seen["map"]
-    assert (grid["width"], grid["height"], grid["frame"]) == (200, 160, "map")
-    assert grid["resolution"] == pytest.approx(0.05) and grid["occupied"] > 1000
-    assert grid["served_equal"]
-    assert seen["urdf"]
 
 
 def test_topics_frames_and_map_are_turtlebot3s(sim):
@@ -129,6 +60,34 @@ def test_map_saver_writes_what_map_server_serves(sim, tmp_path):
     bad = sim.tool("run", "map_server", "map_saver", "--occ", "10", "--free", "20")
     assert bad.returncode == 1
     assert bad.stderr.strip() == "map_saver: threshold_free must be smaller than threshold_occupied"
+
+
+def test_a_second_map_server_remapped_and_change_map(sim, tmp_path):
+    from minros.sim import mapfile
+    from minros.sim.grid import GridMap
+
+    small = GridMap(np.array([[0, 100], [-1, 0]], np.int8), 0.5, (1.0, 2.0, 0.0))
+    mapfile.save_map(small, str(tmp_path / "small"))
+    server = Proc([PYTHON, "-m", "minros", "run", "map_server", "map_server",
+                   str(tmp_path / "small.yaml"), "map:=/map2", "map_metadata:=/map2_metadata",
+                   "static_map:=/static_map2", "change_map:=/change_map2"], sim.env)
+    try:
+        server.read_until("Read a 2 X 2 map @ 0.500 m/cell", timeout=20)
+        names = sim.tool("node", "list").stdout.split()
+        assert any(n.startswith("/map_server_") for n in names)  # anonymous, as map_server
+        meta = sim.tool("topic", "echo", "-n", "1", "/map2_metadata/width").stdout
+        assert meta.split()[0] == "2"
+        missing = sim.tool("service", "call", "/change_map2", str(tmp_path / "nope.yaml"))
+        assert "result: 1" in missing.stdout  # RESULT_MAP_DOES_NOT_EXIST
+        from minros.sim.world import DEFAULT_WORLD
+
+        changed = sim.tool("service", "call", "/change_map2", DEFAULT_WORLD)
+        assert "result: 0" in changed.stdout
+        width = sim.tool("topic", "echo", "-n", "1", "/map2/info/width").stdout
+        assert width.split()[0] == "200"
+    finally:
+        out = server.stop()
+    assert "Traceback" not in out
 
 
 def test_navigation_goals_in_map_and_odom_frames(sim):
@@ -226,6 +185,39 @@ def test_top_down_view_is_an_image_topic(sim):
     assert int(size) == 600 * 480 * 3
 
 
+def test_print_launch_is_the_launch_minros_sim_runs(tmp_path, ros_home):
+    from minros.launch.loader import Loader
+
+    env = ros_env(free_port(), ros_home)
+    (tmp_path / "my world").mkdir()
+    from minros.sim.world import DEFAULT_WORLD
+
+    world = tmp_path / "my world" / "rooms.yaml"
+    world.write_text(Path(DEFAULT_WORLD).read_text().replace("image: rooms.pgm",
+                                                             f"image: {Path(DEFAULT_WORLD).parent / 'rooms.pgm'}"))
+    done = subprocess.run([PYTHON, "-m", "minros", "sim", str(world), "--robots", "2", "--speed",
+                           "3", "--laser-rate", "5", "--web", "9191", "--print-launch"],
+                          env=env, capture_output=True, text=True, timeout=30, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    config = Loader().load_string(done.stdout, [], "<test>")
+    nodes = {n.resolved_name: n for n in config.nodes}
+    assert set(nodes) == {"/sim", "/map_server", "/tb3_0/move_base", "/tb3_1/move_base",
+                          "/minros_web"}
+    sim_args = nodes["/sim"].args
+    # the world's path survives its space; both robots are placed here, by name
+    assert f"'{world}'" in sim_args and "--clock" in sim_args and "--speed=3.0" in sim_args
+    assert "--laser-rate=5.0" in sim_args
+    assert "--robot=tb3_0=0.0,0.0,0.0" in sim_args and "--robot=tb3_1=0.0,0.5,0.0" in sim_args
+    assert nodes["/sim"].required
+    assert config.params["/use_sim_time"] is True
+    assert config.params["/tb3_1/move_base/global_costmap/robot_base_frame"] == "tb3_1/base_footprint"
+    assert ("map", "/map") in nodes["/tb3_0/move_base"].remap_args
+    assert config.params["/minros_web/port"] == 9191
+    help_text = subprocess.run([PYTHON, "-m", "minros", "sim", "--help"], env=env,
+                               capture_output=True, text=True, timeout=30).stdout
+    assert "--no-nav" in help_text and "--robots N" in help_text
+
+
 def test_bad_world_files_are_one_line(tmp_path, ros_home):
     env = ros_env(free_port(), ros_home)
     missing = subprocess.run([PYTHON, "-m", "minros", "sim", str(tmp_path / "nope.yaml")],
@@ -266,7 +258,7 @@ def test_two_robots_are_namespaced_and_navigate_at_once(tmp_path_factory):
         assert math.hypot(*np.subtract(sim.ground_truth("tb3_1"), (2.0, 0.0))) < 0.12
     finally:
         out = sim.stop()
-    assert "Bump!" not in out
+    assert "Bump!" not in out and "Traceback" not in out
 
 
 def test_simulated_time_as_fast_as_possible(tmp_path_factory):
