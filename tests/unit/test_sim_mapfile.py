@@ -13,6 +13,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from minros.sim import mapfile
 from minros.sim.grid import GridMap
@@ -168,3 +170,21 @@ def test_the_default_world_is_a_valid_map():
     grid, desc = mapfile.load_map(DEFAULT_WORLD)
     assert (grid.width, grid.height, grid.resolution) == (200, 160, 0.05)
     assert set(np.unique(grid.data).tolist()) == {0, 100}
+
+
+@settings(max_examples=150, deadline=None)
+@given(text=st.text(max_size=300), image=st.binary(max_size=200))
+def test_any_yaml_or_image_file_loads_or_is_one_map_error(tmp_path_factory, text, image):
+    folder = tmp_path_factory.mktemp("fuzz")
+    (folder / "m.png").write_bytes(image)
+    (folder / "m.yaml").write_text(text)
+    for path in (folder / "m.yaml", folder / "good.yaml"):
+        if path.name == "good.yaml":  # a valid description naming the random image
+            path.write_text("image: m.png\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+                            "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+        try:
+            grid, _ = mapfile.load_map(str(path))
+        except mapfile.MapError as exc:
+            assert "\n" not in str(exc)
+        else:
+            assert grid.data.dtype == np.int8 and grid.data.ndim == 2
