@@ -36,8 +36,15 @@ class Sim:
         # the nodes start in parallel: their lines come in any order
         wanted = list(wait_for or ("Hz steps", READY))
         deadline = time.monotonic() + 45
-        while any(self.startup.count(n) < wanted.count(n) for n in wanted):
-            self.startup += self.proc.read_until("\n", timeout=max(0.1, deadline - time.monotonic()))
+        try:
+            while any(self.startup.count(n) < wanted.count(n) for n in wanted):
+                self.startup += self.proc.read_until(
+                    "\n", timeout=max(0.1, deadline - time.monotonic()))
+        except BaseException:
+            # no fixture will stop a simulator that never came up: stop it here
+            rest = self.proc.stop(timeout=10)
+            raise AssertionError(f"minros sim did not start: waited for {wanted}; output:\n"
+                                 f"{self.startup}{rest}") from None
 
     def run(self, argv, timeout: float = 60, env: dict | None = None,
             ns: str = "") -> subprocess.CompletedProcess:
