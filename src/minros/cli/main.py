@@ -31,6 +31,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
+    "learn": ("minros.cli.learn", "exercises on the ROS wire that check themselves"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
