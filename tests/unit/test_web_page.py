@@ -238,8 +238,11 @@ class FakeState:
 
 class FakeHub:
     def __init__(self, wire=None) -> None:
+        from minros.web.scene import SceneHub
+
         self.sessions = []
         self.wire = wire
+        self.scene = SceneHub(state=None)
 
     def add(self, session):
         self.sessions.append(session)
