@@ -146,6 +146,12 @@ class SceneHub:
         if not frame:
             raise TransformException("the message's header.frame_id is empty: set it to a tf "
                                      f"frame (e.g. {fixed})")
+        try:
+            return self._lookup(fixed, frame, stamp)
+        except TransformException as exc:  # say which frames, as Rviz does
+            raise type(exc)(f"No transform from [{frame}] to [{fixed}]: {exc}".strip()) from None
+
+    def _lookup(self, fixed: str, frame: str, stamp: Any) -> Tuple[List[float], str]:
         zero = minros.Time(0, 0)
         if stamp is None or (stamp.secs == 0 and stamp.nsecs == 0):
             return scenedata.transform7(self.buffer.lookup_transform_core(fixed, frame, zero)), ""
@@ -292,7 +298,10 @@ class Display:
                         raise DisplayError(f"marker {marker.ns}/{marker.id}: {_tf_text(found)}")
                     entry.update(frame=marker.header.frame_id.lstrip("/"), T=found[0],
                                  locked=entry["frame_locked"] or (stamp.secs == 0 and stamp.nsecs == 0))
-                    json_text(entry)  # refuses NaN here, for this marker only
+                    try:
+                        json_text(entry)  # refuses NaN here, for this marker only
+                    except DisplayError as exc:
+                        raise DisplayError(f"marker {marker.ns}/{marker.id}: {exc}") from None
                 items.append(entry)
             except DisplayError as exc:
                 problems.append(str(exc))
