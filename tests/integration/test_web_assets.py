@@ -17,13 +17,12 @@ import xmlrpc.client
 from pathlib import Path
 
 import pytest
+from test_web import node_client, start_web
 
 from support import PYTHON, Proc, free_port, ros_env, wait_for_master
 
 WEB = Path(__file__).resolve().parent.parent / "web"
 PKG = WEB / "scene_pkg"
-
-from test_web import node_client, start_web  # noqa: E402  (one definition of the helpers)
 
 
 class System:
