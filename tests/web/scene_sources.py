@@ -5,9 +5,9 @@
 
 --robot       /robot_description (tests/web/scene_pkg's URDF: box, cylinders, sphere, STL, DAE
               and OBJ meshes) and tf: map -> odom (static), odom -> base_footprint (the robot
-              drives a circle of 1 m, 20 Hz), the links (static), and "old_sensor", sent once
-              on /tf (so it goes stale)
---markers     /markers (MarkerArray): every Marker type in a row along y in map (ns "shapes"),
+              drives a circle of 1 m, 20 Hz), the links (static), and map -> "old_sensor", sent
+              on /tf once to each new subscriber (so it goes stale)
+--markers     /markers (MarkerArray): every Marker type in a row along y at x 4 in map (ns "shapes"),
               their names (ns "labels"), a frame-locked arrow on base_link (ns "locked") and a
               sphere with a 1 s lifetime (ns "blink"), sent every 2 s
 --scan HZ     /scan: 360 rays in base_scan, a wobbly circle of 2 m, intensities
@@ -114,7 +114,7 @@ def all_markers() -> MarkerArray:
     rainbow = [ColorRGBA(abs(math.cos(a)), abs(math.sin(a)), 0.5, 1.0) for a in np.linspace(0, 3, 12)]
     for kind, name in enumerate(names):
         y = -3.0 + kind * 0.6
-        m = marker("shapes", kind, kind, 3.0, y)
+        m = marker("shapes", kind, kind, 4.0, y)
         if kind == Marker.ARROW:
             m.scale.x, m.scale.y, m.scale.z = 0.5, 0.08, 0.08
         elif kind in (Marker.LINE_STRIP, Marker.LINE_LIST):
@@ -134,14 +134,14 @@ def all_markers() -> MarkerArray:
                         Point(0, 0, 0), Point(0, 0.3, 0), Point(-0.3, 0, 0)]
             m.scale.x = m.scale.y = m.scale.z = 1.0
         array.markers.append(m)
-        text = marker("labels", kind, Marker.TEXT_VIEW_FACING, 3.6, y, 0.5, scale=(0, 0, 0.12),
+        text = marker("labels", kind, Marker.TEXT_VIEW_FACING, 4.5, y, 0.5, scale=(0, 0, 0.12),
                       color=(1, 1, 1, 1))
         text.text = name
         array.markers.append(text)
     locked = marker("locked", 0, Marker.ARROW, 0, 0, 0.3, frame="base_link", scale=(0.4, 0.05, 0.05),
                     color=(1.0, 0.5, 0.0, 1.0))
     locked.frame_locked = True
-    blink = marker("blink", 0, Marker.SPHERE, 3.0, 4.2, 0.5, color=(1.0, 1.0, 0.0, 1.0))
+    blink = marker("blink", 0, Marker.SPHERE, 4.0, 4.2, 0.5, color=(1.0, 1.0, 0.0, 1.0))
     blink.lifetime = rospy.Duration(1.0)
     array.markers += [locked, blink]
     return array
@@ -220,17 +220,23 @@ def main() -> None:
     rospy.Subscriber("/move_base_simple/goal", PoseStamped, on_goal)
 
     if args.robot:
-        from tf2_ros import StaticTransformBroadcaster, TransformBroadcaster
+        from tf2_msgs.msg import TFMessage
+        from tf2_ros import StaticTransformBroadcaster
 
         rospy.set_param("/robot_description", URDF.read_text())
         static = StaticTransformBroadcaster()
         static.sendTransform([transform("map", "odom", (0, 0, 0))] +
                              [transform(p, c, xyz) for p, c, xyz in LINKS])
-        moving = TransformBroadcaster()
-        moving.sendTransform(transform("map", "old_sensor", (-2, 2, 0.5)))
-        start(0.05, lambda: moving.sendTransform(
-            transform("odom", "base_footprint", robot_pose(time.time())[:2] + (0,),
-                      robot_pose(time.time())[2])))
+
+        class OldSensor(rospy.SubscribeListener):
+            def peer_subscribe(self, topic_name, topic_publish, peer_publish):
+                peer_publish(TFMessage([transform("map", "old_sensor", (-2, 2, 0.5))]))
+        tf_pub = rospy.Publisher("/tf", TFMessage, queue_size=100, subscriber_listener=OldSensor())
+
+        def send_tf():
+            x, y, yaw = robot_pose(time.time())
+            tf_pub.publish(TFMessage([transform("odom", "base_footprint", (x, y, 0), yaw)]))
+        start(0.05, send_tf)
 
     if args.markers:
         markers_pub = rospy.Publisher("/markers", MarkerArray, queue_size=10, latch=True)

@@ -208,6 +208,26 @@ export class Scene3D {
     return this.ray(event).ray.intersectPlane(GROUND, hit) ? hit : null;
   }
 
+  /** Look at `target` from `eye` (points of the fixed frame). */
+  lookAt(target, eye) {
+    this.controls.target.set(...target);
+    this.camera.position.set(...eye);
+    this.controls.update();
+    this.invalidate();
+  }
+
+  /** The colour [r, g, b, a] drawn at page coordinates (x, y): rendered now and read back. */
+  pixel(x, y) {
+    this.renderer.render(this.scene, this.camera);
+    const rect = this.canvas.getBoundingClientRect();
+    const ratio = this.renderer.getPixelRatio();
+    const gl = this.renderer.getContext();
+    const out = new Uint8Array(4);
+    gl.readPixels(Math.round((x - rect.left) * ratio), Math.round((rect.bottom - y) * ratio), 1, 1,
+                  gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return [...out];
+  }
+
   /** Page coordinates of a point of the fixed frame (for tests and labels). */
   project(x, y, z) {
     const v = new THREE.Vector3(x, y, z).project(this.camera);

@@ -297,7 +297,8 @@ export function createView3dView(app) {
     for (const topic of graph.topics) {
       const kind = KINDS[topic.type];
       if (!kind || shown.has(topic.name) || view.removedTopics.has(topic.name) || app.isQuiet(topic.name)) continue;
-      if (!topic.publishers || !topic.publishers.length) continue;
+      // published by someone (not only by this server, as /initialpose after a click)
+      if (!topic.publishers || topic.publishers.every((node) => app.isQuiet(node))) continue;
       addDisplay({kind, topic: topic.name});
     }
     if (!view.displays.some((d) => d.kind === "robot") && !view.removedTopics.has("/robot_description")) {
