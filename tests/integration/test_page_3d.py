@@ -119,7 +119,7 @@ class Page:
     def open(self) -> None:
         self.page.goto(f"http://127.0.0.1:{self.system.web_port}/#3d")
         self.page.wait_for_function("window.minrosPage && minrosPage.conn.state === 'connected' "
-                                    f"&& {V}.scene3d.frames.size > 5", timeout=30_000)
+                                    f"&& {V}.ready && {V}.scene3d.frames.size > 5", timeout=30_000)
 
     def js(self, expression: str, arg=None):
         return self.page.evaluate(expression, arg)

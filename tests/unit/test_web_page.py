@@ -357,7 +357,7 @@ def test_page_files_load_offline_and_ship_in_the_wheel():
         text = path.read_text(encoding="utf-8")
         if path.parent.name not in ("uplot", "dagre"):
             assert not re.search(r"""(src|href|from)\s*=?\s*["']https?://""", text), path
-        refs = re.findall(r"""(?:src|href)="([^"#:]+\.(?:js|css))"|^\s*(?:import|export)\b[^;'"]*?\bfrom\s*["']([^"']+)["']|^\s*import\s*["']([^"']+)["']""",
+        refs = re.findall(r"""(?:src|href)="([^"#:]+\.(?:js|css))"|^\s*(?:import|export)\b[^;'"]*?\bfrom\s*["']([^"']+)["']|^\s*import\s*["']([^"']+)["']|\bimport\(\s*["']([^"']+)["']\s*\)""",
                           text, re.M)
         for ref in refs:
             name = next(r for r in ref if r)
@@ -366,7 +366,7 @@ def test_page_files_load_offline_and_ship_in_the_wheel():
                 assert name in bare or name.startswith("."), f"{path.relative_to(static)} imports {name}"
             assert target.is_file(), f"{path.relative_to(static)} refers to a missing {target}"
             pending.append(target)
-    for needed in ("js/views/console.js", "vendor/uplot/uPlot.esm.js", "js/views/view3d.js",
+    for needed in ("js/views/console.js", "vendor/uplot/uPlot.esm.js", "js/view3d/view.js",
                    "vendor/three/build/three.core.js",
                    "vendor/three/examples/jsm/loaders/collada/ColladaParser.js"):
         assert static / needed in seen, needed

@@ -29,6 +29,9 @@ are pushed:
 ``wire_watch``     the steps of the wire traces the server follows (``--trace``), then what
                    changes, as ``wire`` frames: ``steps`` (added or changed, by ``id``),
                    ``removed`` ids, ``status`` (files, problems); the first has ``reset``
+``scene_watch``,   the 3D view's: tf into a fixed frame, displays of topics and of the robot
+``display_add``,   model, interactive marker feedback (:mod:`minros.web.scene`; clouds, scans
+...                and maps come as binary frames)
 =================  ==========================================================================
 
 The first frame the server sends is ``hello`` (node name, how the graph is read, the debug

@@ -1,363 +1,38 @@
-// 3D: Rviz in the page. A WebGL scene (three.js) in a fixed frame the user picks, an orbit
-// camera (drag: turn, right-drag or shift-drag: pan, wheel: zoom), and displays as Rviz's: Grid,
-// TF, RobotModel, Markers, LaserScan, PointCloud2, Map, Path, Pose, PoseArray, Odometry,
-// Polygon and InteractiveMarkers; the tools "2D Pose Estimate" and "2D Nav Goal".
-//
-// The server does the heavy work (minros/web/scene.py): tf lookups into the fixed frame, clouds
-// and scans made into arrays sent as binary frames, URDFs parsed, meshes served from their
-// packages. Each display has a status line: a display that cannot show its data (an unknown
-// frame, a malformed cloud) says so there, and nothing else stops.
-//
-// The displays and the fixed frame are kept in the browser (localStorage). On a first visit the
-// view adds a display for every topic it can show, and the robot model when /robot_description
-// is set, and keeps adding new ones while "add new topics" is ticked.
+// 3D: Rviz in the page (the view itself is ../view3d/view.js). three.js is 2 MB of modules, so
+// they load when the view is first shown, not with the page; until then the view is this stub,
+// which then takes on the real view's methods and properties (tests read them through it).
 
-import {errorLine, h} from "../ui.js";
-import {Scene3D} from "../view3d/scene.js";
-import {MeshCache} from "../view3d/shapes.js";
-import {
-  GridDisplay, KINDS, MapDisplay, MarkersDisplay, OdometryDisplay, PathDisplay, PointsDisplay,
-  PolygonDisplay, PoseArrayDisplay, PoseDisplay, RobotDisplay, TFDisplay, TITLES,
-} from "../view3d/displays.js";
-import {Dragger, InteractiveMarkersDisplay} from "../view3d/interactive.js";
-import {GroundTool, TOOLS} from "../view3d/tools.js";
-
-const STORAGE_KEY = "minros.view3d.v1";
-const CLASSES = {
-  grid3d: GridDisplay, tf: TFDisplay, robot: RobotDisplay, markers: MarkersDisplay,
-  scan: PointsDisplay, cloud: PointsDisplay, grid: MapDisplay, path: PathDisplay, pose: PoseDisplay,
-  pose_array: PoseArrayDisplay, odometry: OdometryDisplay, polygon: PolygonDisplay,
-  imarkers: InteractiveMarkersDisplay,
-};
-const LOCAL_KINDS = new Set(["grid3d", "tf"]);
-
-function load() {
-  try {
-    return JSON.parse(localStorage.getItem(STORAGE_KEY) || "null");
-  } catch (err) {
-    return null;
-  }
-}
+import {h} from "../ui.js";
 
 export function createView3dView(app) {
-  const stage = h("div", {class: "view3d-stage"});
-  const fixedInput = h("input", {type: "text", list: "view3d-frames", class: "view3d-fixed",
-                                 "aria-label": "fixed frame", title: "the frame the scene is drawn in"});
-  const fixedStatus = h("div", {class: "view3d-fixed-status muted"});
-  const fpsLabel = h("span", {class: "muted view3d-fps"});
-  const noteLine = h("div", {class: "view3d-note muted"});
-  const error = errorLine();
-  const list = h("div", {class: "view3d-displays"});
-  const addSelect = h("select", {class: "view3d-add", "aria-label": "topic to add"});
-  const autoAdd = h("input", {type: "checkbox"});
-  const toolButtons = {};
-  const toolbar = h("div", {class: "toolbar view3d-toolbar"},
-    ...[["interact", "Interact", "drag a marker; drag the view to turn, right-drag to pan, wheel to zoom"],
-        ...Object.entries(TOOLS).map(([key, spec]) => [key, spec.title, `press where, drag towards the heading: ${spec.type} on ${spec.topic}`])]
-      .map(([key, title, tip]) => (toolButtons[key] = h("button", {class: "tool", "data-tool": key, title: tip,
-                                                                   onclick: () => view.setTool(key)}, title))),
-    h("button", {onclick: () => scene3d.resetCamera(), title: "back to the default view"}, "Reset view"),
-    fpsLabel);
-  const side = h("div", {class: "view3d-side"},
-    h("h4", {}, "Global options"),
-    h("label", {class: "field-inline"}, "Fixed frame ", fixedInput),
-    fixedStatus,
-    h("h4", {}, "Displays"),
-    list,
-    h("div", {class: "row view3d-add-row"}, addSelect,
-      h("button", {onclick: () => addChosen()}, "Add")),
-    h("label", {class: "muted"}, autoAdd, " add new topics as they appear"),
-    error, noteLine);
-  const el = h("section", {}, toolbar, h("div", {class: "view3d-layout"}, side, stage));
-  const scene3d = new Scene3D(stage);
-
-  const saved = load();
+  const el = h("section", {}, h("p", {class: "muted"}, "Loading the 3D view…"));
+  let loading = null;
   const view = {
-    app, scene3d, displays: [], tool: "interact", published: [], nextId: 1,
-    fixedChosen: Boolean(saved && saved.fixed), removedTopics: new Set(saved ? saved.removed || [] : []),
-    meshes: new MeshCache(() => scene3d.invalidate()),
-    displaysChanged: () => renderList(),
-    setTool(tool) {
-      view.tool = tool;
-      for (const [key, button] of Object.entries(toolButtons)) button.classList.toggle("active", key === tool);
-      scene3d.canvas.style.cursor = tool === "interact" ? "" : "crosshair";
+    id: "3d", el, ready: false,
+    show() {
+      load().then((real) => real && real.show());
     },
-    note(text) {
-      noteLine.textContent = text;
+    hide() {},
+    open(args) {
+      load().then((real) => real && real.open(args));
     },
   };
-  new Dragger(view);
-  new GroundTool(view);
-  view.setTool("interact");
-  autoAdd.checked = saved ? saved.autoAdd !== false : true;
-  autoAdd.addEventListener("change", () => { save(); if (autoAdd.checked) autoAddTopics(app.graph); });
-  let fixed = (saved && saved.fixed) || "map";
-  fixedInput.value = fixed;
-  fixedInput.addEventListener("change", () => {
-    const name = fixedInput.value.trim().replace(/^\//, "");
-    if (name) {
-      view.fixedChosen = true;
-      setFixed(name);
-    }
-  });
 
-  // -- the connection --------------------------------------------------------------------
-
-  function watch() {
-    app.conn.request("scene_watch", {fixed}).catch((err) => error.show(`scene_watch: ${err.message}`));
-  }
-
-  function setFixed(name) {
-    fixed = name;
-    fixedInput.value = name;
-    save();
-    if (app.conn.state === "connected") watch();
-  }
-
-  app.conn.on("scene_frames", (msg) => {
-    if (msg.fixed !== fixed) return;  // an answer to an older choice
-    scene3d.setFrames(msg);
-    for (const display of view.displays) display.framesChanged();
-    const names = msg.frames.map((f) => f.name);
-    let datalist = document.getElementById("view3d-frames");
-    if (!datalist) document.body.append(datalist = h("datalist", {id: "view3d-frames"}));
-    if (datalist.dataset.names !== names.join("\n")) {
-      datalist.dataset.names = names.join("\n");
-      datalist.replaceChildren(...names.map((n) => h("option", {value: n})));
-    }
-    if (msg.error && !view.fixedChosen) {  // no such frame, and nobody chose it: pick one
-      const parents = new Set(msg.frames.map((f) => f.name));
-      const pick = ["map", "odom", "world"].find((n) => parents.has(n) && n !== fixed) ||
-        (msg.frames.find((f) => !f.parent && f.name !== fixed) || {}).name;
-      if (pick) {
-        setFixed(pick);
-        return;
-      }
-    }
-    fixedStatus.textContent = msg.error || msg.warning || `${msg.frames.length} frames`;
-    fixedStatus.className = "view3d-fixed-status " + (msg.error ? "error" : "muted");
-  });
-  app.conn.on("scene_data", (msg) => {
-    const display = view.displays.find((d) => d.id === msg.id);
-    if (display && display.enabled) {
-      try {
-        display.data(msg);
-      } catch (err) {
-        display.setLocal("data", "error", `cannot draw the message: ${err.message}`);
+  function load() {
+    if (!loading) {
+      loading = import("../view3d/view.js").then(({createView}) => {
+        const real = createView(app, el);
+        Object.defineProperties(view, Object.getOwnPropertyDescriptors(real));
+        view.ready = true;
+        return real;
+      }).catch((err) => {
+        el.replaceChildren(h("div", {class: "error-line visible"},
+          `The 3D view could not load: ${err.message}. It needs a browser with WebGL 2.`));
         console.warn(err);
-      }
-    }
-  });
-  app.conn.on("scene_status", (msg) => {
-    const display = view.displays.find((d) => d.id === msg.id);
-    if (display) display.setServerStatus(msg.level, msg.text);
-  });
-  app.conn.onOpen(() => {
-    watch();
-    for (const display of view.displays) if (display.enabled) subscribe(display);
-  });
-
-  function subscribe(display) {
-    if (!display.remote || app.conn.state !== "connected") return;
-    const fields = display.kind === "robot" ? {kind: "robot", param: display.param} : {topic: display.topic};
-    app.conn.request("display_add", {id: display.id, ...fields})
-      .catch((err) => display.setServerStatus("error", err.message));
-  }
-
-  function unsubscribe(display) {
-    if (display.remote) app.conn.send({op: "display_remove", id: display.id});
-  }
-
-  // -- displays --------------------------------------------------------------------------
-
-  function addDisplay(config) {
-    const Class = CLASSES[config.kind];
-    if (!Class) return null;
-    const display = new Class(view, {...config, id: `d${view.nextId++}`});
-    display.onStatus = () => updateStatus(display);
-    view.displays.push(display);
-    if (display.enabled) subscribe(display);
-    if (config.topic) view.removedTopics.delete(config.topic);
-    renderList();
-    save();
-    return display;
-  }
-
-  function removeDisplay(display) {
-    unsubscribe(display);
-    display.dispose();
-    view.displays = view.displays.filter((d) => d !== display);
-    if (display.topic || display.kind === "robot") view.removedTopics.add(display.topic || display.param);
-    renderList();
-    save();
-  }
-
-  function setEnabled(display, on) {
-    display.setEnabled(on);
-    if (on) subscribe(display);
-    else {
-      unsubscribe(display);
-      display.clear();
-      display.received = 0;
-      display.setServerStatus("", "");
-    }
-    save();
-  }
-
-  function save() {
-    try {
-      localStorage.setItem(STORAGE_KEY, JSON.stringify({
-        fixed: view.fixedChosen ? fixed : undefined, autoAdd: autoAdd.checked,
-        displays: view.displays.map((d) => d.config()), removed: [...view.removedTopics]}));
-    } catch (err) {
-      // storage full or disabled: the view works, it is just not remembered
-    }
-  }
-
-  function updateStatus(display) {
-    const row = list.querySelector(`[data-display="${display.id}"]`);
-    if (!row) return;
-    const {level, text} = display.status;
-    const status = row.querySelector(".display-status");
-    status.className = "display-status " + (level || "none");
-    status.textContent = text;
-    row.querySelector(".status-dot").title = {ok: "OK", warn: "warning", error: "error"}[level] || "no data yet";
-    row.dataset.level = level || "none";
-  }
-
-  const openRows = new Set();
-
-  function renderList() {
-    list.replaceChildren(...view.displays.map((display) => {
-      const fields = display.constructor.fields.map(([key, title, type, attrs]) => {
-        const input = h("input", {type, ...(attrs || {}), "data-option": key});
-        if (type === "checkbox") input.checked = Boolean(display.options[key]);
-        else input.value = display.options[key];
-        input.addEventListener("change", () => {
-          display.setOption(key, type === "checkbox" ? input.checked : type === "number" ? Number(input.value) : input.value);
-          save();
-        });
-        return h("label", {class: "display-option"}, title, " ", input);
+        return null;
       });
-      const namespaces = display.namespaces ? [...display.namespaces.keys()].sort().map((ns) => {
-        const box = h("input", {type: "checkbox", checked: !display.hiddenNs.has(ns)});
-        box.addEventListener("change", () => { display.setNamespace(ns, box.checked); save(); });
-        return h("label", {class: "display-option"}, box, " ", ns || "(no namespace)");
-      }) : [];
-      const enabled = h("input", {type: "checkbox", checked: display.enabled, "aria-label": "shown"});
-      enabled.addEventListener("change", () => setEnabled(display, enabled.checked));
-      const more = fields.length || namespaces.length ? h("details", {class: "display-more", open: openRows.has(display.id)},
-        h("summary", {}, "options"), h("div", {class: "display-options"}, ...fields,
-          namespaces.length ? h("div", {class: "muted display-ns"}, "namespaces") : null, ...namespaces)) : null;
-      if (more) more.addEventListener("toggle", () => { if (more.open) openRows.add(display.id); else openRows.delete(display.id); });
-      const row = h("div", {class: "display-row", "data-display": display.id, "data-kind": display.kind},
-        h("div", {class: "display-head"},
-          enabled, h("span", {class: "status-dot", title: "status"}), h("b", {}, display.title), h("span", {class: "muted display-source", title: display.source}, display.source),
-          h("button", {class: "small remove", title: "remove this display", onclick: () => removeDisplay(display)}, "×")),
-        h("div", {class: "display-status"}), more);
-      return row;
-    }));
-    for (const display of view.displays) updateStatus(display);
-    renderAddChoices();
-  }
-
-  function renderAddChoices() {
-    const shown = new Set(view.displays.map((d) => d.topic).filter(Boolean));
-    const options = [h("option", {value: ""}, "add a display…")];
-    for (const kind of ["grid3d", "tf", "robot"]) {
-      if (!view.displays.some((d) => d.kind === kind)) options.push(h("option", {value: "kind:" + kind}, TITLES[kind]));
     }
-    for (const topic of app.graph.topics) {
-      const kind = KINDS[topic.type];
-      if (kind && !shown.has(topic.name)) options.push(h("option", {value: "topic:" + topic.name}, `${topic.name} (${TITLES[kind]})`));
-    }
-    addSelect.replaceChildren(...options);
+    return loading;
   }
-
-  function addChosen() {
-    const value = addSelect.value;
-    if (value.startsWith("kind:")) addDisplay({kind: value.slice(5)});
-    else if (value.startsWith("topic:")) addTopic(value.slice(6));
-  }
-
-  function addTopic(topic) {
-    const type = app.topicType(topic);
-    const kind = KINDS[type];
-    if (!kind) {
-      error.show(`${topic} is a ${type || "topic of unknown type"}: the 3D view shows ${Object.keys(KINDS).join(", ")}`);
-      return null;
-    }
-    error.show("");
-    return addDisplay({kind, topic});
-  }
-
-  async function autoAddTopics(graph) {
-    if (!autoAdd.checked) return;
-    const shown = new Set(view.displays.map((d) => d.topic).filter(Boolean));
-    for (const topic of graph.topics) {
-      const kind = KINDS[topic.type];
-      if (!kind || shown.has(topic.name) || view.removedTopics.has(topic.name) || app.isQuiet(topic.name)) continue;
-      // published by someone (not only by this server, as /initialpose after a click)
-      if (!topic.publishers || topic.publishers.every((node) => app.isQuiet(node))) continue;
-      addDisplay({kind, topic: topic.name});
-    }
-    if (!view.displays.some((d) => d.kind === "robot") && !view.removedTopics.has("/robot_description")) {
-      try {
-        const reply = await app.conn.rosapi("has_param", {name: "/robot_description"});
-        if (reply.exists && !view.displays.some((d) => d.kind === "robot")) addDisplay({kind: "robot"});
-      } catch (err) {
-        // rosapi not served: the robot model is added by hand
-      }
-    }
-  }
-
-  app.onGraph((graph) => {
-    renderAddChoices();
-    autoAddTopics(graph);
-  });
-
-  // -- the first displays ----------------------------------------------------------------
-
-  if (saved && Array.isArray(saved.displays)) {
-    for (const config of saved.displays) addDisplay(config);
-  } else {
-    addDisplay({kind: "grid3d"});
-    addDisplay({kind: "tf"});
-  }
-
-  // lifetimes, and the frames-per-second line
-  scene3d.beforeRender.add((now) => {
-    for (const display of view.displays) display.tick(now);
-  });
-  setInterval(() => {
-    if (!scene3d.visible) return;
-    const points = view.displays.reduce((n, d) => n + (d.count || 0), 0);
-    fpsLabel.textContent = `${scene3d.stats.fps} fps` + (points ? ` · ${points.toLocaleString()} points` : "");
-  }, 1000);
-
-  Object.assign(view, {
-    id: "3d", el,
-    show() {
-      scene3d.show();
-    },
-    hide() {
-      scene3d.hide();
-    },
-    open(args) {
-      if (args.fixed) {
-        view.fixedChosen = true;
-        setFixed(args.fixed);
-      }
-      if (args.topic) addTopic(args.topic);
-    },
-    addDisplay, addTopic, removeDisplay, setEnabled, setFixed: (name) => { view.fixedChosen = true; setFixed(name); },
-    get fixed() { return fixed; },
-    /** What a test reads: each display's kind, source, status and counts. */
-    summary() {
-      return view.displays.map((d) => ({id: d.id, kind: d.kind, source: d.source, enabled: d.enabled,
-                                        received: d.received, count: d.count || 0,
-                                        markers: d.markers ? d.markers.size : undefined, ...d.status}));
-    },
-  });
   return view;
 }
