@@ -10,9 +10,9 @@ read back from WebGL, the statuses in the display list) and saves a screenshot
 ``MINROS_SCREENSHOTS=docs/screenshots``).
 
 The performance test publishes a PointCloud2 of 100,000 points at 10 Hz and measures, in the
-page, the frames drawn per second while the camera turns and the clouds that arrive per second,
-for ``MINROS_3D_SECONDS`` (10 by default); it prints them and writes view3d-perf.json beside
-the screenshots.
+page, the frames drawn and the clouds taken per second, with the camera still and then turning,
+for ``MINROS_3D_SECONDS`` (20 by default, half each); it prints them and writes
+view3d-perf.json beside the screenshots.
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import re
 import time
 from pathlib import Path
 
@@ -29,17 +28,19 @@ import pytest
 from support import (
     CHROMIUM,
     PYTHON,
+    REFERENCE_PYTHON,
     Proc,
     free_port,
     launch_chromium,
     need,
+    reference_env,
+    require_reference,
     ros_env,
     wait_for_master,
-    wait_until,
 )
 
 WEB = Path(__file__).resolve().parent.parent / "web"
-PERF_SECONDS = float(os.environ.get("MINROS_3D_SECONDS", "10"))
+PERF_SECONDS = float(os.environ.get("MINROS_3D_SECONDS", "20"))
 V = "minrosPage.view('3d')"
 
 try:
@@ -65,8 +66,8 @@ class System:
     def env(self) -> dict:
         return ros_env(self.port, self.home, {"ROS_PACKAGE_PATH": str(WEB)})
 
-    def start(self, argv: list) -> Proc:
-        proc = Proc(argv, self.env())
+    def start(self, argv: list, reference: bool = False) -> Proc:
+        proc = Proc(argv, reference_env(self.env()) if reference else self.env())
         self.procs.append(proc)
         return proc
 
@@ -361,7 +362,70 @@ def test_an_interactive_marker_is_dragged_and_the_server_moves_it(page, system):
     page.shot("view3d-interactive")
 
 
+DEBIAN_SERVER = r"""
+import rospy
+from interactive_markers.interactive_marker_server import InteractiveMarkerServer
+from visualization_msgs.msg import InteractiveMarker, InteractiveMarkerControl
+
+rospy.init_node("debian_im")
+server = InteractiveMarkerServer("debian_im")
+marker = InteractiveMarker(name="slider", scale=1.0)
+marker.header.frame_id = "map"
+marker.pose.position.x, marker.pose.position.y, marker.pose.position.z = -3.0, -3.0, 0.5
+marker.pose.orientation.w = 1.0
+control = InteractiveMarkerControl(name="slide_x", interaction_mode=InteractiveMarkerControl.MOVE_AXIS)
+control.orientation.w = 1.0  # no markers: the client draws its own arrows, as Rviz does
+marker.controls.append(control)
+
+def on_feedback(fb):
+    print("FEEDBACK %d %s %.3f %.3f %s" % (fb.event_type, fb.control_name, fb.pose.position.x,
+                                          fb.pose.position.y, fb.header.frame_id), flush=True)
+    server.applyChanges()
+
+server.insert(marker, on_feedback)
+server.applyChanges()
+print("READY", flush=True)
+rospy.spin()
+"""
+
+
+@pytest.mark.interop
+def test_an_interactive_marker_of_debians_server_is_dragged(page, system):
+    """The page drives the interactive_markers server of Debian's ROS (python3-interactive-
+    markers, rospy) as Rviz does: its arrows drawn by the client, the drag's feedback to it."""
+    require_reference()
+    server = system.start([REFERENCE_PYTHON, "-c", DEBIAN_SERVER], reference=True)
+    try:
+        server.read_until("READY", timeout=30)
+        page.wait_status("/debian_im/update", "ok", 30_000)
+        page.look((-2.5, -3, 0.5), (-2.5, -6.5, 3.0))
+        page.wait(f"{V}.displays.find((d) => d.source === '/debian_im/update').markers.has('slider')")
+        page.drag(page.project(-2.3, -3.0, 0.5), page.project(-1.3, -3.0, 0.5))
+        while True:
+            line = server.read_until("FEEDBACK", timeout=15)
+            fields = [ln for ln in line.splitlines() if ln.startswith("FEEDBACK")][-1].split()[1:]
+            if int(fields[0]) == 5:  # MOUSE_UP
+                break
+        assert fields[1] == "slide_x" and fields[4] == "map"
+        assert float(fields[2]) == pytest.approx(-2.0, abs=0.06) and float(fields[3]) == pytest.approx(-3.0, abs=1e-3)
+    finally:
+        out = server.stop()
+    assert "Traceback" not in out, out
+
+
 # -- 100,000 points at 10 Hz -------------------------------------------------------------------------
+
+def measure(page, seconds: float) -> dict:
+    """Frames drawn and clouds taken per second over ``seconds``, read in the page."""
+    read = (f"[performance.now(), {V}.scene3d.stats.rendered, "
+            f"{V}.displays.find((d) => d.source === '/cloud').received]")
+    start = page.js(read)
+    time.sleep(seconds)
+    end = page.js(read)
+    elapsed = (end[0] - start[0]) / 1000
+    return {"frames_per_second": round((end[1] - start[1]) / elapsed, 1),
+            "clouds_per_second": round((end[2] - start[2]) / elapsed, 1)}
+
 
 def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
     cloud = system.start([PYTHON, str(WEB / "scene_sources.py"), "--cloud", "100000",
@@ -370,28 +434,25 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
         cloud.read_until("READY", timeout=30)
         page.wait(f"{V}.summary().some((d) => d.source === '/cloud' && d.count === 100000)", 30_000)
         page.js(f"{V}.scene3d.resetCamera()")
+        # the camera still: the view draws when something changes (each cloud, tf)
+        still = measure(page, PERF_SECONDS / 2)
+        # the camera turning: the view draws every frame it can
         page.js(f"{V}.scene3d.controls.autoRotate = true; {V}.scene3d.continuous = true")
         page.js(f"{V}.scene3d.beforeRender.add(() => {V}.scene3d.controls.update())")
-        start = page.js(f"[performance.now(), {V}.scene3d.stats.rendered, "
-                        f"{V}.displays.find((d) => d.source === '/cloud').received]")
-        time.sleep(PERF_SECONDS)
-        end = page.js(f"[performance.now(), {V}.scene3d.stats.rendered, "
-                      f"{V}.displays.find((d) => d.source === '/cloud').received, "
-                      f"{V}.displays.find((d) => d.source === '/cloud').count, {V}.scene3d.stats]")
-        seconds = (end[0] - start[0]) / 1000
-        report = {"points": end[3], "seconds": round(seconds, 1),
-                  "frames_per_second": round((end[1] - start[1]) / seconds, 1),
-                  "clouds_per_second": round((end[2] - start[2]) / seconds, 1),
-                  "canvas": f"{end[4]['width']}x{end[4]['height']}", "renderer": end[4]["renderer"],
-                  "load_average": os.getloadavg()[0]}
+        turning = measure(page, PERF_SECONDS / 2)
+        page.js(f"{V}.scene3d.controls.autoRotate = false; {V}.scene3d.continuous = false")
+        stats = page.js(f"{V}.scene3d.stats")
+        count = page.js(f"{V}.displays.find((d) => d.source === '/cloud').count")
+        report = {"points": count, "camera_still": still, "camera_turning": turning,
+                  "canvas": f"{stats['width']}x{stats['height']}", "renderer": stats["renderer"],
+                  "cpus": os.cpu_count(), "load_average": round(os.getloadavg()[0], 1)}
         print("\n3D view, 100k-point PointCloud2 at 10 Hz:", json.dumps(report))
         (shots / "view3d-perf.json").write_text(json.dumps(report, indent=1) + "\n")
-        page.js(f"{V}.scene3d.controls.autoRotate = false; {V}.scene3d.continuous = false")
         page.shot("view3d-cloud")
     finally:
         cloud.stop()
-    assert report["points"] == 100_000
-    # the view keeps drawing and keeps taking clouds (the server drops what the page cannot
-    # take): a floor that a broken pipeline misses, not a benchmark
-    assert report["frames_per_second"] >= 2.0, report
-    assert report["clouds_per_second"] >= 2.0, report
+    assert count == 100_000
+    # the view keeps drawing and keeps taking clouds, whatever else the machine runs (the
+    # server drops what the page cannot take): floors a broken pipeline misses, not a benchmark
+    for phase in (still, turning):
+        assert phase["frames_per_second"] >= 1.0 and phase["clouds_per_second"] >= 0.3, report
