@@ -264,3 +264,31 @@ def test_the_hub_places_frames_into_the_fixed_frame_and_ages_them():
     assert not frames["odom"]["stale"] and frames["map"]["T"] == [0, 0, 0, 0, 0, 0, 1]
     assert hub.frames_json("world")["error"] == "Fixed Frame [world] does not exist"
     assert "no tf received" in SceneHub(state=None).frames_json("map")["warning"]
+
+
+# -- the view's ops on a page session ------------------------------------------------------------
+
+def test_display_ops_check_what_the_page_asks():
+    import json
+
+    from test_web_page import replies, session
+
+    page, outbox, state = session()
+    page.receive(json.dumps({"op": "scene_watch", "id": "w", "fixed": " "}))
+    assert "the fixed frame is empty" in replies(outbox)[0]["msg"]
+    page.receive(json.dumps({"op": "display_add", "id": "a", "topic": "/nowhere"}))
+    assert replies(outbox) == [{"op": "reply", "id": "a",
+                                "error": "topic /nowhere does not exist (or has no type yet)"}]
+    # a topic not published yet, with the kind the page expects: tapped, waiting
+    page.receive(json.dumps({"op": "display_add", "id": "b", "topic": "/scan_later", "kind": "scan"}))
+    assert replies(outbox) == [{"op": "reply", "id": "b", "kind": "scan", "type": "",
+                                "topic": "/scan_later"}]
+    assert state.tapped == [("/scan_later", ("page", "test", "scene", "b"))]
+    page.receive(json.dumps({"op": "display_add", "id": "c", "topic": "/turtle1/pose"}))
+    error = replies(outbox)[0]["error"]
+    assert error.startswith("/turtle1/pose is a turtlesim/Pose: the 3D view shows ")
+    page.receive(json.dumps({"op": "display_remove", "id": "b"}))
+    assert state.tapped == []
+    page.receive(json.dumps({"op": "im_feedback", "id": "nope", "marker": "m", "event": 1}))
+    assert "no interactive marker display nope" in replies(outbox)[0]["msg"]
+    page.close()

@@ -9,9 +9,10 @@ the view's ops to the page's session:
 =================  ==========================================================================
 ``scene_watch``    ``{fixed}``: ``scene_frames`` now and whenever tf changes (at most 20 a
                    second): every frame's pose in the fixed frame, its parent and age
-``display_add``    ``{id, topic}`` or ``{id, kind: "robot", param}``: reply ``{kind, type}``,
-                   then the display's data (``scene_data`` JSON, or binary frames for
-                   clouds, scans and grids) and ``scene_status`` when its status changes
+``display_add``    ``{id, topic, kind?}`` or ``{id, kind: "robot", param}``: reply ``{kind,
+                   type}``, then the display's data (``scene_data`` JSON, or binary frames for
+                   clouds, scans and grids) and ``scene_status`` when its status changes; a
+                   topic not published yet is waited for when the page says its kind
 ``display_remove`` ``{id}``
 ``im_feedback``    ``{id, marker, control, event, pose}``: an interactive marker moved or
                    clicked in the page (pose in the fixed frame): published on the server's
@@ -70,6 +71,7 @@ KINDS = {
     "geometry_msgs/PolygonStamped": "polygon",
     "visualization_msgs/InteractiveMarkerUpdate": "imarkers",
 }
+IM_UPDATE = "visualization_msgs/InteractiveMarkerUpdate"
 #: messages a display's slot keeps for a page that does not read fast enough
 QUEUE = {"markers": 1000, "odometry": 20}
 
@@ -236,6 +238,10 @@ class Display:
         if self.kind == "imarkers":
             return self._render_imarkers()
         incoming: Incoming = item
+        arrived = incoming.tap.type
+        if arrived and KINDS.get(arrived) != self.kind:  # the topic came with another type
+            raise DisplayError(f"{self.topic} is a {arrived}, not what a {self.kind} display "
+                               "shows: remove this display and add the topic again")
         msg = incoming.decoded()
         fixed = self.session.fixed or ""
         hub = self.session.hub
@@ -422,9 +428,13 @@ class SceneSession:
         self.page._allowed(topic)
         type_name = self.state.topic_type(topic)
         if type_name is None:
-            self.page.fail(msg, f"topic {topic} does not exist (or has no type yet)")
-            return
-        kind = KINDS.get(type_name)
+            # not published yet: wait for it, as Rviz does, with the kind the page expects
+            kind = msg.get("kind")
+            if kind not in set(KINDS.values()):
+                self.page.fail(msg, f"topic {topic} does not exist (or has no type yet)")
+                return
+        else:
+            kind = KINDS.get(type_name)
         if kind is None:
             self.page.fail(msg, f"{topic} is a {type_name}: the 3D view shows "
                                 f"{', '.join(sorted(KINDS))}")
@@ -441,7 +451,7 @@ class SceneSession:
             display.namespace = namespace
             for name, type_, full in ((namespace + "/update_full",
                                        "visualization_msgs/InteractiveMarkerInit", True),
-                                      (topic, type_name, False)):
+                                      (topic, type_name or IM_UPDATE, False)):
                 key = (*self.page.key, "scene", display_id, name)
                 display.keys.append((name, key))
                 self.state.tap(name, type_, key,
@@ -452,7 +462,7 @@ class SceneSession:
             slot = display.slot
             self.state.tap(topic, type_name, key,
                            lambda incoming: put(slot, incoming, incoming.size))
-        self.page.reply(msg, kind=kind, type=type_name, topic=topic)
+        self.page.reply(msg, kind=kind, type=type_name or "", topic=topic)
 
     def _add_robot(self, msg: Dict[str, Any], display_id: str) -> None:
         param = msg.get("param") or DEFAULT_ROBOT_PARAM

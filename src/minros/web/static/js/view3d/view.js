@@ -160,7 +160,8 @@ export function createView(app, el) {
 
   function subscribe(display) {
     if (!display.remote || app.conn.state !== "connected") return;
-    const fields = display.kind === "robot" ? {kind: "robot", param: display.param} : {topic: display.topic};
+    const fields = display.kind === "robot" ? {kind: "robot", param: display.param}
+      : {topic: display.topic, kind: display.kind};  // the kind: for a topic not published yet
     app.conn.request("display_add", {id: display.id, ...fields})
       .catch((err) => display.setServerStatus("error", err.message));
   }
