@@ -313,11 +313,6 @@ export function createView(app, el) {
     }
   }
 
-  app.onGraph((graph) => {
-    renderAddChoices();
-    autoAddTopics(graph);
-  });
-
   // -- the first displays ----------------------------------------------------------------
 
   if (saved && Array.isArray(saved.displays)) {
@@ -326,6 +321,12 @@ export function createView(app, el) {
     addDisplay({kind: "grid3d"});
     addDisplay({kind: "tf"});
   }
+
+  app.onGraph((graph) => {
+    renderAddChoices();
+    autoAddTopics(graph);
+  });
+
 
   // lifetimes, and the frames-per-second line
   scene3d.beforeRender.add((now) => {
