@@ -214,12 +214,12 @@ def test_every_display_draws_and_bad_ones_say_why(page):
     assert "marker bad/1: the message contains NaN" in bad["text"] and bad["markers"] == 1
     status = page.page.locator('.display-row[data-kind="scan"][data-level="error"] .display-status')
     assert "nowhere" in status.inner_text()
-    # drawn: the top of the robot's blue box, the light blue CUBE marker
+    # drawn: the light blue CUBE marker, the map's unknown corner (Rviz's grey green)
     page.look((0.5, -0.5, 0), (4.5, -6.5, 5))
-    r, g, b, _ = page.pixel(*in_frame(page.frame("base_link"), (-0.12, -0.08, 0.13)))
-    assert b > r + 60 and b > g + 40, (r, g, b)
     r, g, b, _ = page.pixel(4.0, -2.4, 0.5)  # marker "shapes"/1, a CUBE of (0.2, 0.7, 1.0)
     assert b > 180 and g > 110 and r < 110, (r, g, b)
+    r, g, b, _ = page.pixel(3.5, 3.5, 0.0)  # map cells [150:, 150:] are unknown (-1)
+    assert g > r + 10 and abs(g - b) < 25 and 90 < g < 190, (r, g, b)
     rendered = page.js(f"{V}.scene3d.stats.rendered")
     page.wait(f"{V}.scene3d.stats.rendered > {rendered} + 5")  # the scan and tf keep it drawing
     page.shot("view3d-overview")
@@ -252,6 +252,8 @@ def test_the_robot_model_has_every_geometry_and_mesh(page):
     page.js(f"{V}.setFixed('base_footprint')")
     page.wait(f"{V}.scene3d.fixed === 'base_footprint'")
     page.look((0, 0, 0.15), (0.6, 1.2, 0.8))
+    r, g, b, _ = page.pixel(0.12, 0.15, 0.09)  # the side of the box of base_link, URDF blue
+    assert b > r + 60 and b > g + 40, (r, g, b)
     r, g, b, _ = page.pixel(0, 0, 0.2)  # the pyramid on base_scan (z 0.13 + up to 0.2)
     assert r > g + 60 and r > b + 60, (r, g, b)
     r, g, b, _ = page.pixel(0.2 + 0.05, 0, 0.05)  # the wedge on bumper

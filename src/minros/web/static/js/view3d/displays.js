@@ -381,6 +381,11 @@ export class MarkersDisplay extends Display {
 
 // -- point clouds and scans ----------------------------------------------------------------
 
+/** Points a software renderer draws of a big cloud while the camera moves: every STRIDE-th
+ * (the whole cloud again as soon as the camera stops). */
+const STRIDE = 4;
+const COARSE_FROM = 50000;
+
 export class PointsDisplay extends Display {
   static defaults = {size: 0.02, color: "#ff0000", alpha: 1};
   static fields = [["size", "size (m)", "number", {min: 0.001, step: 0.01}], ["color", "flat color", "color"],
@@ -394,9 +399,23 @@ export class PointsDisplay extends Display {
     this.material = new THREE.PointsMaterial({size: this.options.size, sizeAttenuation: true});
     this.points = new THREE.Points(this.geometry, this.material);
     this.points.frustumCulled = false;  // the bounds change with every message
+    // the same arrays through an index of every STRIDE-th point, drawn instead of the whole
+    // cloud while the camera moves on a software renderer (vertices are what it is slow at)
+    this.coarseGeometry = new THREE.BufferGeometry();
+    this.coarse = new THREE.Points(this.coarseGeometry, this.material);
+    this.coarse.frustumCulled = false;
+    this.coarse.visible = false;
     this.anchor = null;
     this.count = 0;
     this.applyOptions();
+  }
+
+  tick() {
+    const coarse = this.scene.software && this.scene.moving && this.count >= COARSE_FROM;
+    if (coarse !== this.coarse.visible) {
+      this.coarse.visible = coarse;
+      this.points.visible = !coarse;
+    }
   }
 
   applyOptions() {
@@ -423,6 +442,14 @@ export class PointsDisplay extends Display {
       this.geometry.setAttribute("position", pos);
       this.geometry.setAttribute("color", col);
       this.points.geometry = this.geometry;
+      this.coarseGeometry.dispose();
+      this.coarseGeometry = new THREE.BufferGeometry();
+      this.coarseGeometry.setAttribute("position", pos);
+      this.coarseGeometry.setAttribute("color", col);
+      const index = new Uint32Array(Math.ceil(this.capacity / STRIDE));
+      for (let i = 0; i < index.length; i++) index[i] = i * STRIDE;
+      this.coarseGeometry.setIndex(new THREE.BufferAttribute(index, 1));
+      this.coarse.geometry = this.coarseGeometry;
     }
     const pos = this.geometry.getAttribute("position");
     pos.array.set(position);
@@ -443,11 +470,12 @@ export class PointsDisplay extends Display {
       this.material.needsUpdate = true;
     }
     this.geometry.setDrawRange(0, count);
+    this.coarseGeometry.setDrawRange(0, Math.ceil(count / STRIDE));
     this.count = count;
     const place = {frame: msg.frame, T: msg.T, fixed: msg.fixed};
     if (!this.anchor) {
       this.anchor = this.scene.anchor(place, this.group);
-      this.anchor.add(this.points);
+      this.anchor.add(this.points, this.coarse);
     } else {
       this.anchor.userData.place = place;
       this.scene.placeAnchor(this.anchor);

@@ -59,7 +59,11 @@ export class Scene3D {
     this.camera.add(light, light.target);
     this.controls = new OrbitControls(this.camera, this.canvas);
     this.controls.screenSpacePanning = false;  // panning slides along the ground
-    this.controls.addEventListener("change", () => this.invalidate());
+    this.lastMove = -1e9;
+    this.controls.addEventListener("change", () => {
+      this.lastMove = performance.now();
+      this.invalidate();
+    });
     this.resetCamera();
     this.grid = new THREE.GridHelper(10, 10, 0xa0a0a4, 0xa0a0a4);  // Rviz's grid: 10 cells of 1 m
     this.grid.rotation.x = Math.PI / 2;
@@ -103,6 +107,12 @@ export class Scene3D {
     this.dirty = true;
   }
 
+  /** Whether the camera moved in the last quarter of a second (big clouds draw coarser then
+   * on a software renderer, see PointsDisplay). */
+  get moving() {
+    return performance.now() - this.lastMove < 250;
+  }
+
   show() {
     this.visible = true;
     this.resize();
@@ -116,6 +126,9 @@ export class Scene3D {
   loop(now) {
     this.raf = this.visible ? requestAnimationFrame((t) => this.loop(t)) : null;
     for (const cb of this.beforeRender) cb(now);
+    const moving = this.moving;
+    if (this.wasMoving && !moving) this.invalidate();  // the camera stopped: draw it all again
+    this.wasMoving = moving;
     if (this.dirty || this.continuous) {
       this.dirty = false;
       this.renderer.render(this.scene, this.camera);
