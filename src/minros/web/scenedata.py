@@ -193,16 +193,17 @@ def cloud_arrays(msg: Any) -> Tuple[np.ndarray, np.ndarray, Dict[str, Any]]:
         points = np.frombuffer(np.ascontiguousarray(rows).tobytes(), dtype, count)
     xyz = np.empty((count, 3), np.float32)
     xyz[:, 0], xyz[:, 1], xyz[:, 2] = points["x"], points["y"], points["z"]
-    valid = np.isfinite(xyz).all(axis=1)
-    dropped = int(count - valid.sum())
+    finite = np.isfinite(xyz)
+    valid = finite[:, 0] & finite[:, 1] & finite[:, 2]
+    dropped = count - int(np.count_nonzero(valid))
     if dropped:
         xyz, points = xyz[valid], points[valid]
     color_name = next((n for n in ("rgb", "rgba") if n in names and
                        FIELD_SIZES[fields[n].datatype] == 4), None)
     if color_name is not None:
-        packed = np.ascontiguousarray(points[color_name]).view(order + "u4").astype(np.uint32)
-        colors = np.stack([(packed >> 16) & 255, (packed >> 8) & 255, packed & 255],
-                          axis=1).astype(np.uint8)
+        # 0x00RRGGBB as a little-endian uint32 is the bytes B, G, R, 0
+        packed = np.ascontiguousarray(points[color_name]).view(order + "u4").astype("<u4")
+        colors = packed.view(np.uint8).reshape(-1, 4)[:, 2::-1]
         how = "rgb"
     elif "intensity" in names:
         colors, how = rainbow(points["intensity"]), "intensity"
