@@ -292,3 +292,46 @@ def test_display_ops_check_what_the_page_asks():
     page.receive(json.dumps({"op": "im_feedback", "id": "nope", "marker": "m", "event": 1}))
     assert "no interactive marker display nope" in replies(outbox)[0]["msg"]
     page.close()
+
+
+class FakeIncoming:
+    def __init__(self, msg, type_name):
+        self.msg = msg
+        self.tap = type("Tap", (), {"type": type_name, "topic": "/t"})()
+        self._cache = {}
+
+    def decoded(self):
+        return self.msg
+
+    def cached(self, key, make):
+        if key not in self._cache:
+            self._cache[key] = make()
+        return self._cache[key]
+
+
+def test_a_display_renders_binary_clouds_placed_by_tf_and_each_status_once():
+    import json
+
+    from minros.web.scene import Display
+
+    hub = SceneHub(state=None)
+    hub.add([transform("map", "cam", 2.0, 10)], "/x", static=True)
+    session = type("Session", (), {"hub": hub, "fixed": "map", "mesh_url": staticmethod(mesh)})()
+    display = Display(session, "d1", "cloud", "/t", "sensor_msgs/PointCloud2")
+    cloud = create_cloud(Header(frame_id="cam", stamp=Time(10, 0)), fields(("x", 0, 7), ("y", 4, 7), ("z", 8, 7)),
+                         [(1, 2, 3), (4, 5, 6)])
+    status, frame = display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2"))
+    assert json.loads(status) == {"op": "scene_status", "id": "d1", "level": "ok", "text": ""}
+    header, arrays = scenedata.unpack(frame)
+    assert header["frame"] == "cam" and header["T"][0] == pytest.approx(2.0) and header["fixed"] == "map"
+    assert header["count"] == 2 and arrays["position"].tolist() == [1, 2, 3, 4, 5, 6]
+    assert display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2"))[0] == frame  # no new status
+    cloud.data = cloud.data[:-4]
+    (bad,) = display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2"))
+    assert json.loads(bad)["level"] == "error" and "data holds 20 bytes" in json.loads(bad)["text"]
+    assert display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2")) == []  # said once
+    cloud.header.frame_id = "elsewhere"
+    (lost,) = display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2"))
+    assert json.loads(lost)["text"].startswith("No transform from [elsewhere] to [map]")
+    (wrong,) = display.render(FakeIncoming(cloud, "sensor_msgs/LaserScan"))
+    assert "/t is a sensor_msgs/LaserScan, not what a cloud display shows" in json.loads(wrong)["text"]

@@ -257,10 +257,9 @@ class Display:
             problems.append(warning)
         place = {"frame": frame.lstrip("/"), "T": T, "stamp": header.stamp.to_sec()}
         if self.kind in ("cloud", "scan"):
-            if self.kind == "cloud":
-                xyz, colors, info = scenedata.cloud_arrays(msg)
-            else:
-                xyz, colors, info = scenedata.scan_arrays(msg)
+            convert = scenedata.cloud_arrays if self.kind == "cloud" else scenedata.scan_arrays
+            # the arrays are the same for every page (only the placing differs): made once
+            xyz, colors, info = incoming.cached(("scene", self.kind), lambda: convert(msg))
             arrays = [("position", xyz)] + ([("color", colors)] if colors is not None else [])
             return [pack({"op": "scene_data", **base, **place, "count": len(xyz), **info},
                          arrays)], problems
