@@ -486,32 +486,54 @@ export class PointsDisplay extends Display {
 
 // -- maps ----------------------------------------------------------------------------------
 
-/** Rviz's "map" colour scheme: 0..100 white to black, -1 (255 here) a grey green, other
- * values (illegal) green above 100 and red to yellow below 0. Packed RGBA as a uint32 (little
- * endian, as typed arrays are on every browser's machine). */
-const MAP_PALETTE = (() => {
-  const palette = new Uint32Array(256);
+/** Rviz's colour schemes of a grid, packed RGBA as uint32 (little endian, as typed arrays are
+ * on every browser's machine). "map": 0..100 white to black; "costmap": 0 clear, 1..98 blue to
+ * red, 99 (inscribed) cyan, 100 (lethal) purple. Both: -1 (255 here) a grey green, other
+ * values (illegal) green above 100 and red to yellow below 0. */
+function palette(scheme) {
+  const out = new Uint32Array(256);
   const rgba = (r, g, b, a) => (a << 24 | b << 16 | g << 8 | r) >>> 0;
-  for (let i = 0; i <= 100; i++) {
-    const v = 255 - Math.floor(255 * i / 100);
-    palette[i] = rgba(v, v, v, 255);
+  if (scheme === "costmap") {
+    out[0] = rgba(0, 0, 0, 0);
+    for (let i = 1; i <= 98; i++) {
+      const v = Math.floor(255 * i / 100);
+      out[i] = rgba(v, 0, 255 - v, 255);
+    }
+    out[99] = rgba(0, 255, 255, 255);
+    out[100] = rgba(255, 0, 255, 255);
+  } else {
+    for (let i = 0; i <= 100; i++) {
+      const v = 255 - Math.floor(255 * i / 100);
+      out[i] = rgba(v, v, v, 255);
+    }
   }
-  for (let i = 101; i <= 127; i++) palette[i] = rgba(0, 255, 0, 255);
-  for (let i = 128; i <= 254; i++) palette[i] = rgba(255, Math.floor(255 * (i - 128) / (254 - 128)), 0, 255);
-  palette[255] = rgba(0x70, 0x89, 0x86, 255);
-  return palette;
-})();
+  for (let i = 101; i <= 127; i++) out[i] = rgba(0, 255, 0, 255);
+  for (let i = 128; i <= 254; i++) out[i] = rgba(255, Math.floor(255 * (i - 128) / (254 - 128)), 0, 255);
+  out[255] = rgba(0x70, 0x89, 0x86, 255);
+  return out;
+}
+const PALETTES = {map: palette("map"), costmap: palette("costmap")};
 
 export class MapDisplay extends Display {
-  static defaults = {alpha: 0.7};
-  static fields = [["alpha", "alpha", "number", {min: 0, max: 1, step: 0.1}]];
+  static defaults = {alpha: 0.7, scheme: "map"};
+  static fields = [["alpha", "alpha", "number", {min: 0, max: 1, step: 0.1}],
+                   ["scheme", "colours", "select", {options: ["map", "costmap"]}]];
+
+  constructor(view, config) {
+    super(view, config);
+    // move_base's costmaps get Rviz's costmap colours unless chosen otherwise
+    if (!(config.options && config.options.scheme) && /costmap/.test(this.topic)) this.options.scheme = "costmap";
+  }
 
   data(msg) {
     this.received++;
     const {width, height, resolution, origin} = msg;
     const cells = msg.arrays.cells;
+    this.last = msg;
+    msg.scheme = this.options.scheme;  // what it was drawn with (applyOptions redraws on a change)
+    const colours = PALETTES[this.options.scheme] || PALETTES.map;
     const pixels = new Uint32Array(width * height);
-    for (let i = 0; i < cells.length; i++) pixels[i] = MAP_PALETTE[cells[i]];
+    for (let i = 0; i < cells.length; i++) pixels[i] = colours[cells[i]];
     const rgba = new Uint8Array(pixels.buffer);
     if (!this.mesh || this.size !== `${width}x${height}x${resolution}`) {
       this.clear();
@@ -543,6 +565,7 @@ export class MapDisplay extends Display {
 
   applyOptions() {
     if (this.mesh) this.mesh.material.opacity = Number(this.options.alpha);
+    if (this.last && this.last.scheme !== this.options.scheme) this.data(this.last);
   }
 
   clear() {

@@ -232,7 +232,9 @@ export function createView(app, el) {
   function renderList() {
     list.replaceChildren(...view.displays.map((display) => {
       const fields = display.constructor.fields.map(([key, title, type, attrs]) => {
-        const input = h("input", {type, ...(attrs || {}), "data-option": key});
+        const input = type === "select"
+          ? h("select", {"data-option": key}, attrs.options.map((o) => h("option", {value: o}, o)))
+          : h("input", {type, ...(attrs || {}), "data-option": key});
         if (type === "checkbox") input.checked = Boolean(display.options[key]);
         else input.value = display.options[key];
         input.addEventListener("change", () => {
