@@ -335,3 +335,13 @@ def test_a_display_renders_binary_clouds_placed_by_tf_and_each_status_once():
     assert json.loads(lost)["text"].startswith("No transform from [elsewhere] to [map]")
     (wrong,) = display.render(FakeIncoming(cloud, "sensor_msgs/LaserScan"))
     assert "/t is a sensor_msgs/LaserScan, not what a cloud display shows" in json.loads(wrong)["text"]
+
+
+def test_time_going_back_clears_the_transforms_but_not_the_static_ones():
+    hub = SceneHub(state=None)
+    hub.add([transform("map", "odom", 1.0, 100)], "/x", static=True)
+    hub.add([transform("odom", "base", 5.0, 100)], "/x", static=False)
+    assert hub.lookup("map", "base")[0][0] == pytest.approx(6.0)
+    hub.add([transform("odom", "base", 2.0, 10)], "/x", static=False)  # a simulation restarted
+    assert hub.lookup("map", "base", Time(10, 0))[0][0] == pytest.approx(3.0)
+    assert hub.lookup("map", "odom")[0][0] == pytest.approx(1.0)

@@ -51,6 +51,10 @@ STALE_SECONDS = 5.0
 #: frames sent to a page at most (a tf tree is tens to hundreds)
 MAX_FRAMES = 2000
 FRAMES_INTERVAL = 0.05
+#: a /tf stamp this far older than the newest means time went back (a restarted simulation, a
+#: looping bag): the buffer is cleared, as tf2_ros's listener clears its own when the clock
+#: goes back
+TIME_JUMP_NS = 1_000_000_000
 #: displays one page may have
 MAX_DISPLAYS = 64
 TF_TOPIC, TF_STATIC_TOPIC, TF_TYPE = "/tf", "/tf_static", "tf2_msgs/TFMessage"
@@ -98,6 +102,7 @@ class SceneHub:
         self.watchers: Dict[Hashable, Callable[[], None]] = {}
         self.lock = threading.Lock()
         self.tapped = False
+        self.newest_ns = 0  # the newest stamp of /tf (a jump back clears the buffer)
 
     def watch(self, key: Hashable, on_change: Callable[[], None]) -> None:
         """Call ``on_change()`` (in the receive thread: queue only) whenever tf changes."""
@@ -129,6 +134,16 @@ class SceneHub:
         self.add(msg.transforms, incoming.header.get("callerid", "unknown_publisher"), static)
 
     def add(self, transforms: List[Any], authority: str, static: bool) -> None:
+        if not static and transforms:
+            stamp = transforms[0].header.stamp
+            ns = stamp.secs * 1_000_000_000 + stamp.nsecs
+            if ns < self.newest_ns - TIME_JUMP_NS:  # a simulation restarted, a bag looped
+                minros.loginfo("[web] tf: time went back by "
+                               f"{(self.newest_ns - ns) / 1e9:.1f} s: the 3D view forgets the "
+                               "transforms it had (static ones stay)")
+                self.buffer.clear()
+                self.newest_ns = ns
+            self.newest_ns = max(self.newest_ns, ns)
         self.buffer.set_transforms(transforms, authority, static)
         now = self.clock()
         with self.lock:
