@@ -303,7 +303,9 @@ export function createView(app, el) {
       if (!kind || shown.has(topic.name) || view.removedTopics.has(topic.name) || app.isQuiet(topic.name)) continue;
       // published by someone (not only by this server, as /initialpose after a click)
       if (!topic.publishers || topic.publishers.every((node) => app.isQuiet(node))) continue;
-      addDisplay({kind, topic: topic.name});
+      // a costmap covers the map in strong colours: listed, shown when ticked (as Rviz users
+      // add one when they look at planning)
+      addDisplay({kind, topic: topic.name, enabled: !(kind === "grid" && /costmap/.test(topic.name))});
     }
     if (!view.displays.some((d) => d.kind === "robot") && !view.removedTopics.has("/robot_description")) {
       try {
