@@ -12,7 +12,7 @@ read back from WebGL, the statuses in the display list) and saves a screenshot
 The performance test publishes a PointCloud2 of 100,000 points at 10 Hz and measures, in the
 page, the frames drawn and the clouds taken per second, with the camera still and then turning,
 for ``MINROS_3D_SECONDS`` (20 by default, half each); it prints them and writes
-view3d-perf.json beside the screenshots.
+view3d_perf.json beside the screenshots.
 """
 
 from __future__ import annotations
@@ -224,7 +224,7 @@ def test_every_display_draws_and_bad_ones_say_why(page):
     assert g > r + 10 and abs(g - b) < 25 and 90 < g < 190, (r, g, b)
     rendered = page.js(f"{V}.scene3d.stats.rendered")
     page.wait(f"{V}.scene3d.stats.rendered > {rendered} + 5")  # the scan and tf keep it drawing
-    page.shot("view3d-overview")
+    page.shot("view3d_overview")
 
 
 def test_the_robot_model_has_every_geometry_and_mesh(page):
@@ -263,8 +263,17 @@ def test_the_robot_model_has_every_geometry_and_mesh(page):
     r, g, b, _ = page.pixel(-0.12, 0.1, 0.25)  # the octahedron on antenna
     assert g > r + 50 and g > b + 30, (r, g, b)
     page.js(f"{V}.setEnabled({V}.displays.find((d) => d.kind === 'tf'), true)")
-    page.shot("view3d-robot")
+    page.shot("view3d_robot")
     page.js(f"{V}.setFixed('map')")
+    # the second robot: its description under its namespace, its frames under its tf_prefix
+    second = page.wait_status("/second/robot_description", "ok")
+    assert second["received"] >= 1
+    page.wait(f"[...{V}.displays.find((d) => d.source === '/second/robot_description').links.values()]"
+              ".every((anchor) => anchor.visible)")
+    assert page.js(f"{V}.displays.find((d) => d.source === '/second/robot_description').options.prefix") == "second"
+    base = page.js(f"{V}.displays.find((d) => d.source === '/second/robot_description')"
+                   ".links.get('base_footprint').matrixWorld.elements.slice(12, 14)")
+    assert base == pytest.approx([-1.0, 2.0], abs=1e-6)
 
 
 def test_markers_namespaces_and_lifetimes(page):
@@ -332,7 +341,15 @@ def test_nav_goal_and_pose_estimate_publish_where_the_mouse_says(page, system):
     assert float(yaw) == pytest.approx(math.pi / 2, abs=0.05) and frame == "map"
     assert float(cov_x) == pytest.approx(0.25) and float(cov_yaw) == pytest.approx((math.pi / 12) ** 2, abs=1e-4)
     assert "2D Pose Estimate: published" in page.page.locator(".view3d-note").inner_text()
-    page.shot("view3d-tools")
+    page.shot("view3d_tools")
+    # a robot under a namespace has its own goal topic: the tool's topic is chosen in the panel
+    topic = page.page.get_by_label("2D Nav Goal topic")
+    topic.fill("/second/move_base_simple/goal")
+    topic.press("Enter")
+    page.page.get_by_role("button", name="2D Nav Goal").click()
+    page.drag(page.project(-2.0, 1.5, 0.0), page.project(-2.0, 2.5, 0.0))
+    x, y, frame = sources_line(system, "SECOND_GOAL")
+    assert (float(x), float(y), frame) == (pytest.approx(-2.0, abs=0.03), pytest.approx(1.5, abs=0.03), "map")
 
 
 def test_an_interactive_marker_is_dragged_and_the_server_moves_it(page, system):
@@ -363,7 +380,7 @@ def test_an_interactive_marker_is_dragged_and_the_server_moves_it(page, system):
             break
     assert control == "rotate_z" and float(yaw) == pytest.approx(math.pi / 2, abs=0.12)
     assert float(x) == pytest.approx(cx, abs=1e-3)
-    page.shot("view3d-interactive")
+    page.shot("view3d_interactive")
 
 
 DEBIAN_SERVER = r"""
@@ -451,8 +468,8 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
                   "canvas": f"{stats['width']}x{stats['height']}", "renderer": stats["renderer"],
                   "cpus": os.cpu_count(), "load_average": round(os.getloadavg()[0], 1)}
         print("\n3D view, 100k-point PointCloud2 at 10 Hz:", json.dumps(report))
-        (shots / "view3d-perf.json").write_text(json.dumps(report, indent=1) + "\n")
-        page.shot("view3d-cloud")
+        (shots / "view3d_perf.json").write_text(json.dumps(report, indent=1) + "\n")
+        page.shot("view3d_cloud")
     finally:
         cloud.stop()
     assert count == 100_000

@@ -72,7 +72,7 @@ def test_a_nav_goal_clicked_in_the_3d_view_drives_the_simulated_robot(sim, shots
             page.look((1.0, 0.2, 0.0), (-1.2, -2.4, 2.4))
             # the robot's nine frames crowd their names at this distance
             page.js(f"{V}.displays.find((d) => d.kind === 'tf').setOption('names', false)")
-            page.shot("view3d-sim-start")
+            page.shot("view3d_sim_start")
             # Rviz's gesture: press where the robot should go, drag towards where it faces
             page.page.get_by_role("button", name="2D Nav Goal").click()
             page.drag(page.project(1.8, 0.5, 0.0), page.project(1.8, 1.2, 0.0))
@@ -83,7 +83,7 @@ def test_a_nav_goal_clicked_in_the_3d_view_drives_the_simulated_robot(sim, shots
                       "'/move_base/NavfnROS/plan'); return p && p.received > 0; })()", 15_000)
             page.wait(f"(() => {{ const f = {V}.scene3d.frames.get('base_footprint'); "
                       "return f && f.T && Math.hypot(f.T[0] - 0.9, f.T[1] - 0.25) < 0.3; })()", 30_000)
-            page.shot("view3d-sim-driving")
+            page.shot("view3d_sim_driving")
             # until it stops: move_base's tolerances are 0.08 m and 0.17 rad
             deadline = time.monotonic() + 60
             last = None
@@ -98,7 +98,7 @@ def test_a_nav_goal_clicked_in_the_3d_view_drives_the_simulated_robot(sim, shots
             assert abs(math.remainder(yaw_of(pose) - math.pi / 2, 2 * math.pi)) < 0.2, pose
             x, y = sim.ground_truth()
             assert math.hypot(x - pose[0], y - pose[1]) < 0.02  # the view shows where it is
-            page.shot("view3d-sim-arrived")
+            page.shot("view3d_sim_arrived")
         finally:
             page.close()
             browser.close()

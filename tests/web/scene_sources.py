@@ -6,7 +6,9 @@
 --robot       /robot_description (tests/web/scene_pkg's URDF: box, cylinders, sphere, STL, DAE
               and OBJ meshes) and tf: map -> odom (static), odom -> base_footprint (the robot
               drives a circle of 1 m, 20 Hz), the links (static), and map -> "old_sensor", sent
-              on /tf once to each new subscriber (so it goes stale)
+              on /tf once to each new subscriber (so it goes stale); a second robot as
+              minros sim names several (/second/robot_description, /second/tf_prefix
+              "second", frames second/...), standing at (-1, 2)
 --markers     /markers (MarkerArray): every Marker type in a row along y at x 4 in map (ns "shapes"),
               their names (ns "labels"), a frame-locked arrow on base_link (ns "locked") and a
               sphere with a 1 s lifetime (ns "blink"), sent every 2 s
@@ -21,7 +23,8 @@
               ROTATE_AXIS about z) at (2, -2, 0.5) in map; prints "FEEDBACK <event> <x> <y>
               <yaw>" for each feedback
 Always: prints "INITIALPOSE x y yaw frame" and "GOAL x y yaw frame" for what arrives on
-/initialpose and /move_base_simple/goal, and "READY" once everything is advertised.
+/initialpose and /move_base_simple/goal ("SECOND_GOAL x y frame" on
+/second/move_base_simple/goal), and "READY" once everything is advertised.
 """
 
 from __future__ import annotations
@@ -219,14 +222,24 @@ def main() -> None:
     rospy.Subscriber("/initialpose", PoseWithCovarianceStamped, on_initialpose)
     rospy.Subscriber("/move_base_simple/goal", PoseStamped, on_goal)
 
+    def on_second_goal(msg):
+        out(f"SECOND_GOAL {msg.pose.position.x:.3f} {msg.pose.position.y:.3f} {msg.header.frame_id}")
+    rospy.Subscriber("/second/move_base_simple/goal", PoseStamped, on_second_goal)
+
     if args.robot:
         from tf2_msgs.msg import TFMessage
         from tf2_ros import StaticTransformBroadcaster
 
         rospy.set_param("/robot_description", URDF.read_text())
+        # a second robot as minros sim names several: its description and tf_prefix under its
+        # namespace, its frames prefixed; it stands still at (-1, 2)
+        rospy.set_param("/second/robot_description", URDF.read_text())
+        rospy.set_param("/second/tf_prefix", "second")
         static = StaticTransformBroadcaster()
         static.sendTransform([transform("map", "odom", (0, 0, 0))] +
-                             [transform(p, c, xyz) for p, c, xyz in LINKS])
+                             [transform(p, c, xyz) for p, c, xyz in LINKS] +
+                             [transform("map", "second/base_footprint", (-1, 2, 0))] +
+                             [transform("second/" + p, "second/" + c, xyz) for p, c, xyz in LINKS])
 
         class OldSensor(rospy.SubscribeListener):
             def peer_subscribe(self, topic_name, topic_publish, peer_publish):

@@ -223,8 +223,9 @@ export class TFDisplay extends Display {
 // -- the robot model -----------------------------------------------------------------------
 
 export class RobotDisplay extends Display {
-  static defaults = {alpha: 1, color: "#cccccc"};
-  static fields = [["alpha", "alpha", "number", {min: 0, max: 1, step: 0.1}]];
+  static defaults = {alpha: 1, color: "#cccccc", prefix: ""};
+  static fields = [["alpha", "alpha", "number", {min: 0, max: 1, step: 0.1}],
+                   ["prefix", "tf prefix", "text", {size: 10}]];
 
   constructor(view, config) {
     super(view, config);
@@ -236,15 +237,23 @@ export class RobotDisplay extends Display {
 
   get title() { return "RobotModel"; }
 
+  /** The tf frame of a link: Rviz's "TF Prefix" before its name. */
+  frame(link) {
+    const prefix = String(this.options.prefix || "").replace(/^\/+|\/+$/g, "");
+    return prefix ? `${prefix}/${link}` : link;
+  }
+
   data(msg) {
     this.received++;
+    this.last = msg;
+    this.drawnPrefix = this.options.prefix;
     this.clear();
     this.links.clear();
     this.local.clear();
     this.robot = msg.robot;
     const problems = [];
     for (const link of msg.robot.links) {
-      const anchor = this.scene.anchor({frame: link.name, locked: true}, this.group);
+      const anchor = this.scene.anchor({frame: this.frame(link.name), locked: true}, this.group);
       anchor.name = link.name;
       for (const visual of link.visuals) {
         const color = visual.color || hexColor(this.options.color);
@@ -278,6 +287,10 @@ export class RobotDisplay extends Display {
   }
 
   applyOptions() {
+    if (this.last && this.drawnPrefix !== this.options.prefix) {
+      this.data(this.last);  // calls applyOptions again, with the new frames
+      return;
+    }
     const alpha = Number(this.options.alpha);
     this.group.traverse((o) => {
       if (!o.isMesh) return;
@@ -293,7 +306,7 @@ export class RobotDisplay extends Display {
 
   framesChanged() {
     if (!this.robot) return;
-    const missing = [...this.links].filter(([, anchor]) => !anchor.visible).map(([name]) => name);
+    const missing = [...this.links].filter(([, anchor]) => !anchor.visible).map(([name]) => this.frame(name));
     this.setLocal("tf", missing.length ? "warn" : "",
                   `No transform from [${missing.slice(0, 3).join("], [")}]${missing.length > 3 ? ` and ${missing.length - 3} more` : ""} to [${this.scene.fixed}]`);
   }

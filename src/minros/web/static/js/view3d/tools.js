@@ -1,8 +1,9 @@
 // Rviz's "2D Pose Estimate" and "2D Nav Goal": press on the ground where the robot is (or
 // should go), drag towards where it faces, release. The pose is published in the fixed frame:
 // geometry_msgs/PoseWithCovarianceStamped on /initialpose (Rviz's covariance: 0.5 m in x and y,
-// pi/12 in yaw) or geometry_msgs/PoseStamped on /move_base_simple/goal. As in Rviz, the tool
-// goes back to Interact after one use.
+// pi/12 in yaw) or geometry_msgs/PoseStamped on /move_base_simple/goal (each topic can be
+// changed in the view's panel, as Rviz's tool properties, e.g. for a robot under a namespace).
+// As in Rviz, the tool goes back to Interact after one use.
 
 import {arrow, dispose} from "./shapes.js";
 
@@ -84,11 +85,12 @@ export class GroundTool {
     this.preview = null;
     this.scene.invalidate();
     const spec = TOOLS[tool];
+    const topic = this.view.toolTopic(tool);
     const msg = toolMessage(tool, this.scene.fixed, x, y, this.yaw);
-    this.view.app.conn.publish(spec.topic, spec.type, msg);
-    this.view.published.push({tool, topic: spec.topic, x, y, yaw: this.yaw, frame: this.scene.fixed});
+    this.view.app.conn.publish(topic, spec.type, msg);
+    this.view.published.push({tool, topic, x, y, yaw: this.yaw, frame: this.scene.fixed});
     this.view.setTool("interact");
     this.view.note(`${spec.title}: published x ${x.toFixed(2)}, y ${y.toFixed(2)}, yaw ` +
-                   `${(this.yaw * 180 / Math.PI).toFixed(0)}° in ${this.scene.fixed} on ${spec.topic}`);
+                   `${(this.yaw * 180 / Math.PI).toFixed(0)}° in ${this.scene.fixed} on ${topic}`);
   }
 }

@@ -9,10 +9,10 @@
 // frame, a malformed cloud) says so there, and nothing else stops.
 //
 // The displays and the fixed frame are kept in the browser (localStorage). On a first visit the
-// view adds a display for every topic it can show, and the robot model when /robot_description
-// is set, and keeps adding new ones while "add new topics" is ticked.
+// view adds a display for every topic it can show, and a robot model for each robot_description
+// parameter, and keeps adding new ones while "add new topics" is ticked.
 
-import {errorLine, h} from "../ui.js";
+import {datalist, errorLine, h} from "../ui.js";
 import {Scene3D} from "./scene.js";
 import {MeshCache} from "./shapes.js";
 import {
@@ -30,6 +30,23 @@ const CLASSES = {
   imarkers: InteractiveMarkersDisplay,
 };
 const LOCAL_KINDS = new Set(["grid3d", "tf"]);
+
+/** A fixed frame for a view whose own does not exist: map, odom or world, else the root of the
+ * tree with the most frames. */
+function pickFixed(frames, current) {
+  const names = new Set(frames.map((f) => f.name));
+  const known = ["map", "odom", "world"].find((n) => names.has(n) && n !== current);
+  if (known) return known;
+  const parent = new Map(frames.map((f) => [f.name, f.parent]));
+  const size = new Map();
+  for (const f of frames) {
+    let root = f.name;
+    for (let depth = 0; parent.get(root) && depth < 1000; depth++) root = parent.get(root);
+    size.set(root, (size.get(root) || 0) + 1);
+  }
+  const roots = [...size].filter(([name]) => name !== current).sort((a, b) => b[1] - a[1]);
+  return roots.length ? roots[0][0] : null;
+}
 
 function load() {
   try {
@@ -59,10 +76,17 @@ export function createView(app, el) {
                                                                    onclick: () => view.setTool(key)}, title))),
     h("button", {onclick: () => scene3d.resetCamera(), title: "back to the default view"}, "Reset view"),
     fpsLabel);
+  const saved = load();
+  const toolInputs = Object.fromEntries(Object.entries(TOOLS).map(([key, spec]) => [key, h("input", {
+    type: "text", list: `view3d-tool-${key}`, class: "view3d-tool-topic", "data-tool-topic": key,
+    value: (saved && saved.tools && saved.tools[key]) || spec.topic, "aria-label": `${spec.title} topic`,
+    title: `${spec.type}: the topic ${spec.title} publishes on`, onchange: () => save()})]));
   const side = h("div", {class: "view3d-side"},
     h("h4", {}, "Global options"),
     h("label", {class: "field-inline"}, "Fixed frame ", fixedInput),
     fixedStatus,
+    h("div", {class: "view3d-tools"}, ...Object.entries(TOOLS).map(([key, spec]) =>
+      h("label", {class: "field-inline"}, spec.title + " ", toolInputs[key]))),
     h("h4", {}, "Displays"),
     list,
     h("div", {class: "row view3d-add-row"}, addSelect,
@@ -72,7 +96,6 @@ export function createView(app, el) {
   el.replaceChildren(toolbar, h("div", {class: "view3d-layout"}, side, stage));
   const scene3d = new Scene3D(stage);
 
-  const saved = load();
   const view = {
     app, scene3d, displays: [], tool: "interact", published: [], nextId: 1,
     fixedChosen: Boolean(saved && saved.fixed), removedTopics: new Set(saved ? saved.removed || [] : []),
@@ -85,6 +108,9 @@ export function createView(app, el) {
     },
     note(text) {
       noteLine.textContent = text;
+    },
+    toolTopic(tool) {
+      return toolInputs[tool].value.trim() || TOOLS[tool].topic;
     },
   };
   new Dragger(view);
@@ -126,10 +152,12 @@ export function createView(app, el) {
       datalist.dataset.names = names.join("\n");
       datalist.replaceChildren(...names.map((n) => h("option", {value: n})));
     }
-    if (msg.error && !view.fixedChosen) {  // no such frame, and nobody chose it: pick one
-      const parents = new Set(msg.frames.map((f) => f.name));
-      const pick = ["map", "odom", "world"].find((n) => parents.has(n) && n !== fixed) ||
-        (msg.frames.find((f) => !f.parent && f.name !== fixed) || {}).name;
+    // no such frame, nobody chose it, and tf has had 3 s to fill in: pick map, odom or world,
+    // else the root of the biggest tree
+    if (!msg.error) view.missingSince = 0;
+    else if (!view.fixedChosen && !view.missingSince) view.missingSince = performance.now();
+    if (msg.error && !view.fixedChosen && performance.now() - view.missingSince > 3000) {
+      const pick = pickFixed(msg.frames, fixed);
       if (pick) {
         setFixed(pick);
         return;
@@ -210,6 +238,7 @@ export function createView(app, el) {
     try {
       localStorage.setItem(STORAGE_KEY, JSON.stringify({
         fixed: view.fixedChosen ? fixed : undefined, autoAdd: autoAdd.checked,
+        tools: Object.fromEntries(Object.entries(toolInputs).map(([key, input]) => [key, input.value.trim()])),
         displays: view.displays.map((d) => d.config()), removed: [...view.removedTopics]}));
     } catch (err) {
       // storage full or disabled: the view works, it is just not remembered
@@ -307,15 +336,35 @@ export function createView(app, el) {
       // add one when they look at planning)
       addDisplay({kind, topic: topic.name, enabled: !(kind === "grid" && /costmap/.test(topic.name))});
     }
-    if (!view.displays.some((d) => d.kind === "robot") && !view.removedTopics.has("/robot_description")) {
-      try {
-        const reply = await app.conn.rosapi("has_param", {name: "/robot_description"});
-        if (reply.exists && !view.displays.some((d) => d.kind === "robot")) addDisplay({kind: "robot"});
-      } catch (err) {
-        // rosapi not served: the robot model is added by hand
+    // a robot model for each robot_description parameter (several robots: /tb3_0/..., with
+    // the tf_prefix parameter beside it naming their frames' prefix)
+    if (robotsSearched) return;
+    robotsSearched = true;
+    try {
+      const {names} = await app.conn.rosapi("get_param_names");
+      for (const param of names.filter((n) => n === "/robot_description" || n.endsWith("/robot_description"))) {
+        if (view.displays.some((d) => d.kind === "robot" && d.param === param) || view.removedTopics.has(param)) continue;
+        const ns = param.slice(0, -"robot_description".length);
+        let prefix = "";
+        if (ns !== "/") {
+          const reply = await app.conn.rosapi("get_param", {name: ns + "tf_prefix", default: "\"\""});
+          try {
+            prefix = String(JSON.parse(reply.value) || "");
+          } catch (err) {
+            prefix = "";
+          }
+        }
+        if (!view.displays.some((d) => d.kind === "robot" && d.param === param)) {
+          addDisplay({kind: "robot", param, options: {prefix}});
+        }
       }
+    } catch (err) {
+      // rosapi not served: robot models are added by hand
+    } finally {
+      robotsSearched = false;
     }
   }
+  let robotsSearched = false;
 
   // -- the first displays ----------------------------------------------------------------
 
@@ -329,6 +378,12 @@ export function createView(app, el) {
   app.onGraph((graph) => {
     renderAddChoices();
     autoAddTopics(graph);
+    // the tools' topics offered: every namespace's (a robot under tb3_0/ has its own)
+    for (const [key, spec] of Object.entries(TOOLS)) {
+      const names = new Set([spec.topic, ...graph.topics.map((t) => t.name)
+        .filter((n) => n.endsWith(spec.topic))]);
+      datalist(`view3d-tool-${key}`, [...names].sort());
+    }
   });
 
 
