@@ -145,6 +145,15 @@ class Page:
         px, py = self.project(x, y, z)
         return self.js(f"{V}.scene3d.pixel({px}, {py})")
 
+    def wait_pixel(self, point: tuple, condition: str, timeout: float = 5_000) -> None:
+        """Wait until the colour drawn at ``point`` (of the fixed frame) meets ``condition``, a JS
+        expression of r, g, b (the scene may still be taking the last tf in)."""
+        px, py = self.project(*point)
+        try:
+            self.wait(f"(([r, g, b]) => {condition})({V}.scene3d.pixel({px}, {py}))", timeout)
+        except playwright_api.TimeoutError:
+            raise AssertionError(f"the colour at {point} is {self.pixel(*point)}, not {condition}") from None
+
     def look(self, target, eye) -> None:
         self.js(f"{V}.scene3d.lookAt({json.dumps(list(target))}, {json.dumps(list(eye))})")
 
@@ -218,10 +227,9 @@ def test_every_display_draws_and_bad_ones_say_why(page):
     assert "nowhere" in status.inner_text()
     # drawn: the light blue CUBE marker, the map's unknown corner (Rviz's grey green)
     page.look((0.5, -0.5, 0), (4.5, -6.5, 5))
-    r, g, b, _ = page.pixel(4.0, -2.4, 0.5)  # marker "shapes"/1, a CUBE of (0.2, 0.7, 1.0)
-    assert b > 180 and g > 110 and r < 110, (r, g, b)
-    r, g, b, _ = page.pixel(3.5, 3.5, 0.0)  # map cells [150:, 150:] are unknown (-1)
-    assert g > r + 10 and abs(g - b) < 25 and 90 < g < 190, (r, g, b)
+    # marker "shapes"/1, a CUBE of (0.2, 0.7, 1.0); map cells [150:, 150:] are unknown (-1)
+    page.wait_pixel((4.0, -2.4, 0.5), "b > 180 && g > 110 && r < 110")
+    page.wait_pixel((3.5, 3.5, 0.0), "g > r + 10 && Math.abs(g - b) < 25 && g > 90 && g < 190")
     rendered = page.js(f"{V}.scene3d.stats.rendered")
     page.wait(f"{V}.scene3d.stats.rendered > {rendered} + 5")  # the scan and tf keep it drawing
     page.shot("view3d_overview")
@@ -230,10 +238,10 @@ def test_every_display_draws_and_bad_ones_say_why(page):
 def test_the_robot_model_has_every_geometry_and_mesh(page):
     robot = page.wait_status("/robot_description", "ok")
     assert robot["received"] == 1
-    page.wait(f"{V}.displays.find((d) => d.kind === 'robot').meshes.pending === 0 && "
-              f"{V}.displays.find((d) => d.kind === 'robot').meshes.loaded.size === 3")
+    first = f"{V}.displays.find((d) => d.source === '/robot_description')"
+    page.wait(f"{first}.meshes.pending === 0 && {first}.meshes.loaded.size === 3")
     info = page.js(f"""(() => {{
-      const robot = {V}.displays.find((d) => d.kind === 'robot');
+      const robot = {first};
       const links = {{}};
       for (const [name, anchor] of robot.links) {{
         let meshes = 0;
@@ -254,14 +262,11 @@ def test_the_robot_model_has_every_geometry_and_mesh(page):
     page.js(f"{V}.setFixed('base_footprint')")
     page.wait(f"{V}.scene3d.fixed === 'base_footprint'")
     page.look((0, 0, 0.15), (0.6, 1.2, 0.8))
-    r, g, b, _ = page.pixel(0.12, 0.15, 0.09)  # the side of the box of base_link, URDF blue
-    assert b > r + 60 and b > g + 40, (r, g, b)
-    r, g, b, _ = page.pixel(0, 0, 0.2)  # the pyramid on base_scan (z 0.13 + up to 0.2)
-    assert r > g + 60 and r > b + 60, (r, g, b)
-    r, g, b, _ = page.pixel(0.2 + 0.05, 0, 0.05)  # the wedge on bumper
-    assert r > 150 and g > 120 and b < 90, (r, g, b)
-    r, g, b, _ = page.pixel(-0.12, 0.1, 0.25)  # the octahedron on antenna
-    assert g > r + 50 and g > b + 30, (r, g, b)
+    # the side of the box of base_link, URDF blue
+    page.wait_pixel((0.12, 0.15, 0.09), "b > r + 60 && b > g + 40")
+    page.wait_pixel((0, 0, 0.2), "r > g + 60 && r > b + 60")  # the pyramid on base_scan
+    page.wait_pixel((0.25, 0, 0.05), "r > 150 && g > 120 && b < 90")  # the wedge on bumper
+    page.wait_pixel((-0.12, 0.1, 0.25), "g > r + 50 && g > b + 30")  # the octahedron on antenna
     page.js(f"{V}.setEnabled({V}.displays.find((d) => d.kind === 'tf'), true)")
     page.shot("view3d_robot")
     page.js(f"{V}.setFixed('map')")
