@@ -21,6 +21,7 @@ import json
 import math
 import os
 import time
+import xmlrpc.client
 from pathlib import Path
 
 import pytest
@@ -279,6 +280,15 @@ def test_the_robot_model_has_every_geometry_and_mesh(page):
     base = page.js(f"{V}.displays.find((d) => d.source === '/second/robot_description')"
                    ".links.get('base_footprint').matrixWorld.elements.slice(12, 14)")
     assert base == pytest.approx([-1.0, 2.0], abs=1e-6)
+    # a new description is drawn when the parameter changes; a broken one says why
+    master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{page.system.port}/")
+    master.setParam("/test", "/second/robot_description",
+                    '<robot name="r"><link name="base_footprint"><visual><geometry>'
+                    '<sphere radius="0.3"/></geometry></visual></link></robot>')
+    page.wait(f"{V}.displays.find((d) => d.source === '/second/robot_description').links.size === 1")
+    master.setParam("/test", "/second/robot_description", "<robot><link")
+    broken = page.wait_status("/second/robot_description", "error")
+    assert broken["text"].startswith("the robot description is not valid XML")
 
 
 def test_markers_namespaces_and_lifetimes(page):
