@@ -57,12 +57,16 @@ class System:
         self.port = free_port()
         self.procs = []
         self.start([PYTHON, "-m", "minros", "core", "-p", str(self.port)])
-        wait_for_master(self.port)
-        self.sources = self.start([PYTHON, str(WEB / "scene_sources.py"), "--all"])
-        self.sources.read_until("READY", timeout=30)
-        self.web_port = free_port()
-        self.web = self.start([PYTHON, "-m", "minros", "web", "--port", str(self.web_port)])
-        self.web.read_until("listening on", timeout=30)
+        try:
+            wait_for_master(self.port)
+            self.sources = self.start([PYTHON, str(WEB / "scene_sources.py"), "--all"])
+            self.sources.read_until("READY", timeout=30)
+            self.web_port = free_port()
+            self.web = self.start([PYTHON, "-m", "minros", "web", "--port", str(self.web_port)])
+            self.web.read_until("listening on", timeout=30)
+        except BaseException:
+            self.stop()  # no fixture stops what never came up
+            raise
 
     def env(self) -> dict:
         return ros_env(self.port, self.home, {"ROS_PACKAGE_PATH": str(WEB)})

@@ -33,12 +33,17 @@ class System:
         self.secret = tmp / "secret.stl"
         self.port = free_port()
         self.procs = [Proc([PYTHON, "-m", "minros", "core", "-p", str(self.port)], self.env())]
-        wait_for_master(self.port)
-        master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{self.port}/")
-        code, msg, _ = master.setParam("/test", "/robot_description", (PKG / "urdf" / "robot.urdf").read_text())
-        assert code == 1, msg
-        self.web, self.web_port = start_web(self.port, self.home, env=self.extra)
-        self.procs.append(self.web)
+        try:
+            wait_for_master(self.port)
+            master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{self.port}/")
+            code, msg, _ = master.setParam("/test", "/robot_description",
+                                           (PKG / "urdf" / "robot.urdf").read_text())
+            assert code == 1, msg
+            self.web, self.web_port = start_web(self.port, self.home, env=self.extra)
+            self.procs.append(self.web)
+        except BaseException:
+            self.stop()  # no fixture stops what never came up
+            raise
 
     @property
     def extra(self) -> dict:
