@@ -21,6 +21,7 @@ SCHEMA_ENCODING = "ros1msg"
 MESSAGE_DATA = 0x01
 TIME = 0x02
 SERVICE_CALL_RESPONSE = 0x03
+FETCH_ASSET_RESPONSE = 0x04
 # client -> server binary opcodes
 CLIENT_MESSAGE_DATA = 0x01
 SERVICE_CALL_REQUEST = 0x02
@@ -31,6 +32,8 @@ INFO, WARNING, ERROR = 0, 1, 2
 _MESSAGE_HEAD = struct.Struct("<BIQ")
 _TIME = struct.Struct("<BQ")
 _SERVICE_HEAD = struct.Struct("<BIII")
+_ASSET_HEAD = struct.Struct("<BIBI")
+FETCH_ASSET_SUCCESS, FETCH_ASSET_ERROR = 0, 1
 
 
 class ProtocolError(ValueError):
@@ -55,6 +58,16 @@ def time_frame(ns: int) -> bytes:
 def service_call_response(service_id: int, call_id: int, encoding: str, payload: bytes) -> bytes:
     enc = encoding.encode("utf-8")
     return _SERVICE_HEAD.pack(SERVICE_CALL_RESPONSE, service_id, call_id, len(enc)) + enc + bytes(payload)
+
+
+def fetch_asset_response(request_id: int, data: Optional[bytes] = None,
+                         error: str = "") -> bytes:
+    """A fetchAsset answer: opcode, request id, status (0 success, 1 error), the error text's
+    length and text, then the asset's bytes (success) or nothing."""
+    if data is not None:
+        return _ASSET_HEAD.pack(FETCH_ASSET_RESPONSE, request_id, FETCH_ASSET_SUCCESS, 0) + data
+    text = error.encode("utf-8")
+    return _ASSET_HEAD.pack(FETCH_ASSET_RESPONSE, request_id, FETCH_ASSET_ERROR, len(text)) + text
 
 
 def dumps(obj: Mapping[str, Any]) -> str:

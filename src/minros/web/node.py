@@ -6,7 +6,10 @@ Used by ``minros web`` (minros.cli.web) and by the executables that roslaunch an
 server reads its settings from private parameters, with rosbridge's and foxglove_bridge's
 names: ``~port``, ``~address``, ``~topics_glob``, ``~services_glob``, ``~params_glob``,
 ``~max_message_size``, ``~unregister_timeout``, ``~use_compression``, plus ``~token`` and
-``~allow_origin`` (``--allow-origin``: one origin, or a list). Once listening, the node sets
+``~allow_origin`` (``--allow-origin``: one origin, or a list) and foxglove_bridge's
+``~asset_uri_allowlist`` (regular expressions of the ``package://`` and ``file://`` URLs the
+page's 3D view and Foxglove's ``fetchAsset`` may read; see :mod:`minros.web.assets`; also read
+by ``minros web``, as ``_asset_uri_allowlist:=...``). Once listening, the node sets
 ``~actual_port`` to the port it got, as rosbridge_websocket does (``~port`` 0 picks a free one).
 """
 
@@ -44,6 +47,8 @@ class Settings:
     allow_origins: List[str] = field(default_factory=list)
     #: set ~actual_port once listening (the launch-file nodes, as rosbridge_websocket does)
     set_actual_port: bool = False
+    #: the asset allow-list (None: minros.web.assets' default, or ~asset_uri_allowlist)
+    asset_uri_allowlist: Optional[List[str]] = None
 
 
 def parse_globs(value: Any) -> List[str]:
@@ -103,6 +108,9 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
                              params_glob=settings.params_glob, graph_interval=settings.graph_interval,
                              unregister_timeout=settings.unregister_timeout))
     rosapi = Rosapi(state, settings.topics_glob, settings.services_glob, settings.params_glob)
+    allowlist = settings.asset_uri_allowlist
+    if allowlist is None:
+        allowlist = asset_allowlist(minros.get_param("~asset_uri_allowlist", None))
     if settings.rosapi:
         register_rosapi(rosapi)
     server = None
@@ -115,7 +123,7 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
                                send_timeout=settings.send_timeout,
                                max_message_size=settings.max_message_size,
                                compression=settings.compression, trace=settings.trace,
-                               allow_origins=settings.allow_origins)
+                               allow_origins=settings.allow_origins, asset_allowlist=allowlist)
         except ValueError as exc:
             print(f"minros web: error: {exc}", file=sys.stderr)
             minros.signal_shutdown("bad settings")
@@ -165,6 +173,18 @@ def _banner(server: Any, settings: Settings) -> str:
         f"  video                  {url}/streams{token}   (/stream?topic=..., /snapshot?topic=...)",
     ] + ([f"  wire trace             {url}/{token}#wire   (following {' '.join(settings.trace)})"]
          if settings.trace else []))
+
+
+def asset_allowlist(value: Any) -> List[str]:
+    """foxglove_bridge's ``~asset_uri_allowlist``: a list of regular expressions (one text is
+    one expression); unset, :data:`minros.web.assets.DEFAULT_ALLOWLIST`."""
+    from minros.web.assets import DEFAULT_ALLOWLIST
+
+    if value is None:
+        return list(DEFAULT_ALLOWLIST)
+    if isinstance(value, str):
+        return [value]
+    return [str(v) for v in value]
 
 
 def _origins(value: Any) -> List[str]:

@@ -29,6 +29,9 @@ are pushed:
 ``wire_watch``     the steps of the wire traces the server follows (``--trace``), then what
                    changes, as ``wire`` frames: ``steps`` (added or changed, by ``id``),
                    ``removed`` ids, ``status`` (files, problems); the first has ``reset``
+``scene_watch``,   the 3D view's: tf into a fixed frame, displays of topics and of the robot
+``display_add``,   model, interactive marker feedback (:mod:`minros.web.scene`; clouds, scans
+...                and maps come as binary frames)
 =================  ==========================================================================
 
 The first frame the server sends is ``hello`` (node name, how the graph is read, the debug
@@ -52,6 +55,7 @@ from minros.web.convert import populate_message
 from minros.web.outbox import Outbox
 from minros.web.rosapi import Graph
 from minros.web.rosbridge import OpError, RosbridgeSession, _check
+from minros.web.scene import SceneHub, SceneSession
 from minros.web.state import Incoming, WebState, flatten_params
 from minros.web.wiretrace import WireFeed
 
@@ -89,6 +93,7 @@ class PageHub:
     def __init__(self, state: WebState, wire: Optional[WireFeed] = None) -> None:
         self.state = state
         self.wire = wire
+        self.scene = SceneHub(state)
         self.log = pagemodel.LogRing()
         self.sessions: Dict[int, PageSession] = {}
         self.lock = threading.Lock()
@@ -276,6 +281,8 @@ class PageSession(RosbridgeSession):
             "dynrec_set": self.dynrec_set, "pub_start": self.pub_start,
             "pub_stop": self.pub_stop, "wire_watch": self.wire_watch,
         })
+        self.scene = SceneSession(self, hub.scene)
+        self.ops.update(self.scene.ops)
         hub.add(self)
 
     def start(self) -> None:
@@ -369,6 +376,7 @@ class PageSession(RosbridgeSession):
         self.outbox.open_slot(("page", "stats"), json.dumps, maxlen=1)
 
     def tick(self, now: float) -> None:
+        self.scene.tick()
         with self.page_lock:
             meters = list(self.stats_topics.items())
         if not meters:
@@ -706,6 +714,7 @@ class PageSession(RosbridgeSession):
             self.unplot({"id": plot_id})
         for echo_id in echoes:
             self.unecho({"id": echo_id})
+        self.scene.close()
         super().close()
 
 

@@ -7,7 +7,10 @@ minros). A connection is told apart by:
   ``minros.page.v1`` (the page at ``/``) -> :class:`~minros.web.page.PageSession`; no (or any
   other) subprotocol -> :class:`RosbridgeSession` (roslibjs and roslibpy ask for none);
 * for plain HTTP (no ``Upgrade``), the path: ``/stream``, ``/snapshot``, ``/stream_viewer``,
-  ``/streams`` (web_video_server's endpoints), else the static files of ``minros/web/static``.
+  ``/streams`` (web_video_server's endpoints), ``/pkg/<package>/<path>`` (a mesh or texture of
+  a ROS package, for the 3D view: ``package://<package>/<path>`` under
+  :mod:`minros.web.assets`' rules, which Foxglove's ``fetchAsset`` follows too), else the static
+  files of ``minros/web/static``.
 
 Each WebSocket client has an :class:`~minros.web.outbox.Outbox` and a writer thread: ROS
 callbacks only queue, the writer encodes and sends. A watchdog closes a client whose send has
@@ -46,8 +49,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import minros
 from minros import rosenv
+from minros.web import assets, video
 from minros.web import foxglove_protocol as fp
-from minros.web import video
 from minros.web.foxglove import FoxgloveSession
 from minros.web.origin import OriginPolicy
 from minros.web.outbox import Outbox
@@ -68,6 +71,9 @@ DEFAULT_SEND_TIMEOUT = 10.0
 WEB_LIMITS = admission.Limits(max_connections=512, head_timeout=10.0)
 #: seconds between two renewals of a session's activity (admission's idleness)
 ACTIVITY_INTERVAL = 0.5
+#: content types of the mesh files /pkg/ serves that mimetypes does not know
+_MESH_TYPES = {"stl": "model/stl", "dae": "model/vnd.collada+xml", "obj": "model/obj",
+               "mtl": "model/mtl", "urdf": "application/xml", "xacro": "application/xml"}
 
 
 class _OneLine(logging.Filter):
@@ -285,7 +291,8 @@ class WebServer:
                  send_timeout: float = DEFAULT_SEND_TIMEOUT,
                  max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE, compression: bool = False,
                  static_dir: Path = STATIC_DIR, trace: Sequence[str] = (),
-                 allow_origins: Sequence[str] = ()) -> None:
+                 allow_origins: Sequence[str] = (),
+                 asset_allowlist: Sequence[str] = assets.DEFAULT_ALLOWLIST) -> None:
         self.state = state
         self.host = host
         self.port = port
@@ -313,6 +320,9 @@ class WebServer:
         #: the Host and Origin checks (OriginError naming a malformed --allow-origin)
         self.origins = OriginPolicy(allow_origins, _local_names(host))
         self._refusals_logged: Dict[str, float] = {}
+        #: which package files /pkg/ and Foxglove's fetchAsset serve (ValueError naming a
+        #: pattern that does not parse)
+        self.asset_patterns = assets.compile_allowlist(asset_allowlist)
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -500,6 +510,8 @@ class WebServer:
             params = self._video_params(query)
             return self._response(200, video.viewer_page(params, query).encode(),
                                   "text/html; charset=utf-8")
+        if path.startswith("/pkg/"):
+            return self._package_file(path)
         if path == "/streams":
             graph = self.state.refresh_graph()
             topics = [t for t, ty in graph.topic_types.items() if video.is_image_type(ty)]
@@ -521,6 +533,19 @@ class WebServer:
         if content_type.startswith("text/") or content_type.endswith("javascript"):
             content_type += "; charset=utf-8"
         return self._response(200, target.read_bytes(), content_type)
+
+    def _package_file(self, path: str) -> Any:
+        """``/pkg/<package>/<path>``: the file ``package://<package>/<path>`` names, if the
+        asset rules allow it (the path stays percent-encoded: the rules decode it)."""
+        uri = assets.PACKAGE_PREFIX + path[len("/pkg/"):]
+        try:
+            data = assets.read(uri, self.asset_patterns)
+        except assets.AssetError as exc:
+            return self._text(exc.status, f"minros web: {exc}")
+        suffix = uri.rsplit(".", 1)[-1].lower()
+        content_type = _MESH_TYPES.get(suffix) or mimetypes.guess_type("x." + suffix)[0]
+        return self._response(200, data, content_type or "application/octet-stream",
+                              [("Cache-Control", "no-cache")])
 
     # -- video -----------------------------------------------------------------------------
 
@@ -615,7 +640,8 @@ class WebServer:
         kind = "Foxglove" if foxglove else "page" if page else "rosbridge"
         if foxglove:
             client.session = FoxgloveSession(client_id, self.state, client.outbox, client.close,
-                                             server_name=self.name)
+                                             server_name=self.name,
+                                             asset_patterns=self.asset_patterns)
         elif page:
             client.session = PageSession(client_id, self.state, client.outbox, client.close,
                                          self.page_hub, rosapi=self.rosapi)

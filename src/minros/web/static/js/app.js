@@ -11,6 +11,7 @@ import {createGraphView} from "./views/graph.js";
 import {createTopicsView} from "./views/topics.js";
 import {createPlotView} from "./views/plot.js";
 import {createImagesView} from "./views/images.js";
+import {createView3dView} from "./views/view3d.js";
 import {createTurtlesimView} from "./views/turtlesim.js";
 import {createParamsView} from "./views/params.js";
 import {createServicesView} from "./views/services.js";
@@ -24,6 +25,7 @@ const VIEWS = [
   ["topics", "Topics", createTopicsView],
   ["plot", "Plot", createPlotView],
   ["images", "Images", createImagesView],
+  ["3d", "3D", createView3dView],
   ["turtlesim", "Turtlesim", createTurtlesimView],
   ["params", "Parameters", createParamsView],
   ["services", "Services", createServicesView],
