@@ -185,6 +185,19 @@ def base_env(scratch: Path, pythonpath: Sequence[Path], package_path: Sequence[P
     return env
 
 
+#: For minros, what catkin_make does for a package's messages: a stub package (two lines per
+#: module) in the devel space, so ``import <pkg>.msg`` works before anything imported minros.
+#: A package that is a Python package already (genpy) is left to minros's import hook.
+WRITE_STUBS = r"""
+import importlib.util, sys
+existing = [n for n in sys.argv[2:] if importlib.util.find_spec(n) is not None]
+from minros.msgs.importer import write_stub_package
+for name in sys.argv[2:]:
+    if name not in existing:
+        write_stub_package(name, sys.argv[1])
+"""
+
+
 def message_overlays(suite: Suite, root: Path, out: Path) -> None:
     """For minros: a package folder per test message set that is not a package folder already
     (genpy's test/msg), so minros's import hook serves ``<pkg>.msg`` from the checkout."""
@@ -279,6 +292,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             (shim / rel).write_text(text)
         generated = scratch / "debian-gen"
         overlays = scratch / "minros-packages"
+        devel = scratch / "minros-devel"
         rows = []
         for suite in suites:
             root = roots[suite.repo].resolve()
@@ -286,8 +300,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             for side in sides:
                 if side == "minros":
                     message_overlays(suite, root, overlays)
-                    env = base_env(scratch, [shim], [overlays, root])
+                    env = base_env(scratch, [shim, devel], [overlays, root])
                     python = args.minros_python
+                    if suite.messages:
+                        subprocess.run([python, "-c", WRITE_STUBS, str(devel),
+                                        *[name for name, _ in suite.messages]],
+                                       env=env, check=True, timeout=120)
                 else:
                     generate_debian_messages(deb_python, suite, root, generated)
                     env = base_env(scratch, [shim, generated], [root, Path("/usr/share")])

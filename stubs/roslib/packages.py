@@ -8,40 +8,25 @@ from pathlib import Path
 from typing import Any, Callable, List
 
 from minros import packages
+from minros.packages import (  # noqa: F401
+    MANIFEST_FILE,
+    PACKAGE_FILE,
+    InvalidROSPkgException,
+    MultipleNodesException,
+    ROSPkgException,
+    resource_file,
+)
 from minros.workspace.executables import find_executables
 
-MANIFEST_FILE = "manifest.xml"
-PACKAGE_FILE = "package.xml"
 SRC_DIR = "src"
 ROS_PACKAGE_PATH = "ROS_PACKAGE_PATH"
 ROS_ROOT = "ROS_ROOT"
 
 
-class ROSPkgException(Exception):
-    """Base of roslib.packages' errors."""
-
-
-class InvalidROSPkgException(ROSPkgException):
-    """A package is missing or broken."""
-
-
-class MultipleNodesException(ROSPkgException):
-    """Several programs of one name in a package."""
-
-
 def get_pkg_dir(package: str, required: bool = True, ros_root: Any = None,
                 ros_package_path: Any = None) -> str | None:
     """The folder of ``package``; InvalidROSPkgException (required) or None when missing."""
-    folder = packages.find_package(package)
-    if folder is None:
-        if required:
-            rpp = os.environ.get(ROS_PACKAGE_PATH, "")
-            raise InvalidROSPkgException(
-                f"Cannot locate installation of package {package}: [rospack] Error: package "
-                f"'{package}' not found. ROS_ROOT[{os.environ.get(ROS_ROOT)}] "
-                f"ROS_PACKAGE_PATH[{rpp}]")
-        return None
-    return str(folder)
+    return packages.get_pkg_dir(package, required)
 
 
 def get_pkg_subdir(package: str, subdir: str, required: bool = True, env: Any = None) -> str | None:
@@ -53,10 +38,6 @@ def get_pkg_subdir(package: str, subdir: str, required: bool = True, env: Any = 
     if required and not os.path.isdir(path):
         os.makedirs(path, exist_ok=True)
     return path
-
-
-def resource_file(package: str, subdir: str, resource_name: str) -> str:
-    return os.path.join(get_pkg_dir(package) or "", subdir, resource_name)
 
 
 def get_dir_pkg(d: str) -> tuple:
