@@ -150,7 +150,9 @@ def run_pytest(python: str, suite: Suite, root: Path, env: Dict[str, str], scrat
             "--rootdir", str(root), "-q", "--timeout", "120", f"--junitxml={report}",
             "-o", "junit_family=xunit1", "--continue-on-collection-errors", *[str(root / p) for p in suite.paths]]
     try:
-        proc = subprocess.run(argv, cwd=root, env=env, capture_output=True, text=True,
+        # not in the checkout: python -m puts the working folder first on sys.path, where a
+        # checkout folder (geometry/tf) would shadow the package under test
+        proc = subprocess.run(argv, cwd=scratch, env=env, capture_output=True, text=True,
                               timeout=SUITE_TIMEOUT)
         output = proc.stdout + proc.stderr
     except subprocess.TimeoutExpired as exc:

@@ -395,6 +395,11 @@ class XmlRpcServer:
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(2.0)
 
+    def serve_forever(self) -> None:
+        """Block until :meth:`shutdown` (the accept thread serves; this is for callers written
+        for socketserver, whose server loop runs in the calling thread)."""
+        self._stopping.wait()
+
     def connection_count(self) -> int:
         with self._conns_lock:
             return len(self._conns)
