@@ -30,6 +30,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
+    "clean": ("minros.cli.clean", "check the size of the ROS log files and purge them (rosclean)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -51,6 +52,7 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "rosbag": ("bag", []),
     "rostest": ("test", []),
     "rosconsole": ("console", []),
+    "rosclean": ("clean", []),
 }
 
 
@@ -129,6 +131,7 @@ catkin_make = _alias("catkin_make")
 rosbag = _alias("rosbag")
 rostest = _alias("rostest")
 rosconsole = _alias("rosconsole")
+rosclean = _alias("rosclean")
 
 if __name__ == "__main__":
     sys.exit(main())
