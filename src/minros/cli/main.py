@@ -31,6 +31,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
     "clean": ("minros.cli.clean", "check the size of the ROS log files and purge them (rosclean)"),
+    "wtf": ("minros.cli.wtf", "check the ROS environment and the running graph (roswtf)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -53,6 +54,7 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "rostest": ("test", []),
     "rosconsole": ("console", []),
     "rosclean": ("clean", []),
+    "roswtf": ("wtf", []),
 }
 
 
@@ -132,6 +134,7 @@ rosbag = _alias("rosbag")
 rostest = _alias("rostest")
 rosconsole = _alias("rosconsole")
 rosclean = _alias("rosclean")
+roswtf = _alias("roswtf")
 
 if __name__ == "__main__":
     sys.exit(main())
