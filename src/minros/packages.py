@@ -188,6 +188,19 @@ def resource_file(package: str, subdir: str, resource_name: str) -> str:
     return os.path.join(get_pkg_dir(package) or "", subdir, resource_name)
 
 
+def get_dir_pkg(d: str) -> tuple:
+    """``(package folder, package name)`` of the package folder ``d`` is in, or
+    ``(None, None)`` (roslib.packages.get_dir_pkg)."""
+    d = os.path.abspath(d)
+    while True:
+        if os.path.isfile(os.path.join(d, PACKAGE_FILE)) or os.path.isfile(os.path.join(d, MANIFEST_FILE)):
+            return d, manifest_name(Path(d)) or os.path.basename(d)
+        parent = os.path.dirname(d)
+        if parent == d:
+            return None, None
+        d = parent
+
+
 def manifest_file(package: str, required: bool = True) -> Optional[str]:
     """The ``manifest.xml`` of a rosbuild package (a catkin package has none: with
     ``required`` that is InvalidROSPkgException, as roslib.manifest says)."""

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any, Callable, List
 
 from minros import packages
@@ -14,6 +13,7 @@ from minros.packages import (  # noqa: F401
     InvalidROSPkgException,
     MultipleNodesException,
     ROSPkgException,
+    get_dir_pkg,
     resource_file,
 )
 from minros.workspace.executables import find_executables
@@ -38,18 +38,6 @@ def get_pkg_subdir(package: str, subdir: str, required: bool = True, env: Any = 
     if required and not os.path.isdir(path):
         os.makedirs(path, exist_ok=True)
     return path
-
-
-def get_dir_pkg(d: str) -> tuple:
-    """(package folder, package name) of the package holding folder ``d``, or (None, None)."""
-    d = os.path.abspath(d)
-    while True:
-        if os.path.isfile(os.path.join(d, PACKAGE_FILE)) or os.path.isfile(os.path.join(d, MANIFEST_FILE)):
-            return d, packages.manifest_name(Path(d)) or os.path.basename(d)
-        parent = os.path.dirname(d)
-        if parent == d:
-            return None, None
-        d = parent
 
 
 def list_pkgs_by_path(path: str, packages_: List[str] | None = None, cache: Any = None,

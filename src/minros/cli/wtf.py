@@ -541,7 +541,7 @@ def main(argv: Sequence[str], prog: str = "minros wtf") -> int:
         if options.launch_files:
             ctx = WtfContext.from_roslaunch(options.launch_files)
         else:
-            _pkg_dir, pkg = packages_get_dir_pkg(os.getcwd())
+            _pkg_dir, pkg = packages.get_dir_pkg(os.getcwd())
             if pkg:
                 print("Package:", pkg)
                 ctx = WtfContext.from_package(pkg)
@@ -574,20 +574,6 @@ def main(argv: Sequence[str], prog: str = "minros wtf") -> int:
         print("\nAborting checks, partial results summary:\n")
     print_results(ctx)
     return 0
-
-
-def packages_get_dir_pkg(d: str) -> Tuple[Optional[str], Optional[str]]:
-    """The package the folder ``d`` is in (its folder and name), or ``(None, None)``."""
-    from pathlib import Path
-
-    d = os.path.abspath(d)
-    while True:
-        if os.path.isfile(os.path.join(d, "package.xml")) or os.path.isfile(os.path.join(d, "manifest.xml")):
-            return d, packages.manifest_name(Path(d)) or os.path.basename(d)
-        parent = os.path.dirname(d)
-        if parent == d:
-            return None, None
-        d = parent
 
 
 def _master_online(uri: str) -> bool:

@@ -42,6 +42,51 @@ class Node(NodeSpec):
     def node_type(self) -> str:
         return self.type
 
+    @property
+    def machine_name(self) -> str | None:
+        return self.machine
+
+    def xmltype(self) -> str:
+        return "node"
+
+    def xmlattrs(self) -> List[Tuple[str, Any]]:
+        return node_xmlattrs(self)
+
+    def to_xml(self) -> str:
+        """The node as launch XML (private parameters are not part of it)."""
+        return node_to_xml(self)
+
+    def to_remote_xml(self) -> str:
+        return node_to_xml(self, remote=True)
+
+
+def _xml_escape(s: Any) -> Any:
+    """``s`` with ``< > & "`` escaped (other values as they are)."""
+    if isinstance(s, str):
+        from xml.sax.saxutils import escape
+
+        return escape(s, entities={'"': "&quot;"})
+    return s
+
+
+def node_xmlattrs(node: Any) -> List[Tuple[str, Any]]:
+    """The attributes of a node's XML element, as roslaunch writes them."""
+    return [("pkg", node.package), ("type", node.type), ("machine", node.machine),
+            ("ns", node.namespace), ("args", node.args), ("output", node.output),
+            ("cwd", node.cwd or None), ("respawn", node.respawn),
+            ("respawn_delay", node.respawn_delay), ("name", node.name or None),
+            ("launch-prefix", node.launch_prefix), ("required", node.required)]
+
+
+def node_to_xml(node: Any, remote: bool = False) -> str:
+    """A node as launch XML (its remappings and environment included)."""
+    tag = node.xmltype()
+    attrs = [(a, v) for a, v in node.xmlattrs() if v is not None and not (remote and a == "machine")]
+    out = f"<{tag} " + " ".join(f'{a}="{_xml_escape(v)}"' for a, v in attrs) + ">\n"
+    out += "".join(f'  <remap from="{a}" to="{b}" />\n' for a, b in node.remap_args)
+    out += "".join(f'  <env name="{a}" value="{b}" />\n' for a, b in node.env_args)
+    return out + f"</{tag}>"
+
 
 def get_or_generate_uuid(options_runid: str | None = None,
                          options_wait_for_master: bool = False) -> str:

@@ -275,8 +275,11 @@ class Loader:
 
     def __init__(self, env: Mapping[str, str] | None = None,
                  find: Callable[[str], Path | None] | None = None,
-                 run_commands: bool = True, args_only: bool = False) -> None:
+                 run_commands: bool = True, args_only: bool = False,
+                 check_machines: bool = True) -> None:
         self.config = LaunchConfig()
+        #: False for roslaunch's loader API, whose config checks machine names later
+        self.check_machines = check_machines
         self.args_only = args_only  # `roslaunch --ros-args`: read the <arg> declarations only
         self.env = os.environ if env is None else env
         self.find = find
@@ -597,7 +600,7 @@ class Loader:
             if bad:
                 raise self._err(scope, el, f"Invalid <{el.tag}> tag: {message}")
         machine = opt["machine"]
-        if machine and machine not in self.config.machines:
+        if machine and self.check_machines and machine not in self.config.machines:
             raise self._err(scope, el, f"unknown machine [{machine}]")
         spec = NodeSpec(
             package=pkg, type=node_type, name=name, namespace=child.ns, args=opt["args"] or "",
