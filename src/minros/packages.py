@@ -4,8 +4,11 @@ A package is a folder holding a ``package.xml``; its name is the manifest's ``<n
 (as rospack reads it), not the folder's (a rosbuild package, with a ``manifest.xml``, is named
 by its folder). Discovery walks each ROS_PACKAGE_PATH entry in
 order, does not descend into a package, skips folders holding ``CATKIN_IGNORE`` and hidden
-folders, and the first package found under a name wins. minros's bundled packages (message
-definitions, turtlesim, rospy_tutorials, ...) come last, so a workspace can override them.
+folders, and the first package found under a name wins. minros's bundled packages come last,
+so a workspace can override them: message definitions, turtlesim, rospy_tutorials, ..., and a
+``package.xml`` (with Debian's ROS version) for each ROS package whose Python API, nodes or
+tools minros provides (rospy, roslaunch, rosbag, ...), so ``rosversion``, ``rospack find`` and
+``roslib.load_manifest`` know them as on a real install.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from typing import Any, Dict, List, Optional
 BUILTIN_SHARE_DIRS: List[Path] = [Path(__file__).resolve().parent / "msgs" / "share"]
 
 _NAME_RE = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
+_VERSION_RE = re.compile(rb"<version(?:\s[^>]*)?>\s*([^<\s]+)\s*</version>")
 _cache: Dict[str, Dict[str, Path]] = {}
 _cache_lock = threading.Lock()
 
@@ -37,6 +41,17 @@ def manifest_name(package_dir: Path) -> Optional[str]:
     except OSError:
         return None
     match = _NAME_RE.search(head)
+    return match.group(1).decode("utf-8", "replace") if match else None
+
+
+def manifest_version(package_dir: Path) -> Optional[str]:
+    """The ``<version>`` declared in ``package_dir/package.xml``, or None (rosversion's
+    "<unversioned>")."""
+    try:
+        head = (package_dir / "package.xml").read_bytes()[:65536]
+    except OSError:
+        return None
+    match = _VERSION_RE.search(head)
     return match.group(1).decode("utf-8", "replace") if match else None
 
 

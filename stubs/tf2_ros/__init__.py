@@ -4,3 +4,12 @@ from minros.tf.broadcaster import StaticTransformBroadcaster, TransformBroadcast
 from minros.tf.buffer import *  # noqa: F403
 from minros.tf.listener import TransformListener  # noqa: F401
 from tf2_py import *  # noqa: F403 (tf2_ros re-exports tf2_py, the exceptions included)
+
+
+def __getattr__(name: str):
+    # BufferClient/BufferServer sit on actionlib: imported when first used
+    if name in ("BufferClient", "BufferServer"):
+        import minros.tf2_buffer
+
+        return getattr(minros.tf2_buffer, name)
+    raise AttributeError(f"module 'tf2_ros' has no attribute {name!r}")

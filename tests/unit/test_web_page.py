@@ -266,7 +266,7 @@ def replies(outbox: Outbox) -> list:
             return out
         slot, item = got
         frames = item if slot is None else slot.render(item)
-        for frame in frames if isinstance(frames, list) else [frames]:
+        for frame in [frames] if isinstance(frames, (str, bytes)) else frames:
             out.append(json.loads(frame))
 
 
@@ -332,7 +332,10 @@ def test_page_files_load_offline_and_ship_in_the_wheel():
     import re
     from pathlib import Path
 
-    import tomllib
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10: the same parser, from PyPI
+        import tomli as tomllib
 
     import minros.web
 

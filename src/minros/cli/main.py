@@ -24,6 +24,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "srv": ("minros.cli.srv", "show and hash service types (rossrv)"),
     "graph": ("minros.cli.graph", "draw the node/topic graph as DOT, SVG or PNG (rqt_graph)"),
     "pkg": ("minros.cli.pkg", "find and list packages (rospack)"),
+    "version": ("minros.cli.rosversion", "print a package's version or the ROS distribution (rosversion)"),
     "ws": ("minros.cli.ws", "catkin workspaces: init, create_pkg, make"),
     "web": ("minros.cli.web", "rosbridge, rosapi, Foxglove and video for browsers, on one port"),
     "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
@@ -47,6 +48,7 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "rossrv": ("srv", []),
     "rqt_graph": ("graph", []),
     "rospack": ("pkg", []),
+    "rosversion": ("version", []),
     "catkin_init_workspace": ("ws", ["init"]),
     "catkin_create_pkg": ("ws", ["create_pkg"]),
     "catkin_make": ("ws", ["make"]),
@@ -127,6 +129,7 @@ rosmsg = _alias("rosmsg")
 rossrv = _alias("rossrv")
 rqt_graph = _alias("rqt_graph")
 rospack = _alias("rospack")
+rosversion = _alias("rosversion")
 catkin_init_workspace = _alias("catkin_init_workspace")
 catkin_create_pkg = _alias("catkin_create_pkg")
 catkin_make = _alias("catkin_make")

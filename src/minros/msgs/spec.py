@@ -144,13 +144,16 @@ class MsgSpec:
     """A parsed message: fields, constants and the raw text it came from."""
 
     def __init__(self, full_name: str, fields: List[Field], constants: List[Constant],
-                 text: str, filename: str | None = None) -> None:
+                 text: str, filename: str | None = None,
+                 field_lines: Dict[str, int] | None = None) -> None:
         self.full_name = full_name
         self.package, _, self.short_name = full_name.rpartition("/")
         self.fields = fields
         self.constants = constants
         self.text = text
         self.filename = filename
+        #: field name -> line of ``filename`` declaring it (errors about a field cite it)
+        self.field_lines = field_lines or {}
 
     @property
     def names(self) -> List[str]:
@@ -291,7 +294,7 @@ def parse_msg(text: str, full_name: str, filename: str | None = None,
                                filename or full_name, lineno)
         seen[name] = lineno
         fields.append(Field(name, type_))
-    return MsgSpec(full_name, fields, constants, text, filename)
+    return MsgSpec(full_name, fields, constants, text, filename, seen)
 
 
 def split_srv_text(text: str) -> Tuple[str, str, int]:

@@ -121,7 +121,7 @@ class Master:
         except xmlrpc.client.Fault as exc:
             raise MasterFailure(f"{method}: {exc.faultString}") from None
         except (xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError) as exc:
-            raise MasterIOError(str(exc)) from None
+            raise MasterIOError(str(exc)) from exc  # a CallError's line is what tools print
         except OSError as exc:
             raise MasterIOError(str(exc)) from None
 

@@ -14,6 +14,7 @@ import threading
 from typing import Any, Callable, Dict, List, Optional, Set, Tuple
 
 import minros
+from minros.msgs import reader_for
 from minros.web import foxglove_protocol as fp
 from minros.web.outbox import Outbox
 from minros.web.rosapi import Graph
@@ -25,6 +26,9 @@ CAPABILITIES = ["clientPublish", "parameters", "parametersSubscribe", "services"
 QUEUE_LENGTH = 10
 QUEUE_BYTES = 32 << 20
 MAX_CALLS_IN_FLIGHT = 16
+#: subscriptions and advertised channels one client may hold (each costs memory; a channel
+#: a publisher and a master registration)
+MAX_PER_CLIENT = 10_000
 
 
 def _graph_maps(graph: Graph) -> Tuple[Dict[str, Set[str]], ...]:
@@ -223,6 +227,10 @@ class FoxgloveSession:
                 if sub_id in self.subscriptions:
                     self.error(f"Client subscription id {sub_id} was already used; ignoring subscription")
                     continue
+                if len(self.subscriptions) >= MAX_PER_CLIENT:
+                    self.error(f"this client has {MAX_PER_CLIENT} subscriptions already, the "
+                               f"most one client may have; ignoring subscription {sub_id}")
+                    continue
                 channel = self.channels.get(channel_id)
                 if channel is None:
                     self.error(f"Channel {channel_id} is not available; ignoring subscription")
@@ -274,6 +282,10 @@ class FoxgloveSession:
             if channel_id in self.client_channels:
                 self.error(f"Client channel {channel_id} was already advertised")
                 continue
+            if len(self.client_channels) >= MAX_PER_CLIENT:
+                self.error(f"this client advertised {MAX_PER_CLIENT} channels already, the most "
+                           f"one client may; ignoring channel {channel_id}")
+                continue
             if not self.state.topic_allowed(topic):
                 self.error(f"topic {topic} is not in the server's topics_glob")
                 continue
@@ -318,8 +330,10 @@ class FoxgloveSession:
         topic, cls = entry
         payload = bytes(frame.payload)
         try:  # a malformed payload stops here instead of breaking every subscriber
-            msg = cls()
-            msg.deserialize(payload)
+            # read from the bytes (every length checked against them before anything is built),
+            # never cls() first: a schema the client chose ("float64[100000000] a") would make
+            # the default instance take 800 MB before a 13-byte message was found short
+            msg = reader_for(cls)(payload)
         except Exception as exc:
             self.error(f"Dropping a message on {topic}: the payload is not a valid "
                        f"{cls._type}: {exc}")

@@ -149,14 +149,23 @@ def parameter_from_client(entry: Mapping[str, Any]) -> Tuple[str, Any, bool]:
         return name, None, True
     value = entry["value"]
     kind = entry.get("type")
-    if kind == "byte_array":
-        if not isinstance(value, str):
-            raise ProtocolError(f"setParameters: {name}: byte_array value must be base64 text")
-        return name, base64.b64decode(value), False
-    if kind == "float64":
-        return name, float(value), False
-    if kind == "float64_array":
-        return name, [float(v) for v in value], False
+    try:
+        if kind == "byte_array":
+            if not isinstance(value, str):
+                raise ValueError
+            return name, base64.b64decode(value, validate=True), False
+        if kind == "float64":
+            if isinstance(value, (str, bool)):
+                raise ValueError
+            return name, float(value), False
+        if kind == "float64_array":
+            if not isinstance(value, list) or any(isinstance(v, (str, bool)) for v in value):
+                raise ValueError
+            return name, [float(v) for v in value], False
+    except (TypeError, ValueError, OverflowError):
+        what = {"byte_array": "base64 text", "float64": "a number",
+                "float64_array": "a list of numbers"}[kind]
+        raise ProtocolError(f"setParameters: {name}: a {kind} value must be {what}") from None
     return name, value, False
 
 
@@ -230,6 +239,8 @@ def parse_text(text: str) -> Dict[str, Any]:
         obj = json.loads(text)
     except ValueError as exc:
         raise ProtocolError(f"Invalid JSON message: {exc}") from None
+    except RecursionError:  # json's C parser counts its depth against the recursion limit
+        raise ProtocolError("Invalid JSON message: nested too deeply to read") from None
     if not isinstance(obj, dict) or not isinstance(obj.get("op"), str):
         raise ProtocolError("JSON message must be an object with a string 'op'")
     return obj

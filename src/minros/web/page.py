@@ -146,6 +146,9 @@ class PageHub:
             if client is not None:
                 self._dynrec[server] = client  # now the most recently used
         if client is None:
+            # its Subscribers and our taps cannot both hold a topic of the node
+            self.state.share_topics([minros.resolve_name(f"{server}/{suffix}") for suffix in
+                                     ("parameter_descriptions", "parameter_updates")])
             client = Client(server, timeout=DYNREC_TIMEOUT)
             evicted = []
             with self.lock:

@@ -49,6 +49,7 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     # tf's tools (minros.tf): names as Debian's tf-tools and tf2-tools install them
     "tf2_ros": {
         "static_transform_publisher": "minros.tf.static_transform_publisher",
+        "buffer_server": "minros.nodes.tf2_ros.buffer_server",
     },
     "tf": {
         "static_transform_publisher": "minros.tf.tf_static_transform_publisher",
@@ -78,6 +79,25 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosmsg": {"rosmsg": "minros.cli.msg", "rossrv": "minros.cli.srv"},
     "rosconsole": {"rosconsole": "minros.cli.console"},
     "rostest": {"rostest": "minros.cli.rostest"},
+    "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
+    "image_transport": {"republish": "minros.nodes.image_transport.republish"},
+    "robot_state_publisher": {
+        "robot_state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher",
+        "state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher"},
+    "joint_state_publisher": {
+        "joint_state_publisher": "minros.nodes.joint_state_publisher.joint_state_publisher"},
+    # PyPI's xacro with minros's package lookup (the package folder holds the same program
+    # for <param command="$(find xacro)/xacro ...">)
+    "xacro": {"xacro": "minros.nodes.xacro.xacro", "xacro.py": "minros.nodes.xacro.xacro"},
+    "tf2_web_republisher": {
+        "tf2_web_republisher": "minros.nodes.tf2_web_republisher.tf2_web_republisher"},
+    # headless: ROS's axclient is a wxPython window
+    "actionlib_tools": {"axclient.py": "minros.nodes.actionlib_tools.axclient",
+                        "axclient": "minros.nodes.actionlib_tools.axclient"},
+    # topic_tools' programs (minros.topic_tools; ROS ships C++ relay/throttle/drop/mux)
+    "topic_tools": {name: f"minros.nodes.topic_tools.{name}" for name in (
+        "relay", "throttle", "drop", "mux", "transform", "mux_select", "mux_add",
+        "mux_delete", "mux_list")},
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...

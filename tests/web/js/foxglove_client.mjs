@@ -9,6 +9,7 @@
 //   node foxglove_client.mjs params URL NAME JSON_VALUE
 //   node foxglove_client.mjs graph URL NODE
 //   node foxglove_client.mjs bench URL TOPIC SECONDS
+// FOXGLOVE_CLIENT_ORIGIN=https://app.foxglove.dev sends that Origin, as the hosted app would.
 import { createRequire } from "node:module";
 
 const require = createRequire(import.meta.url);
@@ -37,7 +38,10 @@ function fail(text) {
 
 setTimeout(() => fail(`timed out after ${TIMEOUT_MS} ms in mode ${mode}`), TIMEOUT_MS).unref();
 
-const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+// FOXGLOVE_CLIENT_ORIGIN: send the Origin header a page of that site would (the Foxglove or
+// Lichtblick web app hosted there), as a browser does
+const origin = process.env.FOXGLOVE_CLIENT_ORIGIN;
+const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL], origin ? { origin } : {});
 ws.binaryType = "arraybuffer";
 const client = new FoxgloveClient({ ws });
 const channels = new Map();

@@ -1,0 +1,32 @@
+"""The bond state machine as data: (state, event) -> (next state, actions).
+
+Events: the sister's heartbeat (SisterAlive), its dead heartbeat (SisterDead), the three
+timeouts and our own Die. Actions are the Bond's methods of the same name. A pair missing
+from the table leaves the state as it is and does nothing.
+"""
+
+from __future__ import annotations
+
+from typing import Dict, Tuple
+
+WAITING = "SM.WaitingForSister"
+ALIVE = "SM.Alive"
+AWAIT_SISTER_DEATH = "SM.AwaitSisterDeath"
+DEAD = "SM.Dead"
+
+TRANSITIONS: Dict[Tuple[str, str], Tuple[str, Tuple[str, ...]]] = {
+    (WAITING, "ConnectTimeout"): (DEAD, ("Death",)),
+    (WAITING, "Die"): (DEAD, ("Death",)),
+    (WAITING, "SisterAlive"): (ALIVE, ("Connected",)),
+    (WAITING, "SisterDead"): (DEAD, ("Connected", "SisterDied", "Death")),
+    (ALIVE, "Die"): (AWAIT_SISTER_DEATH, ("StartDying",)),
+    (ALIVE, "HeartbeatTimeout"): (DEAD, ("Death",)),
+    (ALIVE, "SisterAlive"): (ALIVE, ("Heartbeat",)),
+    (ALIVE, "SisterDead"): (DEAD, ("SisterDied", "Death")),
+    (AWAIT_SISTER_DEATH, "DisconnectTimeout"): (DEAD, ("Death",)),
+    (AWAIT_SISTER_DEATH, "SisterDead"): (DEAD, ("Death",)),
+}
+
+
+def step(state: str, event: str) -> Tuple[str, Tuple[str, ...]]:
+    return TRANSITIONS.get((state, event), (state, ()))

@@ -1,0 +1,10 @@
+"""joint_state_publisher: the robot's movable joints on ``joint_states``, at their default
+positions or at what ``source_list`` topics say, with mimic joints following their joint and
+ROS's parameters (``rate``, ``publish_default_positions|velocities|efforts``, ``zeros``,
+``use_mimic_tags``, ``use_smallest_joint_limits``, ``dependent_joints``, ``delta``). The
+program is ``rosrun joint_state_publisher joint_state_publisher`` (no GUI: the sliders of
+joint_state_publisher_gui are not there)."""
+
+from minros.joint_state_publisher.joints import JointTable
+
+__all__ = ["JointTable"]
