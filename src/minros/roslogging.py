@@ -177,6 +177,17 @@ class RospyLogger(logging.getLoggerClass()):  # type: ignore[misc]
 logging.setLoggerClass(RospyLogger)
 
 
+def _adopt_rospy_loggers() -> None:
+    """Loggers of rospy's names made before this module was imported (minros's node names its
+    'rosout' logger on import) become RospyLoggers too; the class adds behaviour, not state."""
+    for name, logger in list(logging.Logger.manager.loggerDict.items()):
+        if type(logger) is logging.Logger and (name == "rosout" or name.startswith("rospy")):
+            logger.__class__ = RospyLogger
+
+
+_adopt_rospy_loggers()
+
+
 # ---------------------------------------------------------------------------------------------
 # log files and configuration
 

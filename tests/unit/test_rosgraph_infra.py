@@ -5,6 +5,8 @@ from __future__ import annotations
 import io
 import logging
 import struct
+import subprocess
+import sys
 import threading
 import xmlrpc.client
 from pathlib import Path
@@ -121,3 +123,14 @@ def test_configure_logging_refuses_a_file_in_the_way(tmp_path: Path, monkeypatch
     (tmp_path / "blocker").write_text("x")
     with pytest.raises(rosgraph.roslogging.LoggingException, match="is in the way"):
         rosgraph.roslogging.configure_logging("x", filename="blocker/x.log")
+
+
+def test_rosout_logger_made_before_roslogging_names_methods_too():
+    """minros's node names the 'rosout' logger on import, possibly before roslogging's is
+    imported: that logger still names a method's caller Class.method."""
+    code = (
+        "import logging; early = logging.getLogger('rosout'); other = logging.getLogger('app')\n"
+        "import minros.roslogging as r\n"
+        "assert type(early) is r.RospyLogger and type(other) is logging.Logger\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
