@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import os
+import re
 import threading
 import uuid
 from typing import Any, Dict, List, Sequence, Tuple
@@ -21,6 +22,30 @@ __all__ = ["Node", "ROSLaunchParent", "ROSLaunch", "get_or_generate_uuid", "RLEx
 RLException = LaunchError
 
 
+def _namespace(ns: str | None) -> str:
+    return re.sub("//+", "/", names.make_global_ns(ns or "/"))
+
+
+def _cwd(cwd: str | None) -> str | None:
+    return "ROS_HOME" if cwd == "ros_home" else cwd  # lenient on case, as roslaunch
+
+
+def validate_node(node: NodeSpec) -> None:
+    """roslaunch's checks of a node's settings, with its texts (ValueError)."""
+    if node.respawn and node.required:
+        raise ValueError("respawn and required cannot both be set to true")
+    if node.name and "/" in node.name:
+        raise ValueError("node name cannot contain a namespace")
+    if not node.package.strip():
+        raise ValueError("package must be non-empty")
+    if not node.type.strip():
+        raise ValueError("type must be non-empty")
+    if node.output not in ("log", "screen", None):
+        raise ValueError("output must be one of 'log', 'screen'")
+    if node.cwd not in ("ROS_HOME", "node", None):
+        raise ValueError("cwd must be one of 'ROS_HOME', 'node'")
+
+
 class Node(NodeSpec):
     """roslaunch.core.Node: a node to launch, with roslaunch's constructor."""
 
@@ -32,11 +57,12 @@ class Node(NodeSpec):
                  cwd: str | None = None, launch_prefix: str | None = None, required: bool = False,
                  filename: str = "<unknown>") -> None:
         super().__init__(package=package, type=node_type, name=name or "",
-                         namespace=names.make_global_ns(namespace or "/"), args=args or "",
+                         namespace=_namespace(namespace), args=args or "",
                          remap_args=list(remap_args or []), env_args=list(env_args or []),
                          output=output, respawn=respawn, respawn_delay=respawn_delay,
-                         required=required, cwd=cwd, launch_prefix=launch_prefix,
-                         machine=machine_name, filename=filename)
+                         required=required, cwd=_cwd(cwd), launch_prefix=launch_prefix or None,
+                         machine=machine_name or None, filename=filename)
+        validate_node(self)
 
     @property
     def node_type(self) -> str:

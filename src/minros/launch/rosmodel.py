@@ -23,7 +23,15 @@ import xmlrpc.client
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from minros import names, packages, rosenv
-from minros.launch.api import Node, _xml_escape, node_to_xml, node_xmlattrs  # noqa: F401
+from minros.launch.api import (  # noqa: F401
+    Node,
+    _cwd,
+    _namespace,
+    _xml_escape,
+    node_to_xml,
+    node_xmlattrs,
+    validate_node,
+)
 from minros.launch.config import LaunchConfig, LaunchError, NodeSpec
 from minros.launch.loader import Loader
 
@@ -56,25 +64,35 @@ _printlog_handlers: List[Callable[[str], Any]] = []
 _printerrlog_handlers: List[Callable[[str], Any]] = []
 
 
+def _tell(handlers: List[Callable[[str], Any]], msg: str) -> None:
+    for handler in handlers:
+        try:  # a handler that fails does not stop the launch
+            handler(msg)
+        except Exception:  # noqa: BLE001
+            pass
+
+
+def _print(text: str, stream: Any = None) -> None:
+    try:  # nor does a console gone away (roslaunch saw errno 104 here)
+        print(text, file=stream or sys.stdout)
+    except Exception:  # noqa: BLE001
+        pass
+
+
 def printlog(msg: str) -> None:
-    """Print (unless in child mode) and tell the printlog handlers."""
-    for handler in _printlog_handlers:
-        handler(msg)
-    if not is_child_mode():
-        print(msg)
+    """Tell the printlog handlers, then print."""
+    _tell(_printlog_handlers, msg)
+    _print(msg)
 
 
 def printlog_bold(msg: str) -> None:
-    for handler in _printlog_handlers:
-        handler(msg)
-    if not is_child_mode():
-        print(f"\033[1m{msg}\033[0m" if sys.stdout.isatty() else msg)
+    _tell(_printlog_handlers, msg)
+    _print(f"\033[1m{msg}\033[0m")
 
 
 def printerrlog(msg: str) -> None:
-    for handler in _printerrlog_handlers:
-        handler(msg)
-    print(f"\033[31m{msg}\033[0m" if sys.stderr.isatty() else msg, file=sys.stderr)
+    _tell(_printerrlog_handlers, msg)
+    _print(f"\033[31m{msg}\033[0m", sys.stderr)
 
 
 def add_printlog_handler(h: Callable[[str], Any]) -> None:
@@ -259,15 +277,20 @@ class Test(NodeSpec):
                  time_limit: Optional[float] = None, cwd: Optional[str] = None,
                  launch_prefix: Optional[str] = None, retry: Optional[int] = None,
                  filename: str = "<unknown>") -> None:
-        time_limit = TEST_TIME_LIMIT_DEFAULT if time_limit is None else float(time_limit)
+        time_limit = time_limit or TEST_TIME_LIMIT_DEFAULT
+        if type(time_limit) not in (int, float):
+            raise ValueError("'time-limit' must be a number")
         if time_limit <= 0:
-            raise ValueError("'time_limit' must be a positive number")
+            raise ValueError("'time-limit' must be a positive number")
         super().__init__(package=package, type=node_type, name=name or "",
-                         namespace=names.make_global_ns(namespace or "/"), args=args or "",
+                         namespace=_namespace(namespace), args=args or "",
                          remap_args=list(remap_args or []), env_args=list(env_args or []),
-                         cwd=cwd, launch_prefix=launch_prefix, machine=machine_name,
-                         filename=filename, test_name=test_name, time_limit=time_limit)
-        self.retry = int(retry or 0)
+                         output="log", cwd=_cwd(cwd), launch_prefix=launch_prefix or None,
+                         machine=machine_name or None, filename=filename, test_name=test_name,
+                         time_limit=float(time_limit))
+        validate_node(self)
+        self.name = name or None  # type: ignore[assignment] - roslaunch's unnamed test
+        self.retry = retry or 0
 
     @property
     def machine_name(self) -> Optional[str]:
@@ -278,9 +301,13 @@ class Test(NodeSpec):
 
     def xmlattrs(self) -> List[Tuple[str, Any]]:
         attrs = node_xmlattrs(self)
-        attrs = [(a, v) for a, v in attrs if a not in ("respawn", "respawn_delay", "required")]
-        return attrs + [("test-name", self.test_name), ("time-limit", self.time_limit),
-                        ("retry", str(self.retry))]
+        attrs = [(a, v) for a, v in attrs if a not in ("respawn", "respawn_delay")]
+        attrs.append(("test-name", self.test_name))
+        if self.retry:
+            attrs.append(("retry", str(self.retry)))
+        if self.time_limit != TEST_TIME_LIMIT_DEFAULT:
+            attrs.append(("time-limit", self.time_limit))
+        return attrs
 
     def to_xml(self) -> str:
         return node_to_xml(self)
@@ -465,12 +492,12 @@ def _ros_node(spec: NodeSpec) -> Any:
     if spec.test_name is not None:
         return Test(spec.test_name, spec.package, spec.type, name=spec.name,
                     namespace=spec.namespace, machine_name=spec.machine, args=spec.args,
-                    remap_args=spec.remap_args, env_args=spec.env_args,
+                    remap_args=[list(r) for r in spec.remap_args], env_args=spec.env_args,
                     time_limit=spec.time_limit, cwd=spec.cwd, launch_prefix=spec.launch_prefix,
-                    retry=getattr(spec, "retry", 0), filename=spec.filename or "<unknown>")
+                    retry=spec.retry, filename=spec.filename or "<unknown>")
     return Node(spec.package, spec.type, name=spec.name or None, namespace=spec.namespace,
                 machine_name=spec.machine, args=spec.args, respawn=spec.respawn,
-                respawn_delay=spec.respawn_delay, remap_args=spec.remap_args,
+                respawn_delay=spec.respawn_delay, remap_args=[list(r) for r in spec.remap_args],
                 env_args=spec.env_args, output=spec.output, cwd=spec.cwd,
                 launch_prefix=spec.launch_prefix, required=spec.required,
                 filename=spec.filename or "<unknown>")
@@ -482,8 +509,11 @@ def fill_config(loaded: LaunchConfig, ros_config: Any, core: bool = False, verbo
     for f in loaded.files:
         ros_config.add_roslaunch_file(f)
     for name, machine in loaded.machines.items():
-        ros_config.add_machine(Machine(name, machine.address,
-                                       assignable=machine.default != "never"), verbose)
+        ros_config.add_machine(Machine(name, machine.address, env_loader=machine.env_loader,
+                                       ssh_port=machine.ssh_port, user=machine.user,
+                                       password=machine.password,
+                                       assignable=machine.default != "never",
+                                       timeout=machine.timeout), verbose)
     for ns in loaded.clear_params:
         ros_config.add_clear_param(ns)
     for command in loaded.rosparam_commands:
@@ -499,9 +529,11 @@ def fill_config(loaded: LaunchConfig, ros_config: Any, core: bool = False, verbo
         ros_config.add_config_error(warning)
 
 
-def _parse_error(exc: LaunchError) -> XmlParseException:
-    """roslaunch's exception with roslaunch's text; the place stays in ``source``."""
-    error = XmlParseException(exc.message)
+def _parse_error(exc: LaunchError) -> RLException:
+    """roslaunch's exception with roslaunch's text; the place stays in ``source``. A
+    <rosparam> that cannot be loaded is a LoadException, as roslaunch's loader raises it."""
+    kind = LoadException if exc.message.startswith("Invalid <rosparam> tag") else XmlParseException
+    error = kind(exc.message)
     error.source = (exc.filename, exc.line)  # type: ignore[attr-defined]
     return error
 
@@ -513,12 +545,18 @@ class XmlLoader:
         self.resolve_anon = resolve_anon
         self.args_only = args_only
         self.root_context = None
+        #: set by load_config_default: a file using an arg without a value loads up to there
+        self.ignore_unset_args = False
+
+    def _loader(self) -> Loader:
+        return Loader(check_machines=False, args_only=self.args_only,
+                      ignore_unset_args=self.ignore_unset_args)
 
     def load(self, filename: str, ros_config: Any, core: bool = False,
              argv: Optional[Sequence[str]] = None, verbose: bool = True) -> None:
         argv = list(sys.argv if argv is None else argv)
         try:
-            loaded = Loader(check_machines=False, args_only=self.args_only).load(filename, argv)
+            loaded = self._loader().load(filename, argv)
         except LaunchError as exc:
             raise _parse_error(exc) from None
         fill_config(loaded, ros_config, core, verbose, filename)
@@ -526,8 +564,7 @@ class XmlLoader:
     def load_string(self, xml_text: str, ros_config: Any, core: bool = False,
                     verbose: bool = True) -> None:
         try:
-            loaded = Loader(check_machines=False, args_only=self.args_only).load_string(
-                xml_text, list(sys.argv))
+            loaded = self._loader().load_string(xml_text, list(sys.argv))
         except LaunchError as exc:
             raise _parse_error(exc) from None
         fill_config(loaded, ros_config, core, verbose)
@@ -559,6 +596,7 @@ def load_config_default(roslaunch_files: Sequence[Any], port: Optional[int],
                         assign_machines: bool = True, ignore_unset_args: bool = False) -> ROSLaunchConfig:
     """A config from launch files (or ``(file, [args])`` pairs) and XML strings."""
     loader = loader or XmlLoader()
+    loader.ignore_unset_args = ignore_unset_args
     config = ROSLaunchConfig()
     if port:
         host = rosenv.parse_http_host_and_port(config.master.uri)[0]
@@ -587,23 +625,59 @@ class ArgException(SubstitutionException):
     """``$(arg x)`` of an undeclared argument."""
 
 
-def resolve_args(arg_str: Optional[str], context: Optional[Dict[str, Any]] = None,
-                 resolve_anon: bool = True, filename: Optional[str] = None) -> Optional[str]:
-    """Resolve the ``$(env)``, ``$(optenv)``, ``$(find)``, ``$(anon)``, ``$(arg)``,
-    ``$(dirname)`` and ``$(eval)`` substitutions of ``arg_str``; ``context['arg']`` holds the
-    arguments."""
+def _context(context: Optional[Dict[str, Any]], filename: Optional[str] = None) -> Any:
+    """A minros substitution context over a roslaunch context dict (``arg``, ``anon``,
+    ``filename``); the dict's ``anon`` and ``arg`` tables are shared, as in roslaunch."""
     from minros.launch import substitution
 
     context = {} if context is None else context
-    ctx = substitution.SubstitutionContext(
-        args=dict(context.get("arg", {})), filename=filename or "",
-        anon=context.setdefault("anon", {}))
+    return substitution.SubstitutionContext(
+        args=context.setdefault("arg", {}), anon=context.setdefault("anon", {}),
+        filename=filename or context.get("filename") or "")
+
+
+def _substituting(fn: Callable[[], Any]) -> Any:
+    from minros.launch import substitution
+
     try:
-        return substitution.resolve_args(arg_str, ctx)
+        return fn()
     except substitution.ArgError as exc:
         raise ArgException(str(exc)) from None
     except substitution.SubstitutionError as exc:
         raise SubstitutionException(str(exc)) from None
+
+
+def resolve_args(arg_str: Optional[str], context: Optional[Dict[str, Any]] = None,
+                 resolve_anon: bool = True, filename: Optional[str] = None) -> Optional[str]:
+    """Resolve the ``$(env)``, ``$(optenv)``, ``$(find)``, ``$(anon)``, ``$(arg)``,
+    ``$(dirname)`` and ``$(eval)`` substitutions of ``arg_str``; ``context['arg']`` holds the
+    arguments, ``context['anon']`` the anonymous names given so far."""
+    from minros.launch import substitution
+
+    ctx = _context(context, filename)
+    return _substituting(lambda: substitution.resolve_args(arg_str, ctx))
+
+
+def _command(command: str) -> Callable[[str, str, List[str], Dict[str, Any]], str]:
+    """roslaunch's handler of one substitution command: ``(resolved, a, args, context)`` ->
+    ``resolved`` with ``$(a)`` replaced."""
+    def handler(resolved: str, a: str, args: List[str], context: Dict[str, Any]) -> str:
+        from minros.launch import substitution
+
+        ctx = _context(context)
+        return _substituting(lambda: substitution._apply(resolved, a, ctx, (command,)))
+    handler.__name__ = handler.__qualname__ = "_" + command
+    return handler
+
+
+_env, _optenv, _anon, _dirname, _arg, _find = (
+    _command(c) for c in ("env", "optenv", "anon", "dirname", "arg", "find"))
+
+
+def _collect_args(arg_str: str) -> List[str]:
+    from minros.launch import substitution
+
+    return _substituting(lambda: substitution.collect_args(arg_str))
 
 
 def packages_of(config: ROSLaunchConfig) -> List[str]:

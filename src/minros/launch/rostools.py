@@ -9,6 +9,9 @@ import os
 import sys
 import xmlrpc.client
 from typing import Any, Dict, List, Optional, Sequence, Tuple
+from xml.etree import ElementTree
+
+import rospkg
 
 from minros import names, packages, rosenv
 from minros.launch.config import LaunchConfig, LaunchError
@@ -211,30 +214,28 @@ class RoslaunchDepsException(Exception):
     """A launch file's dependencies cannot be computed."""
 
 
-def roslaunch_deps(files: Sequence[str], verbose: bool = False, use_test_depends: bool = False,
-                   ignore_unset_args: bool = False) -> Tuple[Optional[str], Dict[str, Any], Dict[str, List[str]]]:
-    """``(base package, {file: packages its nodes use}, {package: packages it uses but does
-    not declare})`` of launch files (all in one package)."""
-    base_pkgs = {packages_of_file(f) for f in files}
-    if len(base_pkgs) > 1:
-        raise RoslaunchDepsException("roslaunch files must be in the same package: "
-                                     + ", ".join(sorted(str(p) for p in base_pkgs)))
-    base_pkg = base_pkgs.pop() if base_pkgs else None
-    file_deps: Dict[str, Any] = {}
-    for f in files:
-        try:
-            loaded = Loader(check_machines=False).load(f)
-        except LaunchError as exc:
-            raise RoslaunchDepsException(str(exc)) from None
-        file_deps[f] = sorted({n.package for n in loaded.nodes + loaded.tests})
-    missing: Dict[str, List[str]] = {}
-    if base_pkg:
-        declared = set(packages.dependency_query(base_pkg))
-        used = {p for deps in file_deps.values() for p in deps}
-        absent = sorted(used - declared - {base_pkg})
-        if absent:
-            missing[base_pkg] = absent
-    return base_pkg, file_deps, missing
+class RoslaunchDeps:
+    """What one launch file uses: ``nodes`` as ``(package, type)``, the files it includes, and
+    the packages of both (roslaunch.depends.RoslaunchDeps)."""
+
+    def __init__(self, nodes: Optional[List[Tuple[str, str]]] = None,
+                 includes: Optional[List[str]] = None, pkgs: Optional[List[str]] = None) -> None:
+        self.nodes = [] if nodes is None else nodes
+        self.includes = [] if includes is None else includes
+        self.pkgs = [] if pkgs is None else pkgs
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, RoslaunchDeps):
+            return False
+        return ((set(self.nodes), set(self.includes), set(self.pkgs))
+                == (set(other.nodes), set(other.includes), set(other.pkgs)))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"nodes: {self.nodes}\nincludes: {self.includes}\npkgs: {self.pkgs}"
+
+    __str__ = __repr__
 
 
 def packages_of_file(path: str) -> Optional[str]:
@@ -242,24 +243,277 @@ def packages_of_file(path: str) -> Optional[str]:
     return packages.get_dir_pkg(os.path.dirname(os.path.abspath(path)))[1]
 
 
+def _attr(el: Any, name: str, context: Dict[str, Any]) -> str:
+    from minros.launch.rosmodel import resolve_args
+
+    try:
+        return resolve_args(el.attrib[name], context)  # type: ignore[return-value]
+    except KeyError as exc:
+        xml = ElementTree.tostring(el, encoding="unicode").strip()
+        raise RoslaunchDepsException(f"Cannot load roslaunch <{el.tag}> tag: missing required "
+                                     f"attribute {exc}.\nXML is {xml}") from None
+
+
+def _arg_value(el: Any, context: Dict[str, Any]) -> str:
+    from minros.launch.rosmodel import resolve_args
+
+    name = el.attrib["name"]
+    if "value" in el.attrib:
+        return resolve_args(el.attrib["value"], context)  # type: ignore[return-value]
+    if name in context["arg"]:
+        return context["arg"][name]
+    if "default" in el.attrib:
+        return resolve_args(el.attrib["default"], context)  # type: ignore[return-value]
+    raise RoslaunchDepsException(f"No value for arg [{name}]")
+
+
+def _included(el: Any, context: Dict[str, Any]) -> bool:
+    """The element's if= / unless= (one of them, if first) allows it."""
+    from minros.launch.rosmodel import resolve_args
+    from minros.launch.substitution import convert_value
+
+    if "if" in el.attrib:
+        return bool(convert_value(resolve_args(el.attrib["if"], context) or "", "bool"))
+    if "unless" in el.attrib:
+        return not convert_value(resolve_args(el.attrib["unless"], context) or "", "bool")
+    return True
+
+
+def _launch_element(path: str) -> Any:
+    """The <launch> element of a file (None when it has none); OSError, ParseError pass up."""
+    root = ElementTree.parse(path).getroot()
+    return root if root.tag == "launch" else next(root.iter("launch"), None)
+
+
+def _walk(elements: Sequence[Any], launch_file: str, file_deps: Dict[str, RoslaunchDeps],
+          verbose: bool, context: Dict[str, Any]) -> None:
+    """roslaunch.depends' walk: groups, args, includes (recursively, each file its own entry)
+    and the packages of nodes and tests, honouring if/unless; nothing is loaded or run."""
+    context["filename"] = os.path.abspath(launch_file)
+    own_pkg = packages_of_file(launch_file)
+    deps = file_deps[launch_file]
+    for el in elements:
+        if not _included(el, context):
+            continue
+        if el.tag == "group":
+            _walk(list(el), launch_file, file_deps, verbose, context)
+        elif el.tag == "arg":
+            context["arg"][el.attrib["name"]] = _arg_value(el, context)
+        elif el.tag == "include":
+            sub_file = _attr(el, "file", context)
+            if sub_file == "":  # an include left empty on purpose (inside a condition)
+                if verbose:
+                    print(f"Empty <include> in {launch_file}. Skipping <include> of {el.attrib['file']}")
+                continue
+            if verbose:
+                print(f"processing included launch {sub_file}")
+            sub_pkg = packages_of_file(sub_file)
+            if sub_pkg is None:
+                print(f"ERROR: cannot determine package for [{sub_file}]", file=sys.stderr)
+            if sub_file not in deps.includes:
+                deps.includes.append(sub_file)
+            if own_pkg != sub_pkg:
+                deps.pkgs.append(sub_pkg)  # type: ignore[arg-type]
+            file_deps[sub_file] = RoslaunchDeps()
+            try:
+                launch = _launch_element(sub_file)
+            except (OSError, ElementTree.ParseError):
+                raise RoslaunchDepsException(f"Cannot load roslaunch include '{sub_file}' in "
+                                             f"'{launch_file}'") from None
+            if launch is None:
+                print(f"ERROR: {sub_file} is not a valid roslaunch file", file=sys.stderr)
+                continue
+            sub_context: Dict[str, Any] = {"arg": {}}
+            for child in el:
+                if child.tag == "arg" and _included(child, context):
+                    sub_context["arg"][child.attrib["name"]] = _arg_value(child, context)
+            if "pass_all_args" in el.attrib:  # present at all, as roslaunch.depends reads it
+                context["arg"].update(sub_context["arg"])
+                sub_context["arg"] = context["arg"]
+            _walk(list(launch), sub_file, file_deps, verbose, sub_context)
+        elif el.tag in ("node", "test"):
+            pkg, node_type = _attr(el, "pkg", context), _attr(el, "type", context)
+            if (pkg, node_type) not in deps.nodes:
+                deps.nodes.append((pkg, node_type))
+            if pkg not in deps.pkgs:
+                deps.pkgs.append(pkg)
+
+
+def parse_launch(launch_file: str, file_deps: Dict[str, RoslaunchDeps], verbose: bool) -> None:
+    """Add ``launch_file`` (and what it includes) to ``file_deps``; arguments come from the
+    command line (``name:=value``), as roslaunch-deps reads them."""
+    if verbose:
+        print(f"processing launch {launch_file}")
+    try:
+        launch = _launch_element(launch_file)
+    except (OSError, ElementTree.ParseError):
+        launch = None
+    if launch is None:
+        raise RoslaunchDepsException(f"invalid XML in {launch_file}")
+    file_deps[launch_file] = RoslaunchDeps()
+    context = {"arg": names.load_mappings(sys.argv)}
+    _walk(list(launch), launch_file, file_deps, verbose, context)
+
+
+rl_file_deps = parse_launch
+
+
+def declared_run_depends(pkg: str, use_test_depends: bool = False) -> set:
+    """The packages ``pkg`` declares it needs at run time (with its test dependencies when
+    asked; a rosbuild manifest's every <depend>)."""
+    folder = packages.find_package(pkg)
+    if folder is None:
+        raise rospkg.ResourceNotFound(pkg)
+    if (folder / "package.xml").is_file():
+        from catkin_pkg.package import parse_package
+
+        parsed = parse_package(str(folder))
+        found = {d.name for d in parsed.run_depends}
+        if use_test_depends:
+            found |= {d.name for d in parsed.test_depends}
+        return found
+    return {d.package for d in packages.parse_manifest_file(str(folder / "manifest.xml")).depends}
+
+
+def calculate_missing(base_pkg: Optional[str], missing: Dict[str, set],
+                      file_deps: Dict[str, RoslaunchDeps],
+                      use_test_depends: bool = False) -> Dict[str, set]:
+    """Add to ``missing`` the packages each launch file uses that its package does not
+    declare."""
+    for launch_file, deps in file_deps.items():
+        pkg = packages_of_file(launch_file)
+        if pkg is None:
+            print(f"ERROR: cannot determine package for [{launch_file}]", file=sys.stderr)
+            continue
+        declared = declared_run_depends(pkg, use_test_depends) | {pkg}
+        missing.setdefault(pkg, set()).update(set(deps.pkgs) - declared)
+    return missing
+
+
+def roslaunch_deps(files: Sequence[str], verbose: bool = False, use_test_depends: bool = False,
+                   ignore_unset_args: bool = False) -> Tuple[Optional[str], Dict[str, RoslaunchDeps], Dict[str, set]]:
+    """``(package of the files, {file: RoslaunchDeps}, {package: packages used but not
+    declared})``; the files must be in one package. With ``ignore_unset_args``, an arg without
+    a value ends a file's walk instead of failing."""
+    file_deps: Dict[str, RoslaunchDeps] = {}
+    missing: Dict[str, set] = {}
+    base_pkg = None
+    for launch_file in files:
+        if not os.path.exists(launch_file):
+            raise RoslaunchDepsException(f"roslaunch file [{launch_file}] does not exist")
+        pkg = packages_of_file(launch_file)
+        if base_pkg and pkg != base_pkg:
+            raise RoslaunchDepsException(f"roslaunch files must be in the same package: {base_pkg} vs. {pkg}")
+        base_pkg = pkg
+        try:
+            parse_launch(launch_file, file_deps, verbose)
+        except RoslaunchDepsException as exc:
+            if not (ignore_unset_args and "No value for arg" in str(exc)):
+                raise
+    calculate_missing(base_pkg, missing, file_deps, use_test_depends=use_test_depends)
+    return base_pkg, file_deps, missing
+
+
+def print_deps(base_pkg: Optional[str], file_deps: Dict[str, RoslaunchDeps], verbose: bool) -> None:
+    if verbose:
+        for f, deps in file_deps.items():
+            for p, t in deps.nodes:
+                print(f"{p} [{p}/{t}]")
+            pkg = packages_of_file(f)
+            if pkg is None:
+                print(f"ERROR: cannot determine package for [{f}]", file=sys.stderr)
+            else:
+                print(f"{pkg} [{f}]")
+        print("-" * 80)
+    used = dict.fromkeys(p for deps in file_deps.values() for p in deps.pkgs)
+    print(" ".join(str(p) for p in used))  # one line, space-separated, for rosmake
+
+
+def roslaunch_deps_main(argv: Sequence[str] = sys.argv) -> None:
+    """roslaunch-deps: the packages launch files use, with --warn those their package does not
+    declare."""
+    from optparse import OptionParser
+
+    parser = OptionParser(usage="usage: %prog [options] <file(s)...>", prog="roslaunch-deps")
+    parser.add_option("--verbose", "-v", action="store_true", dest="verbose", default=False,
+                      help="Verbose output")
+    parser.add_option("--warn", "-w", action="store_true", dest="warn", default=False,
+                      help="Warn about missing manifest dependencies")
+    options, args = parser.parse_args(list(argv[1:]))
+    if not args:
+        parser.error("please specify a launch file")
+    files = [a for a in args if os.path.exists(a)]
+    absent = [a for a in args if not os.path.exists(a)]
+    if absent:
+        parser.error(f"cannot locate {','.join(absent)}")
+    try:
+        base_pkg, file_deps, missing = roslaunch_deps(files, verbose=options.verbose)
+    except (RoslaunchDepsException, rospkg.ResourceNotFound) as exc:
+        print(str(exc), file=sys.stderr)
+        sys.exit(1)
+    if options.warn:
+        print("Dependencies:")
+    print_deps(base_pkg, file_deps, options.verbose)
+    if options.warn:
+        print("\nMissing declarations:")
+        for pkg, miss in missing.items():
+            if miss:
+                print(f"{pkg}/manifest.xml:")
+                for m in miss:
+                    print(f'  <depend package="{m}" />')
+
+
 def check_roslaunch(f: str, use_test_depends: bool = False,
                     ignore_unset_args: bool = False) -> Optional[str]:
-    """Problems of launch file ``f`` as one text (None when there are none): it must load, and
-    the packages its nodes use must be installed. With ``ignore_unset_args``, arguments that
-    have no value are given one."""
-    argv: List[str] = []
-    if ignore_unset_args:
-        try:
-            # a value every use accepts (if=, a number, a name): the file is only checked
-            argv = [f"{n}:=0" for n, (_doc, default) in get_args([f]).items() if default is None]
-        except RLException:
-            argv = []
+    """Problems of launch file ``f`` as one text (None when there are none), as roslaunch's
+    rlutil.check_roslaunch finds them: it must load; its package must declare the packages it
+    uses (else the packages that package depends on must); those packages and their programs
+    must be installed; the config must hold no errors."""
+    from minros.launch.rosmodel import ArgException, printerrlog
+    from minros.workspace.executables import find_executables
+
     try:
-        loaded = Loader(check_machines=False).load(f, argv)
-    except LaunchError as exc:
-        return f"[{f}]:\n\t{exc.message}"
-    errors = []
-    for node in loaded.nodes + loaded.tests:
-        if packages.find_package(node.package) is None:
-            errors.append(f"[{f}]:\n\tcannot find package [{node.package}] for node [{node.name}]")
+        config = load_config_default([f], rosenv.DEFAULT_MASTER_PORT, verbose=False,
+                                     ignore_unset_args=ignore_unset_args)
+    except RLException as exc:
+        return str(exc)
+    errors: List[str] = []
+    try:
+        _base, file_deps, missing = roslaunch_deps([f], use_test_depends=use_test_depends,
+                                                   ignore_unset_args=ignore_unset_args)
+    except rospkg.ResourceNotFound as exc:
+        errors.append(f"Could not find package [{exc}] included from [{f}]")
+        file_deps, missing = {}, {}
+    except ArgException as exc:
+        errors.append(f"Could not resolve arg [{exc}] in [{f}]")
+        file_deps, missing = {}, {}
+    except RoslaunchDepsException as exc:
+        return str(exc)
+    for pkg, miss in missing.items():
+        provided: set = set()
+        try:
+            for dep_file in file_deps:
+                provided.update(packages.dependency_query(packages_of_file(dep_file) or "", direct=True))
+            unprovided = set(miss) - provided
+        except Exception as exc:  # noqa: BLE001 - roslaunch prints it and counts all as missing
+            print(exc, file=sys.stderr)
+            unprovided = set(miss) or {""}
+        if unprovided:
+            text = f"Missing package dependencies: {pkg}/package.xml: {', '.join(sorted(miss))}"
+            printerrlog(text)
+            errors.append(text)
+        elif miss:
+            printerrlog(f"Missing package dependencies: {pkg}/package.xml: {', '.join(sorted(miss))} "
+                        "(notify upstream maintainer)")
+    nodes = [n for deps in file_deps.values() for n in deps.nodes]
+    for pkg, node_type in nodes:
+        if packages.find_package(pkg) is None:
+            errors.append(f"cannot find package [{pkg}] for node [{node_type}]")
+    for pkg, node_type in nodes:
+        try:
+            if not find_executables(pkg, node_type):
+                errors.append(f"cannot find node [{node_type}] in package [{pkg}]")
+        except Exception as exc:  # noqa: BLE001
+            errors.append(f"unable to find node [{pkg}/{node_type}]: {exc}")
+    errors.extend(f"ROSLaunch config error: {e}" for e in config.config_errors)
     return "\n".join(errors) or None
