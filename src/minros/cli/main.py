@@ -33,6 +33,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
     "clean": ("minros.cli.clean", "check the size of the ROS log files and purge them (rosclean)"),
     "wtf": ("minros.cli.wtf", "check the ROS environment and the running graph (roswtf)"),
+    "master": ("minros.master", "run a ROS master alone, without rosout (rosmaster)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -57,6 +58,7 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "rosconsole": ("console", []),
     "rosclean": ("clean", []),
     "roswtf": ("wtf", []),
+    "rosmaster": ("master", []),
 }
 
 
@@ -138,6 +140,7 @@ rostest = _alias("rostest")
 rosconsole = _alias("rosconsole")
 rosclean = _alias("rosclean")
 roswtf = _alias("roswtf")
+rosmaster = _alias("rosmaster")
 
 if __name__ == "__main__":
     sys.exit(main())

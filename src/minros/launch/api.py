@@ -61,16 +61,14 @@ class Node(NodeSpec):
                          remap_args=list(remap_args or []), env_args=list(env_args or []),
                          output=output, respawn=respawn, respawn_delay=respawn_delay,
                          required=required, cwd=_cwd(cwd), launch_prefix=launch_prefix or None,
-                         machine=machine_name or None, filename=filename)
+                         machine=None, filename=filename)
+        #: the <machine> named in the launch file; ``machine`` is that Machine once assigned
+        self.machine_name = machine_name or None
         validate_node(self)
 
     @property
     def node_type(self) -> str:
         return self.type
-
-    @property
-    def machine_name(self) -> str | None:
-        return self.machine
 
     def xmltype(self) -> str:
         return "node"
@@ -97,7 +95,7 @@ def _xml_escape(s: Any) -> Any:
 
 def node_xmlattrs(node: Any) -> List[Tuple[str, Any]]:
     """The attributes of a node's XML element, as roslaunch writes them."""
-    return [("pkg", node.package), ("type", node.type), ("machine", node.machine),
+    return [("pkg", node.package), ("type", node.type), ("machine", getattr(node, "machine_name", None)),
             ("ns", node.namespace), ("args", node.args), ("output", node.output),
             ("cwd", node.cwd or None), ("respawn", node.respawn),
             ("respawn_delay", node.respawn_delay), ("name", node.name or None),

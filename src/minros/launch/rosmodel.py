@@ -286,15 +286,12 @@ class Test(NodeSpec):
                          namespace=_namespace(namespace), args=args or "",
                          remap_args=list(remap_args or []), env_args=list(env_args or []),
                          output="log", cwd=_cwd(cwd), launch_prefix=launch_prefix or None,
-                         machine=machine_name or None, filename=filename, test_name=test_name,
+                         machine=None, filename=filename, test_name=test_name,
                          time_limit=float(time_limit))
+        self.machine_name = machine_name or None
         validate_node(self)
         self.name = name or None  # type: ignore[assignment] - roslaunch's unnamed test
         self.retry = retry or 0
-
-    @property
-    def machine_name(self) -> Optional[str]:
-        return self.machine
 
     def xmltype(self) -> str:
         return "test"
@@ -311,6 +308,9 @@ class Test(NodeSpec):
 
     def to_xml(self) -> str:
         return node_to_xml(self)
+
+    def to_remote_xml(self) -> str:
+        return node_to_xml(self, remote=True)
 
 
 class Executable:
@@ -393,11 +393,11 @@ class ROSLaunchConfig:
             return
         self._remote_nodes_present = False
         for node in self.nodes_core + self.nodes + self.tests:
-            name = getattr(node, "machine", None) or ""
+            name = getattr(node, "machine_name", None) or ""
             machine = self.machines.get(name)
             if machine is None:
                 raise RLException(f"ERROR: unknown machine [{name}]")
-            node.machine_obj = machine  # type: ignore[attr-defined]
+            node.machine = machine
             if name and not is_machine_local(machine):
                 self._remote_nodes_present = True
         self._assign_machines_complete = True
@@ -578,11 +578,17 @@ def get_roscore_filename() -> str:
 
 
 def load_roscore(loader: XmlLoader, config: ROSLaunchConfig, verbose: bool = True) -> None:
-    """The nodes and parameters roscore adds (core nodes)."""
+    """The nodes and parameters roscore adds to every launch: rosout (a core node), and
+    /rosversion and /rosdistro, which ROS's roscore.xml gets from the rosversion program."""
     path = get_roscore_filename()
     if not os.path.isfile(path):
         raise RLException(f"Unable to locate roscore.xml file: {path}")
     loader.load(path, config, core=True, verbose=verbose)
+    folder = packages.find_package("roslaunch")
+    version = (packages.manifest_version(folder) if folder is not None else None) or "1.15.15"
+    config.add_param(Param("/rosversion", f"{version}\n"), verbose=verbose)
+    config.add_param(Param("/rosdistro", f"{os.environ.get('ROS_DISTRO') or 'noetic'}\n"),
+                     verbose=verbose)
 
 
 def calculate_env_loader(env: Optional[Dict[str, str]] = None) -> Optional[str]:
@@ -601,6 +607,7 @@ def load_config_default(roslaunch_files: Sequence[Any], port: Optional[int],
     if port:
         host = rosenv.parse_http_host_and_port(config.master.uri)[0]
         config.master.uri = f"http://{host}:{port}/"
+    load_roscore(loader, config, verbose=verbose)  # first: later declarations win
     for item in roslaunch_files:
         path, args = (item if isinstance(item, (list, tuple)) else (item, []))
         if not os.path.isfile(path):

@@ -65,14 +65,27 @@ def _find_node(node_name: str, roslaunch_files: Sequence[str], config: Any) -> A
 
 
 def create_local_process_args(node: Any, machine: Any, env: Optional[Dict[str, str]] = None) -> List[str]:
-    """The command line of ``node`` (its executable found as rosrun finds it)."""
+    """The command line of ``node``: its launch-prefix, its executable (found as rosrun finds
+    it), its args (substitution args resolved), its remappings and ``__name:=``.
+    NodeParamsException when the executable cannot be found."""
+    import copy
+
+    from minros.launch.rosmodel import resolve_args
+
     if not node.name:
         raise ValueError("node name must be defined")
+    context: Dict[str, Any] = {} if env is None else {"env": env}
+    resolved = copy.copy(node)
+    resolved.name = resolve_args(node.name, context=context)
+    resolved.args = resolve_args(node.args, context=context) or ""
     runner = LaunchRunner(LaunchConfig(), master_uri=rosenv.get_master_uri(), env=env)
     try:
-        argv, _cwd = runner.node_command(node, node.name)
-    except LaunchError as exc:
-        raise RLException(str(exc)) from None
+        argv, _cwd = runner.node_command(resolved, resolved.name)
+    except LaunchError as exc:  # the cause alone: callers say which node could not launch
+        prefix = f"cannot launch node of type [{node.package}/{node.type}]: "
+        message = exc.message[len(prefix):] if exc.message.startswith(prefix) else exc.message
+        raise NodeParamsException(message) from None
+    node.name = resolved.name
     return argv
 
 
