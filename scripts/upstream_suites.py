@@ -78,6 +78,16 @@ SUITES: List[Suite] = [
     Suite("roslaunch-unit", "ros_comm", ["tools/roslaunch/test/unit"], target=False),
     Suite("roswtf", "ros_comm", ["utilities/roswtf/test"], target=False),
     Suite("rosbag-roundtrip", "ros_comm", ["tools/rosbag/test"], target=False),
+    # the command-line tools' nosetests (their offline parts; the online ones need a graph)
+    Suite("test_rosparam", "ros_comm", ["test/test_rosparam/test"], target=False),
+    Suite("test_rostopic", "ros_comm", ["test/test_rostopic/test"],
+          [("test_rostopic", "test/test_rostopic")], target=False),
+    Suite("test_rosservice", "ros_comm", ["test/test_rosservice/test"],
+          [("test_rosservice", "test/test_rosservice")], target=False),
+    Suite("rosmsg", "ros_comm", ["tools/rosmsg/test"], target=False),
+    Suite("rostopic-offline", "ros_comm", ["tools/rostopic/test/test_rostopic_command_line_offline.py"],
+          target=False),
+    Suite("topic_tools-args", "ros_comm", ["tools/topic_tools/test/args.py"], target=False),
 ]
 
 #: Test-only modules the upstream tests import that neither side installs, on both sides'
