@@ -56,6 +56,8 @@ EXCLUSIONS: Dict[str, str] = {
     "genlisp.*": "the Lisp message generator, run by catkin at build time",
     "nodelet_topic_tools.*": "parameter configs of C++ nodelets (throttle), no Python API",
     "dynamic_reconfigure.cfg.TestConfig": "config of dynamic_reconfigure's own C++ test node",
+    "joint_state_publisher_gui": "a Qt window of sliders (GUI only); the joint_state_publisher "
+                                 "module it builds on is there",
     "rviz": "Python bindings (SIP) of rviz's C++/Qt visualizer library",
     "rviz.librviz_sip": "Python bindings (SIP) of rviz's C++/Qt visualizer library",
     "rosdistro.*": "workspace bootstrap tool, not part of a ROS runtime; PyPI has the real one",

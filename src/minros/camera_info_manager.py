@@ -21,7 +21,8 @@ from sensor_msgs.srv import SetCameraInfo, SetCameraInfoResponse
 
 __all__ = ["CameraInfoManager", "CameraInfoError", "CameraInfoMissingError", "genCameraName",
            "loadCalibrationFile", "parseURL", "resolveURL", "saveCalibration", "URL_empty",
-           "URL_file", "URL_package", "URL_invalid", "default_camera_info_url"]
+           "URL_file", "URL_package", "URL_invalid", "default_camera_info_url", "parse_ini",
+           "readCalibration"]
 
 URL_empty, URL_file, URL_package, URL_invalid = 0, 1, 2, 3
 default_camera_info_url = "file://${ROS_HOME}/camera_info/${NAME}.yaml"
@@ -191,3 +192,139 @@ class CameraInfoManager:
             return False
         self.url = url
         return True
+
+
+# ---------------------------------------------------------------------------------------------
+# camera_calibration_parsers: read a calibration file, YAML or the legacy Videre INI format, as
+# its C++ readers read them
+
+_INI_REAL = re.compile(r"([+-]?)(?:(\d+)\.?(\d*)|\.(\d+))(?:[eE]([+-]?\d+))?")
+_INI_UINT = re.compile(r"\d+")
+
+
+class _IniScanner:
+    """A cursor over an INI calibration: whitespace and ``#`` comments skipped before each
+    token, as the C++ grammar's skipper does."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.pos = 0
+
+    def skip(self) -> None:
+        while self.pos < len(self.text):
+            if self.text[self.pos].isspace():
+                self.pos += 1
+            elif self.text[self.pos] == "#":
+                end = self.text.find("\n", self.pos)
+                self.pos = len(self.text) if end < 0 else end + 1
+            else:
+                return
+
+    def literal(self, word: str) -> bool:
+        self.skip()
+        if self.text.startswith(word, self.pos):
+            self.pos += len(word)
+            return True
+        return False
+
+    def expect(self, word: str) -> None:
+        if not self.literal(word):
+            raise CameraInfoError(f"INI calibration: expected '{word}' at offset {self.pos}")
+
+    def number(self, pattern: re.Pattern, what: str) -> float:
+        self.skip()
+        match = pattern.match(self.text, self.pos)
+        if match is None:
+            raise CameraInfoError(f"INI calibration: expected {what} at offset {self.pos}")
+        self.pos = match.end()
+        return _spirit_real(match) if pattern is _INI_REAL else float(match.group())
+
+    def reals(self, count: int) -> list:
+        return [self.number(_INI_REAL, "a number") for _ in range(count)]
+
+
+def _spirit_real(match: re.Match) -> float:
+    """The number as the C++ parser (Boost.Spirit's real_p) computes it: the fraction's digits
+    as an integer times 10^-digits added to the integer part, then scaled by the exponent, so
+    that a value reads back to the same double C++ gets (0.33758 -> 0.33758000000000005)."""
+    sign, whole, frac, only_frac, exponent = match.groups()
+    frac = frac if only_frac is None else only_frac
+    value = float(int(whole or "0"))
+    if frac:
+        value += int(frac) * 10.0 ** -len(frac)
+    if exponent:
+        value *= 10.0 ** int(exponent)
+    return -value if sign == "-" else value
+
+
+def parse_ini(text: str) -> Tuple[str, Any]:
+    """(camera name, CameraInfo) of a Videre INI calibration: ``[image]`` width and height,
+    an optional ``[externals]`` section, then the camera's section with its camera matrix,
+    distortion (5 values: plumb_bob, 8: rational_polynomial), rectification and projection."""
+    scan = _IniScanner(text)
+    info = CameraInfo()
+    scan.expect("[image]")
+    scan.expect("width")
+    info.width = int(scan.number(_INI_UINT, "the width"))
+    scan.expect("height")
+    info.height = int(scan.number(_INI_UINT, "the height"))
+    if scan.literal("[externals]"):
+        scan.expect("translation")
+        scan.reals(3)
+        scan.expect("rotation")
+        scan.reals(3)
+    scan.expect("[")
+    end = scan.text.find("]", scan.pos)
+    if end < 0:
+        raise CameraInfoError("INI calibration: the camera section's name has no ']'")
+    name = scan.text[scan.pos:end]
+    scan.pos = end + 1
+    scan.expect("camera matrix")
+    info.K = scan.reals(9)
+    scan.expect("distortion")
+    distortion = []
+    while True:
+        scan.skip()
+        match = _INI_REAL.match(scan.text, scan.pos)
+        if match is None:
+            break
+        distortion.append(_spirit_real(match))
+        scan.pos = match.end()
+    info.D = distortion
+    scan.expect("rectification")
+    info.R = scan.reals(9)
+    scan.expect("projection")
+    info.P = scan.reals(12)
+    info.distortion_model = {5: "plumb_bob", 8: "rational_polynomial"}.get(len(distortion), "")
+    return name, info
+
+
+def _parse_calibration_yaml(text: str) -> Tuple[str, Any]:
+    """camera_calibration_parsers' YAML reader: the name defaults to "unknown", the distortion
+    model to plumb_bob, and the distortion's rows x cols values are read."""
+    name, info = from_yaml(text)
+    doc = yaml.safe_load(text)
+    try:
+        distortion = doc["distortion_coefficients"]
+        count = int(distortion["rows"]) * int(distortion["cols"])
+        info.D = [float(v) for v in distortion["data"][:count]]
+        if len(info.D) != count:
+            raise CameraInfoError(f"distortion_coefficients has {len(info.D)} values, not {count}")
+    except (KeyError, TypeError, ValueError) as exc:
+        raise CameraInfoError(f"missing or malformed entry {exc}") from None
+    return (name if "camera_name" in doc else "unknown"), info
+
+
+def readCalibration(file_name: str) -> Optional[Tuple[str, Any]]:  # noqa: N802 - ROS's name
+    """(camera name, CameraInfo) from a ``.yaml``/``.yml`` or ``.ini`` calibration file, or
+    None when it cannot be read (camera_calibration_parsers.readCalibration)."""
+    lower = file_name.lower()
+    parse = (parse_ini if lower.endswith(".ini") else
+             _parse_calibration_yaml if lower.endswith((".yaml", ".yml")) else None)
+    if parse is None:
+        return None
+    try:
+        with open(file_name, encoding="utf-8") as f:
+            return parse(f.read())
+    except (OSError, UnicodeDecodeError, CameraInfoError, yaml.YAMLError):
+        return None

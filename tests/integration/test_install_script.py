@@ -15,6 +15,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
+
 from support import REPO, need
 
 SCRIPT = REPO / "scripts" / "install-ros-reference.sh"

@@ -785,3 +785,22 @@ def test_port_in_use_is_one_line(minros_core, ros_home):
     assert "Traceback" not in done.stderr
 
 
+
+
+def test_a_latched_message_reaches_every_client_that_subscribes_later(graph):
+    """The web node shares one subscription per topic: a client that subscribes after the
+    first still gets the latched message, as from rosbridge_suite."""
+    pub = Proc([PYTHON, "-m", "minros", "topic", "pub", "/web_latched", "std_msgs/String",
+                "data: kept"], graph.env())
+    try:
+        pub.read_until("publishing and latching message", timeout=20)
+        proc = Proc([PYTHON, str(WEB / "roslibpy_client.py"), graph.ws, "latched_twice"],
+                     graph.env())
+        try:
+            out = proc.read_until("RESULT ", timeout=90)
+        finally:
+            out += proc.stop()
+    finally:
+        pub.stop()
+    result = json.loads(out.split("RESULT ", 1)[1].splitlines()[0])
+    assert result["received"] == [{"data": "kept"}, {"data": "kept"}]

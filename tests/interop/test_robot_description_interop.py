@@ -208,3 +208,53 @@ def test_xacro_command_line_and_missing_package(tmp_path: Path) -> None:
                             text=True, timeout=60)
     assert failed.returncode != 0
     assert "no_such_pkg" in failed.stderr and "Traceback" not in failed.stderr, failed.stderr
+
+
+URDF = """<robot name="r">
+  <link name="base"/><link name="a"/><link name="b"/><link name="c"/><link name="d"/>
+  <joint name="pan" type="revolute"><parent link="base"/><child link="a"/>
+    <limit lower="-1.5" upper="1.5" effort="1" velocity="1"/></joint>
+  <joint name="lift" type="prismatic"><parent link="a"/><child link="b"/>
+    <limit lower="0.2" upper="0.4" effort="1" velocity="1"/>
+    <safety_controller soft_lower_limit="0.25" soft_upper_limit="0.5" k_velocity="1"/></joint>
+  <joint name="grip" type="prismatic"><parent link="b"/><child link="c"/>
+    <limit lower="0" upper="0.1" effort="1" velocity="1"/>
+    <mimic joint="lift" multiplier="-0.5" offset="0.01"/></joint>
+  <joint name="spin" type="continuous"><parent link="base"/><child link="d"/></joint>
+</robot>"""
+
+JSP_API = r'''
+import json, rospy, joint_state_publisher as jsp
+from sensor_msgs.msg import JointState
+rospy.init_node("jsp_api", anonymous=True)
+publisher = jsp.JointStatePublisher()
+calls = []
+publisher.set_source_update_cb(lambda: calls.append(1))
+publisher.source_cb(JointState(name=["pan", "nope", "spin"], position=[0.5, 9.0, 2.0]))
+print(json.dumps({"free": publisher.free_joints, "list": publisher.joint_list,
+                  "dependent": publisher.dependent_joints, "calls": len(calls),
+                  "rate": jsp.get_param("rate", 10), "zeros": jsp.get_param("zeros"),
+                  "topic": publisher.pub.resolved_name}, sort_keys=True))
+'''
+
+
+def test_joint_state_publisher_module_as_debians(debian_rosmaster: int, ros_home: Path) -> None:
+    """joint_state_publisher's JointStatePublisher (what joint_state_publisher_gui builds on)
+    reads the description and parameters into the same joint tables as Debian's, and takes a
+    source's values the same way."""
+    denv = reference_env(ros_env(debian_rosmaster, ros_home))
+    for args in (["/robot_description", URDF], ["/zeros", "{pan: 0.3}"], ["/use_sim_time", "false"]):
+        done = subprocess.run(["/usr/bin/rosparam", "set", *args], env=denv, capture_output=True,
+                              text=True, timeout=30)
+        assert done.returncode == 0, done.stderr
+    env = ros_env(debian_rosmaster, ros_home)
+    ours = subprocess.run([PYTHON, "-c", JSP_API], env=env, capture_output=True, text=True,
+                          timeout=60)
+    assert ours.returncode == 0, ours.stderr
+    mine = json.loads(ours.stdout.strip().splitlines()[-1])
+    assert mine["list"] == ["pan", "lift", "grip", "spin"] and mine["calls"] == 1
+    assert mine["free"]["pan"]["position"] == 0.5 and mine["free"]["spin"]["continuous"] is True
+    theirs = subprocess.run([REFERENCE_PYTHON, "-c", JSP_API], env=denv, capture_output=True,
+                            text=True, timeout=60)
+    assert theirs.returncode == 0, theirs.stderr
+    assert mine == json.loads(theirs.stdout.strip().splitlines()[-1])

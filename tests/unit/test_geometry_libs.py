@@ -267,7 +267,6 @@ def test_stereo_depth_and_disparity_are_inverse():
 
 def test_tf2_geometry_msgs_transform_to_kdl_gives_a_pykdl_frame():
     import PyKDL
-    import tf2_geometry_msgs
     import tf2_kdl
     from geometry_msgs.msg import TransformStamped
 

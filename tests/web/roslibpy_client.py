@@ -4,6 +4,7 @@ tests/integration/test_web.py: one scenario, one ``RESULT {json}`` line.
     python roslibpy_client.py WS_URL   (turtlesim must be running on the graph)
     python roslibpy_client.py WS_URL connect   (connects and asks rosapi the time)
     python roslibpy_client.py WS_URL refusing_service   (serves a service answering result false)
+    python roslibpy_client.py WS_URL latched_twice   (two clients, one latched message each)
 """
 
 from __future__ import annotations
@@ -115,7 +116,30 @@ def refusing_service(url: str) -> int:
     return 0
 
 
+def latched_twice(url: str) -> int:
+    """Two clients subscribe to /web_latched one after the other (the first still subscribed):
+    the latched message each gets, or None after 20 s."""
+    out: dict = {"received": []}
+    clients, topics = [], []
+    for _ in range(2):
+        ros = roslibpy.Ros(url)
+        ros.run(timeout=10)
+        clients.append(ros)
+        got = threading.Event()
+        received: list = []
+        topic = roslibpy.Topic(ros, "/web_latched", "std_msgs/String")
+        topic.subscribe(lambda msg, received=received, got=got: (received.append(msg), got.set()))
+        topics.append(topic)
+        got.wait(20)
+        out["received"].append(received[0] if received else None)
+    for topic in topics:
+        topic.unsubscribe()
+    clients[0].terminate()
+    print("RESULT " + json.dumps(out, default=dict), flush=True)
+    return 0
+
+
 if __name__ == "__main__":
     scenario = sys.argv[2] if len(sys.argv) > 2 else "turtlesim"
-    sys.exit({"turtlesim": main, "connect": connect,
-              "refusing_service": refusing_service}[scenario](sys.argv[1]))
+    sys.exit({"turtlesim": main, "connect": connect, "refusing_service": refusing_service,
+              "latched_twice": latched_twice}[scenario](sys.argv[1]))

@@ -195,37 +195,3 @@ def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
         except (ROSBagException, OSError) as exc:
             _err(f"ERROR operating on {path}: {exc}")
     return 0
-
-
-def check(path: str) -> int:
-    """Which connections' types differ from the installed ones (``rosbag check``)."""
-    try:
-        bag = Bag(path)
-    except ROSBagException as exc:
-        _read_error(path, exc)
-        return 1
-    from minros.msgs import get_message_class
-
-    needed = []
-    seen = set()
-    for conn in bag._connections.values():
-        if (conn.datatype, conn.md5sum) in seen:
-            continue
-        seen.add((conn.datatype, conn.md5sum))
-        try:
-            installed = get_message_class(conn.datatype)
-        except Exception:
-            installed = None
-        if installed is None or installed._md5sum != conn.md5sum:
-            needed.append((conn, installed))
-    bag.close()
-    if not needed:
-        print("Bag file does not need any migrations.")
-        return 0
-    print("The following migrations need to occur:")
-    for conn, installed in needed:
-        print(f" * From: {conn.datatype} [{conn.md5sum}]")
-        print("   To:   " + (f"{installed._type} [{installed._md5sum}]" if installed else "Unknown"))
-    print("\nminros writes no migration rules (rosbag fix is not available); the bag still "
-          "plays and reads with the definitions it stores.")
-    return 0

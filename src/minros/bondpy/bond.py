@@ -11,7 +11,17 @@ import minros
 from bond.msg import Constants, Status
 from minros.bondpy import states
 
-__all__ = ["Bond", "Timeout"]
+__all__ = ["Bond", "Timeout", "as_float_duration", "as_ros_duration"]
+
+
+def as_float_duration(d: Any) -> Any:
+    """Seconds of a Duration; anything else (a number of seconds) as given."""
+    return d.to_sec() if isinstance(d, minros.Duration) else d
+
+
+def as_ros_duration(d: Any) -> Any:
+    """A Duration of ``d`` seconds; a Duration as given."""
+    return d if isinstance(d, minros.Duration) else minros.Duration.from_sec(d)
 
 
 def _seconds(value: Any) -> float:

@@ -28,5 +28,16 @@ TRANSITIONS: Dict[Tuple[str, str], Tuple[str, Tuple[str, ...]]] = {
 }
 
 
+#: the pairs that stay in their state doing nothing (ROS's BondSM.sm names them); every other
+#: pair missing from TRANSITIONS is one the machine does not define (SMC raises for those,
+#: and Bond, which never makes them, ignores them)
+STAYS = frozenset({(AWAIT_SISTER_DEATH, "Die"), (AWAIT_SISTER_DEATH, "HeartbeatTimeout"),
+                   (AWAIT_SISTER_DEATH, "SisterAlive")}
+                  | {(DEAD, event) for event in ("ConnectTimeout", "Die", "DisconnectTimeout",
+                                                 "HeartbeatTimeout", "SisterAlive", "SisterDead")})
+EVENTS = ("ConnectTimeout", "Die", "DisconnectTimeout", "HeartbeatTimeout", "SisterAlive",
+          "SisterDead")
+
+
 def step(state: str, event: str) -> Tuple[str, Tuple[str, ...]]:
     return TRANSITIONS.get((state, event), (state, ()))

@@ -30,10 +30,13 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
     "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
+    "sim": ("minros.cli.sim", "a 2D robot simulator with map_server and move_base (Stage-like)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
     "clean": ("minros.cli.clean", "check the size of the ROS log files and purge them (rosclean)"),
     "wtf": ("minros.cli.wtf", "check the ROS environment and the running graph (roswtf)"),
     "master": ("minros.master", "run a ROS master alone, without rosout (rosmaster)"),
+    "learn": ("minros.cli.learn", "exercises on the ROS wire that check themselves"),
+    "zenoh": ("minros.cli.zenoh", "bridge topics and services with Zenoh (zenoh-bridge-ros1's wire)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)

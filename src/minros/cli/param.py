@@ -463,5 +463,62 @@ def yamlmain(argv: List[str] | None = None) -> None:
     sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
 
 
+# -- more of rosparam's Python API: its YAML hooks and helpers (the angle and binary tags are
+# minros.launch.rosparam_yaml's, on a loader of their own: importing rosparam patches nothing)
+
+#: the key of a YAML document that names the namespace it loads into
+NS = "_ns"
+
+
+def get_param_server() -> Master:
+    """The master client rosparam's calls go through (caller id ``/rosparam-<pid>``)."""
+    return _master()
+
+
+def load_str(text: str, filename: str | None, default_namespace: str | None = None,
+             verbose: bool = False) -> List[Tuple[Any, str]]:
+    """``[(values, namespace), ...]`` for the YAML documents in ``text`` (``_ns`` keys
+    honoured; ``filename`` only names the source)."""
+    def run() -> List[Tuple[Any, str]]:
+        return load_documents(text, default_namespace or names.get_ros_namespace(), verbose)
+
+    return _library(run)
+
+
+def construct_angle_radians(loader: Any, node: Any) -> float:
+    """YAML constructor of ``!radians 2*pi`` / ``rad(pi/2)``: the value in radians."""
+    from minros.launch.rosparam_yaml import RosparamLoader
+
+    try:
+        return RosparamLoader.yaml_constructors["!radians"](loader, node)
+    except ValueError as exc:
+        raise RosParamException(str(exc)) from None
+
+
+def construct_angle_degrees(loader: Any, node: Any) -> float:
+    """YAML constructor of ``!degrees 180`` / ``deg(90)``: the value in radians."""
+    from minros.launch.rosparam_yaml import RosparamLoader
+
+    try:
+        return RosparamLoader.yaml_constructors["!degrees"](loader, node)
+    except ValueError as exc:
+        raise RosParamException(str(exc)) from None
+
+
+def construct_yaml_binary(loader: Any, node: Any) -> xmlrpc.client.Binary:
+    """YAML constructor of ``!!binary``: an XML-RPC Binary, as the parameter server stores it."""
+    return xmlrpc.client.Binary(loader.construct_yaml_binary(node))
+
+
+def represent_xml_binary(dumper: Any, data: xmlrpc.client.Binary) -> Any:
+    """YAML representer of an XML-RPC Binary: ``!!binary`` base64 text."""
+    return _represent_binary(dumper, data)
+
+
+def represent_foo(dumper: Any, data: Any) -> Any:
+    """rosparam's representer writing ``data`` as a scalar tagged ``#``."""
+    return dumper.represent_scalar("#", data)
+
+
 if __name__ == "__main__":  # rosrun rosparam rosparam / <node pkg="rosparam" type="rosparam">
     sys.exit(main(sys.argv[1:]))

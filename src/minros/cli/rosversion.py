@@ -17,7 +17,9 @@ import sys
 from typing import List
 
 from minros import packages
-from minros.cli.core import ROSDISTRO
+
+#: minros implements the Noetic protocols; tools that ask for the distro get a real one.
+ROSDISTRO = "noetic"
 
 
 def _parser(prog: str) -> argparse.ArgumentParser:

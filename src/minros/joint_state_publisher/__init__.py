@@ -7,4 +7,13 @@ joint_state_publisher_gui are not there)."""
 
 from minros.joint_state_publisher.joints import JointTable
 
-__all__ = ["JointTable"]
+__all__ = ["JointTable", "JointStatePublisher", "get_param"]
+
+
+def __getattr__(name: str):
+    # the publisher needs a node runtime: imported when first used
+    if name in ("JointStatePublisher", "get_param"):
+        from minros.joint_state_publisher import publisher
+
+        return getattr(publisher, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

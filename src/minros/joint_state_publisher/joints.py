@@ -52,14 +52,15 @@ class JointTable:
             zero = zeros.get(joint.name)
             if not zero:
                 zero = (low + high) / 2 if low > 0 or high < 0 else 0.0
-            values: Dict[str, Any] = {"min": low, "max": high, "zero": zero,
-                                      "continuous": joint.type == "continuous"}
+            values: Dict[str, Any] = {"min": low, "max": high, "zero": zero}
             if default_positions:
                 values["position"] = zero
             if default_velocities:
                 values["velocity"] = 0.0
             if default_efforts:
                 values["effort"] = 0.0
+            if joint.type == "continuous":
+                values["continuous"] = True  # the key only where true, as ROS's table has it
             self.free[joint.name] = values
         for name in self.dependent:
             self._resolve(name)  # reject cycles and unknown joints now, with their names
@@ -104,7 +105,7 @@ class JointTable:
             forward = joint.get("forward", True)
             joint["position"] += delta if forward else -delta
             if joint["position"] > joint["max"]:
-                if joint["continuous"]:
+                if joint.get("continuous", False):
                     joint["position"] = joint["min"]
                 else:
                     joint["position"] = joint["max"]

@@ -148,6 +148,10 @@ class TopicTap:
         self.bytes = 0
         self.last_ns = 0
         self.header: Dict[str, str] = {}
+        # the last message of each latching publisher, for listeners that come later: the one
+        # subscription is shared, so a second client would otherwise never see a latched
+        # message (rosbridge's shared subscriber keeps it too)
+        self.latched: Dict[str, Incoming] = {}
         self._times: List[float] = []
         self.subscriber: Any = None
         self.raw: Any = None
@@ -191,6 +195,8 @@ class TopicTap:
         self.header = header
         now_ns = self.state.now_ns()
         incoming = Incoming(self, data, header, now_ns)
+        if header.get("latching") == "1":
+            self.latched[header.get("callerid", "")] = incoming
         self.count += 1
         self.bytes += len(data)
         self.last_ns = now_ns
@@ -214,6 +220,9 @@ class TopicTap:
     def add(self, key: Hashable, listener: Callable[[Incoming], None]) -> None:
         with self.lock:
             self.listeners = {**self.listeners, key: listener}
+            latched = list(self.latched.values())
+        for incoming in latched:
+            listener(incoming)
 
     def remove(self, key: Hashable) -> bool:
         """Drop a listener; True when none is left."""

@@ -62,6 +62,13 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "tf2_tools": {
         "view_frames.py": "minros.tf.view_frames",
     },
+    # minros sim and the navigation nodes it starts (minros.sim holds their logic)
+    "minros_sim": {"sim_node": "minros.nodes.minros_sim.sim_node"},
+    "map_server": {
+        "map_server": "minros.nodes.map_server.map_server",
+        "map_saver": "minros.nodes.map_server.map_saver",
+    },
+    "move_base": {"move_base": "minros.nodes.move_base.move_base"},
     "turtle_tf": {
         "turtle_tf_broadcaster.py": "minros.nodes.turtle_tf.turtle_tf_broadcaster",
         "turtle_tf_listener.py": "minros.nodes.turtle_tf.turtle_tf_listener",
