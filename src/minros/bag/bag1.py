@@ -387,6 +387,11 @@ class Bag1Reader:
             raise ROSBagFormatException(f"the chunk at offset {pos} is damaged ({type(exc).__name__}: "
                                         f"{exc}): run rosbag reindex to keep the others") from None
 
+    @property
+    def file(self) -> BinaryIO:
+        """The open bag file."""
+        return self._index.bio
+
     def close(self) -> None:
         if not self._keep_open:
             self._index.bio.close()
@@ -464,6 +469,11 @@ class Bag1Writer:
         self._conns: Dict[int, Connection] = {c.id: c for c in self._w.connections}
         self._by_key: Dict[tuple, Connection] = {self._key(c): c for c in self._w.connections}
         self.connections: Dict[int, ConnInfo] = {c.id: _conn_info(c) for c in self._w.connections}
+
+    @property
+    def file(self) -> Optional[BinaryIO]:
+        """The open bag file (None once closed)."""
+        return self._w.bio
 
     @staticmethod
     def _key(conn: Connection) -> tuple:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import collections
 import errno
+import io
 import logging
 import select
 import socket
@@ -484,6 +485,39 @@ def _advance(parts: list, sent: int) -> _Partial | None:
     return _Partial(*rest) if rest else None
 
 
+class _TransportConnection:
+    """A connection added through rospy's ``add_connection`` (a rospy.impl.transport Transport,
+    which sends with ``write_data(bytes)``), as the publisher's connections are driven."""
+
+    def __init__(self, transport: Any) -> None:
+        self.transport = transport
+        self.id = getattr(transport, "id", _next_conn_id())
+        self.stat_bytes = 0
+        self.stat_msgs = 0
+
+    @property
+    def callerid(self) -> str:
+        return self.transport.endpoint_id
+
+    endpoint_id = callerid
+
+    @property
+    def done(self) -> bool:
+        return bool(getattr(self.transport, "done", False))
+
+    def write(self, frame: Any) -> None:
+        data = frame if frame.__class__ is bytes else b"".join(bytes(p) for p in frame)
+        self.transport.write_data(data)
+        self.stat_bytes += len(data)
+        self.stat_msgs += 1
+
+    def info(self) -> str:
+        return f"{getattr(self.transport, 'transport_type', 'UNKNOWN')} connection to [{self.callerid}]"
+
+    def close(self) -> None:
+        self.transport.close()
+
+
 class _PublisherImpl:
     """Shared state of all Publisher handles for one topic in this process."""
 
@@ -572,7 +606,9 @@ class _PublisherImpl:
         self.message_data_sent += _frame_len(frame) - 4
         return frame
 
-    def publish(self, msg: Any) -> None:
+    def publish(self, msg: Any, connection_override: Any = None) -> None:
+        """Send ``msg`` to every connection (or only to ``connection_override``, a connection
+        of this publication: rospy's way of sending a latched message to a newcomer)."""
         with self.lock:
             if self.closed:
                 if self.node.is_shutdown():
@@ -583,6 +619,9 @@ class _PublisherImpl:
             conns = self.connections
             if not conns:
                 return
+            if connection_override is not None:
+                conns = [c for c in conns if c is connection_override
+                         or getattr(c, "transport", None) is connection_override]
             # Header auto-fill, then one serialization for every connection
             self.seq += 1
             if getattr(msg, "_has_header", False):
@@ -593,6 +632,39 @@ class _PublisherImpl:
                 conn.write(frame)
 
     # -- bookkeeping ---------------------------------------------------------------------
+
+    # -- rospy's internal names (rospy.topics._PublisherImpl), for code written against them --
+
+    #: rospy serializes into this buffer and empties it after each publish
+    buff = property(lambda self: io.BytesIO())
+
+    def acquire(self) -> None:
+        self.lock.acquire()
+
+    def release(self) -> None:
+        self.lock.release()
+
+    def add_connection(self, transport: Any) -> bool:
+        """Add a connection made outside the node's TCPROS server (a rospy Transport); one to
+        the same endpoint replaces it, and a latched message is sent to it at once."""
+        conn = transport if isinstance(transport, (_PubConnection, _TransportConnection)) \
+            else _TransportConnection(transport)
+        with self.lock:
+            if self.closed:
+                return False
+            self.connections = [c for c in self.connections
+                                if c.callerid != conn.callerid] + [conn]
+            if self.is_latch and self.latch is not None:
+                self.publish(self.latch, connection_override=transport)
+        return True
+
+    def remove_connection(self, transport: Any) -> None:
+        with self.lock:
+            self.connections = [c for c in self.connections if c is not transport
+                                and getattr(c, "transport", None) is not transport]
+
+    def get_num_connections(self) -> int:
+        return sum(1 for c in self.connections if not c.done)
 
     def get_stats(self) -> list:
         return [self.resolved_name, self.message_data_sent,

@@ -91,8 +91,12 @@ class Master:
 
     @property
     def handle(self) -> ServerProxy:
-        """The XML-RPC proxy of the master (rosgraph's name)."""
+        """The XML-RPC proxy of the master (rosgraph's name; tests replace it by a mock)."""
         return self._get_proxy()
+
+    @handle.setter
+    def handle(self, proxy: Any) -> None:
+        self._proxy = proxy
 
     def is_online(self) -> bool:
         """Whether the master answers ``getPid``."""

@@ -407,6 +407,11 @@ class XmlRpcServer:
             if thread is not None and thread is not threading.current_thread():
                 thread.join(max(0.0, deadline - time.monotonic()))
 
+    def serve_forever(self) -> None:
+        """Block until :meth:`shutdown` (the accept thread serves; this is for callers written
+        for socketserver, whose server loop runs in the calling thread)."""
+        self._stopping.wait()
+
     def connection_count(self) -> int:
         with self._conns_lock:
             return len(self._conns)
