@@ -238,3 +238,28 @@ def test_a_reload_keeps_the_exercise_and_closing_the_page_stops_it(server, brows
     wait_until(lambda: not any(_alive(pid) for pid in pids), OWNER_GRACE + 30,
                what="the closed page's exercise to stop")
     assert not _left_in(Path(facts["dir"]))
+
+
+def test_the_server_stopping_stops_the_exercise(browser, shots, tmp_path):
+    own = Server(tmp_path)  # a server of its own: this test stops it
+    try:
+        tab = Page(browser, own, shots)
+        try:
+            tab.open("learn")
+            view = tab.view("learn")
+            view.locator('.learn-item[data-number="2"]').click()
+            view.locator(".learn-start").click()
+            _running(tab, 2)
+            facts = own.facts(2)
+            pids = list(facts["pids"].values())
+            assert all(_alive(pid) for pid in pids)
+            out = own.web.stop(timeout=30)  # Ctrl-C: the server stops what the page started
+            assert "exercise 2 stopped: the server stopped" in out, out[-2000:]
+            assert not [pid for pid in pids if _alive(pid)]
+            assert not _left_in(Path(facts["dir"]))
+            tab.page.wait_for_function("minrosPage.conn.state !== 'connected'", timeout=20_000)
+        finally:
+            tab.errors.clear()  # the page's reconnection attempts, to a server that is gone
+            tab.close()
+    finally:
+        own.stop()
