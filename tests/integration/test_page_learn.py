@@ -190,6 +190,13 @@ def test_a_learner_starts_exercise_1_answers_wrong_then_right_and_stops_it(serve
         assert view.locator(".learn-hint").count() == 0
         tab.page.wait_for_timeout(300)
         tab.shot("learn")
+        # minros learn 1 in a terminal meanwhile is refused, and told where this one stops
+        again = subprocess.run([PYTHON, "-m", "minros", "learn", "1", "--dir", str(server.base)],
+                               env=server.env, capture_output=True, text=True, timeout=60)
+        assert again.returncode == 1 and again.stderr.strip().endswith(
+            f"is already running (pid {server.web.pid}): stop it in the Learn view of minros "
+            "web's page first (it started it)"), again.stderr
+        assert all(_alive(pid) for pid in pids)
 
         # stopped from the page: every process it started ends, none is left in its folder
         view.locator(".learn-stop").click()

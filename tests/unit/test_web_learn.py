@@ -41,7 +41,7 @@ class FakeRunner:
     log: list = []
     hold = False  # start waits until the test opens its gate
 
-    def __init__(self, exercise, base, variant="", say=print) -> None:
+    def __init__(self, exercise, base, variant="", say=print, stop_hint="") -> None:
         if variant and variant not in exercise.variants:
             raise LookupError(f"no variant {variant}")
         self.exercise = exercise

@@ -212,7 +212,9 @@ class LearnHub:
         what to do when it cannot."""
         ex = learn.exercise(number)  # LookupError: there is no such exercise
         runner = self.make_runner(ex, self.base, variant=variant,
-                                  say=lambda text: minros.loginfo(f"[web] learn: {text}"))
+                                  say=lambda text: minros.loginfo(f"[web] learn: {text}"),
+                                  stop_hint="stop it in the Learn view of minros web's page "
+                                            "first (it started it)")
         with self.lock:
             if self._closed:
                 raise LearnError("the server is stopping")
