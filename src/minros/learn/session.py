@@ -99,7 +99,7 @@ class Runner:
 
     def __init__(self, exercise: Exercise, base: Path, variant: str = "",
                  seed: Optional[int] = None, python: str = sys.executable,
-                 say: Callable[[str], None] = print) -> None:
+                 say: Callable[[str], None] = print, stop_hint: str = "") -> None:
         if variant and variant not in exercise.variants:
             if variant in exercise.planned:
                 raise LearnError(f"--via {variant}: {exercise.planned[variant]}; use --via "
@@ -116,6 +116,8 @@ class Runner:
         self.procs: Dict[str, subprocess.Popen] = {}
         self.reported: set = set()
         self.facts: Dict[str, Any] = {}
+        #: how whoever finds this start running stops it (kept in state.json)
+        self.stop_hint = stop_hint or "stop it with Ctrl-C in its terminal first"
 
     # -- start
 
@@ -155,8 +157,9 @@ class Runner:
                 old = {}
             pid = int(old.get("runner", 0) or 0)
             if pid and pid != os.getpid() and _alive(pid) and old.get("running"):
+                how = old.get("stop_hint") or "stop it with Ctrl-C in its terminal first"
                 raise LearnError(f"exercise {self.exercise.number} is already running (pid "
-                                 f"{pid}): stop it with Ctrl-C in its terminal first")
+                                 f"{pid}): {how}")
         if self.folder.exists():
             shutil.rmtree(self.folder)
         try:
@@ -188,6 +191,7 @@ class Runner:
                 field=facts["field"]).splitlines())
         facts["runner"] = os.getpid()
         facts["running"] = True
+        facts["stop_hint"] = self.stop_hint
         return facts
 
     def _write_env(self, facts: Dict[str, Any]) -> None:
