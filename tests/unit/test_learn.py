@@ -400,6 +400,30 @@ def test_the_command_lists_and_refuses_in_one_line(tmp_path, capsys):
     assert "not an exercise number" in capsys.readouterr().err
 
 
+def test_an_exercise_whose_traces_grow_too_big_stops(tmp_path):
+    import threading
+
+    from minros.learn import session
+    from minros.learn.session import Runner
+
+    said: List[str] = []
+    runner = Runner(learn.exercise(1), tmp_path, say=said.append)
+    runner.folder.mkdir(parents=True)
+    (runner.folder / "master.jsonl").write_bytes(b"x" * 3000)
+    (runner.folder / "master.log").write_bytes(b"x" * 9000)  # logs do not count
+    assert runner.too_big(limit=4000) == ""
+    (runner.folder / "me.jsonl").write_bytes(b"x" * 2000)
+    assert runner.too_big(limit=4000).startswith(f"its traces in {runner.folder} passed")
+    (runner.folder / "talker.jsonl").write_bytes(b"x" * (session.TRACE_LIMIT - 4000))
+    session_every = session.SIZE_EVERY
+    try:
+        session.SIZE_EVERY = 0.0
+        runner.wait(threading.Event(), poll=0.01, limit=5.0)
+    finally:
+        session.SIZE_EVERY = session_every
+    assert len(said) == 1 and said[0].startswith("minros learn: stopping: its traces in")
+
+
 def test_an_exercise_left_running_stops_by_itself(tmp_path):
     import threading
 

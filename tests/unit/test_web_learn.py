@@ -40,6 +40,7 @@ class FakeRunner:
     made: list = []
     log: list = []
     hold = False  # start waits until the test opens its gate
+    too_big_text = ""  # what too_big says: "" while the traces may grow
 
     def __init__(self, exercise, base, variant="", say=print, stop_hint="") -> None:
         if variant and variant not in exercise.variants:
@@ -66,6 +67,9 @@ class FakeRunner:
             self.procs[process.name] = FakeProc(1000 + i)
         return facts
 
+    def too_big(self):
+        return FakeRunner.too_big_text
+
     def stop(self):
         FakeRunner.log.append(("stop", self.exercise.number))
         for proc in self.procs.values():
@@ -77,6 +81,7 @@ class FakeRunner:
 @pytest.fixture
 def hub(tmp_path):
     FakeRunner.made, FakeRunner.log, FakeRunner.hold = [], [], False
+    FakeRunner.too_big_text = ""
     made = LearnHub(tmp_path / "learn", runner=FakeRunner, grace=0.3)
     yield made
     made.close()
@@ -246,6 +251,24 @@ def test_an_exercise_stops_at_the_time_limit(tmp_path):
         assert FakeRunner.log == [("start", 7), ("stop", 7)]
         page.close()
     finally:
+        hub.close()
+
+
+def test_an_exercise_whose_traces_grow_too_big_stops(tmp_path):
+    FakeRunner.made, FakeRunner.log, FakeRunner.too_big_text = [], [], ""
+    hub = LearnHub(tmp_path / "learn", runner=FakeRunner, size_every=0.05)
+    try:
+        page, outbox, _ = session(learn=hub)
+        send(page, op="learn_watch")
+        send(page, op="learn_start", id="s", number=7)
+        frames(outbox, "learn", run_state("running"))
+        FakeRunner.too_big_text = "its traces in /x passed 200 MB (start it again)"
+        stopped = frames(outbox, "learn", run_state("stopped"))["run"]
+        assert stopped["reason"] == "its traces in /x passed 200 MB (start it again)"
+        assert FakeRunner.log == [("start", 7), ("stop", 7)]
+        page.close()
+    finally:
+        FakeRunner.too_big_text = ""
         hub.close()
 
 

@@ -38,6 +38,11 @@ READY_TIMEOUT = 30.0
 #: an exercise left running stops after this long (its nodes' traces keep growing: every
 #: node probes its master once a second)
 RUN_LIMIT = 3600.0
+#: an exercise whose folder's traces pass this many bytes stops too (five minutes of any
+#: exercise write a few MB, but a run left going need not fill the disk)
+TRACE_LIMIT = 200 << 20
+#: how often the traces' size is looked at (seconds)
+SIZE_EVERY = 5.0
 STOP_GRACE = (("SIGINT", 5.0), ("SIGTERM", 3.0), ("SIGKILL", 3.0))
 
 
@@ -284,16 +289,37 @@ class Runner:
         """Until ``stop`` is set or ``limit`` seconds have passed, saying once when a process
         ends (the learner may end one on purpose: exercise 10 kills the master)."""
         deadline = time.monotonic() + limit
+        sized = time.monotonic()
         while not stop.wait(poll):
-            if time.monotonic() > deadline:
+            now = time.monotonic()
+            if now > deadline:
                 self.say(f"minros learn: stopping after {limit / 60:g} minutes (an exercise "
                          "takes five; start it again with the same command)")
                 return
+            if now - sized >= SIZE_EVERY:
+                sized = now
+                too_big = self.too_big()
+                if too_big:
+                    self.say(f"minros learn: stopping: {too_big}")
+                    return
             for name, proc in self.procs.items():
                 if name not in self.reported and proc.poll() is not None:
                     self.reported.add(name)
                     self.say(f"minros learn: {name} (pid {proc.pid}) ended, status "
                              f"{proc.returncode}")
+
+    def too_big(self, limit: int = TRACE_LIMIT) -> str:
+        """Why the exercise must stop for the size of its traces ("" while it need not)."""
+        size = 0
+        for path in self.folder.glob("*.jsonl"):
+            try:
+                size += path.stat().st_size
+            except OSError:
+                continue
+        if size <= limit:
+            return ""
+        return (f"its traces in {self.folder} passed {limit >> 20} MB (start it again with the "
+                "same command)")
 
     def stop(self) -> None:
         """Stop every process this runner started (SIGINT, then SIGTERM, then SIGKILL, each
