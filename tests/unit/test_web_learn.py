@@ -132,7 +132,15 @@ def test_the_list_names_every_exercise_with_its_form_what_it_starts_and_a_previe
     assert "ROS_MASTER_URI=<master>" in first["preview"]
     assert f"{hub.base}/01-register-subscriber/me.jsonl" in first["preview"]
     eleven = listed[10]
-    assert eleven["variants"] == ["relay"] and "zenoh" in eleven["planned"]
+    assert eleven["variants"] == ["zenoh", "relay"]
+    # a start without a variant (the page's) runs the first that can start here
+    assert eleven["variant"] == learn.exercise(11).default_variant
+    assert eleven["answer_form"] == learn.exercise(11).form()
+    if eleven["variant"] == "zenoh":
+        assert eleven["planned"] == {} and "bridge_a" in eleven["processes"]
+        assert "key expression" in eleven["preview"]
+    else:  # without eclipse-zenoh: why, in the about line
+        assert "pip install minros[zenoh]" in eleven["planned"]["zenoh"]
     assert listed[4]["processes"] == []  # the md5sum is worked out by hand
 
 
@@ -311,7 +319,8 @@ def test_a_failed_start_says_why(tmp_path):
     ({"number": "1"}, "status", "Expected field number to be one of ('int',). Invalid value: 1"),
     ({"number": True}, "status", "number is an exercise's number (1, 2, ...), not true or false"),
     ({}, "status", "Expected a number field but none was found."),
-    ({"number": 11, "variant": "zenoh"}, "reply", "--via zenoh: minros zenoh does not exist yet"),
+    ({"number": 11, "variant": "pigeon"}, "reply",
+     "exercise 11 has no variant 'pigeon' (variants: zenoh, relay)"),
     ({"number": 1, "variant": "relay"}, "reply", "exercise 1 has no variant 'relay' (variants: none)"),
 ])
 def test_a_start_the_catalog_does_not_have_is_refused_with_what_to_do(tmp_path, msg, op, text):

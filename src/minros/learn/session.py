@@ -17,6 +17,7 @@ import shlex
 import shutil
 import signal
 import socket
+import string
 import subprocess
 import sys
 import threading
@@ -26,7 +27,6 @@ from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Optional
 
 from minros import rosenv
-from minros.learn.catalog import VARIANT_FACTS
 from minros.learn.model import Attempt, Exercise, Process
 from minros.wire.xmlrpc import ServerProxy
 
@@ -39,7 +39,8 @@ READY_TIMEOUT = 30.0
 #: node probes its master once a second)
 RUN_LIMIT = 3600.0
 #: an exercise whose folder's traces pass this many bytes stops too (five minutes of any
-#: exercise write a few MB, but a run left going need not fill the disk)
+#: exercise write a few MB; the masters of exercise 11's zenoh variant trace the bridges'
+#: graph reads, some 110 kB/s together: 200 MB in half an hour)
 TRACE_LIMIT = 200 << 20
 #: how often the traces' size is looked at (seconds)
 SIZE_EVERY = 5.0
@@ -65,6 +66,18 @@ def _free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
+
+
+def _port_fields(processes: Iterable[Process]) -> List[str]:
+    """The ``{..._port}`` fields of the processes' arguments (each start gives each a free
+    port: a Zenoh endpoint, say), besides the masters' ``port`` and ``port_b``."""
+    names: List[str] = []
+    for process in processes:
+        for arg in process.argv:
+            for _text, name, _spec, _conv in string.Formatter().parse(arg):
+                if name and name.endswith("_port") and name not in names:
+                    names.append(name)
+    return names
 
 
 def _alive(pid: int) -> bool:
@@ -105,13 +118,15 @@ class Runner:
     def __init__(self, exercise: Exercise, base: Path, variant: str = "",
                  seed: Optional[int] = None, python: str = sys.executable,
                  say: Callable[[str], None] = print, stop_hint: str = "") -> None:
-        if variant and variant not in exercise.variants:
-            if variant in exercise.planned:
-                raise LearnError(f"--via {variant}: {exercise.planned[variant]}; use --via "
-                                 f"{exercise.default_variant}")
+        if variant and variant not in exercise.variants and variant not in exercise.planned:
             known = ", ".join(v for v in exercise.variants if v) or "none"
             raise LearnError(f"exercise {exercise.number} has no variant {variant!r} "
                              f"(variants: {known})")
+        missing = exercise.missing(variant) if variant else ""
+        if missing:
+            others = [v for v in exercise.variants if v != variant and not exercise.missing(v)]
+            instead = f"; --via {others[0]} runs without it" if others else ""
+            raise LearnError(f"--via {variant}: {missing}{instead}")
         self.exercise = exercise
         self.variant = variant or exercise.default_variant
         self.folder = folder_for(base, exercise)
@@ -186,9 +201,11 @@ class Runner:
         if "b" in masters:
             facts["port_b"] = _free_port()
             facts["master_b"] = f"http://localhost:{facts['port_b']}/"
+        for name in _port_fields(ex.processes(self.variant)):
+            facts.setdefault(name, _free_port())
         if ex.choose is not None:
             facts.update(ex.choose(self.rng))
-        facts.update(VARIANT_FACTS.get((ex.number, self.variant), {}))
+        facts.update(ex.variant_facts.get(self.variant, {}))
         if ex.slug == "md5sum":
             from minros.learn.catalog import READING_MSG
 
@@ -215,8 +232,9 @@ class Runner:
                if not k.startswith(("ROS_", "MINROS_")) and k != "PYTHONPATH"}
         master = facts["master_b"] if process.master == "b" else facts["master"]
         env.update(ROS_MASTER_URI=master, ROS_HOSTNAME="localhost", PYTHONUNBUFFERED="1",
-                   ROS_LOG_DIR=str(self.folder / "log"),
-                   MINROS_TRACE=str(self.folder / f"{process.name}.jsonl"))
+                   ROS_LOG_DIR=str(self.folder / "log"))
+        if process.traced:
+            env["MINROS_TRACE"] = str(self.folder / f"{process.name}.jsonl")
         return env
 
     def _start(self, process: Process, facts: Dict[str, Any]) -> None:
@@ -269,6 +287,8 @@ class Runner:
         if len(process.ready) != 2:
             return True
         method, name = process.ready
+        if not process.traced:
+            return self._registered(process, facts, method, name)
         for ev in _events(self.folder / f"{process.name}.jsonl"):
             args = ev.get("args") or []
             reply = ev.get("reply")
@@ -276,6 +296,25 @@ class Runner:
                     and args[1] == name and isinstance(reply, list) and reply[:1] == [1]):
                 return True
         return False
+
+    def _registered(self, process: Process, facts: Dict[str, Any], method: str,
+                    name: str) -> bool:
+        """Whether the master lists ``process`` (untraced: by its node name) as ``method``
+        made it: a publisher, subscriber or provider of ``name``."""
+        column = {"registerPublisher": 0, "registerSubscriber": 1, "registerService": 2}
+        if method not in column or not process.node:
+            raise LearnError(f"{process.name} is not traced: its readiness needs its node name "
+                             "and a register* call")
+        port = facts["port_b"] if process.master == "b" else facts["port"]
+        proxy = ServerProxy(f"http://127.0.0.1:{port}/", timeout=2.0)
+        try:
+            code, _status, state = proxy.getSystemState("/minros_learn")
+        except (OSError, xmlrpc.client.Error):
+            return False
+        finally:
+            proxy.close()
+        return code == 1 and any(entry[0] == name and process.node in entry[1]
+                                 for entry in state[column[method]])
 
     def _node_uri(self, name: str) -> str:
         for ev in _events(self.folder / f"{name}.jsonl"):
