@@ -34,8 +34,9 @@ from typing import Any, Callable, Dict, List, Protocol, Sequence, Tuple
 from minros import names, rosenv
 from minros.exceptions import ROSException, ROSInitException, ServiceException
 from minros.wire import admission, sockets, tcpros, trace
+from minros.wire.masterapi import MasterClient, MasterIOError
 from minros.wire.rosapi import ParameterInvalid, api, is_topic
-from minros.wire.xmlrpc import ProtocolError, ServerProxy, XmlRpcServer, after_reply
+from minros.wire.xmlrpc import ServerProxy, XmlRpcServer, after_reply
 
 __all__ = [
     "DEFAULT_MASTER_URI",
@@ -56,6 +57,7 @@ __all__ = [
     "is_initialized",
     "is_shutdown",
     "is_shutdown_requested",
+    "master",
     "master_call",
     "master_call_once",
     "myargv",
@@ -165,7 +167,9 @@ class Node:
         self._tcpros_admission = admission.Admission(TCPROS_LIMITS)
         self._inbound: Dict[int, socket.socket] = {}  # admission key -> inbound socket
         self._inbound_lock = threading.Lock()
-        self._local = threading.local()  # one master proxy per thread
+        #: the typed Master API, as this node (its caller id and master URI as they are now)
+        self.master = MasterClient(lambda: self.master_uri, lambda: self.caller_id,
+                                   XMLRPC_TIMEOUT)
         self._reg_lock = threading.Lock()
         self._master_pid: int | None = None
         self._master_lost = False
@@ -404,25 +408,10 @@ class Node:
         self._register_all(first=True)
         threading.Thread(target=self._monitor_master, name="minros-master-probe", daemon=True).start()
 
-    def master(self) -> ServerProxy:
-        """This thread's proxy to the master, kept alive between calls (a new one when the
-        master URI changed, which it may before init_node fixes it)."""
-        uri = self.master_uri
-        proxy = getattr(self._local, "master", None)
-        if proxy is None or proxy.uri != uri:
-            proxy = ServerProxy(uri, timeout=XMLRPC_TIMEOUT)
-            self._local.master = proxy
-        return proxy
-
     def master_call(self, method: str, *args: Any) -> list:
         """``master.method(caller_id, *args)``: the raw triplet; works before init_node. The
-        connection is kept alive (a lookupService per service call, a getParam per parameter
-        read, must not each pay for a new TCP connection); OSError when the master is down."""
-        try:
-            return getattr(self.master(), method)(self.caller_id, *args)
-        except Exception:
-            self._local.master = None
-            raise
+        connection is kept alive per thread; MasterIOError (an OSError) when the master is down."""
+        return self.master.raw(method, *args)
 
     def master_call_once(self, method: str, *args: Any) -> list:
         """``master.method(caller_id, *args)`` on a fresh connection, closed afterwards."""
@@ -741,7 +730,7 @@ class Node:
                     self._warned_master = True
                     text = (f"Unable to immediately register with master node [{self.master_uri}]: "
                             "master may not be running yet. Will keep trying.")
-                    if isinstance(exc, ProtocolError) and exc.errcode == 403:
+                    if isinstance(exc, MasterIOError) and exc.errcode == 403:
                         # not "may not be running": it runs and refuses us (ROS_ALLOWED_HOSTS)
                         text = (f"The master [{self.master_uri}] refuses this node: {exc.errmsg}. "
                                 "Will keep trying.")
@@ -1044,6 +1033,11 @@ def get_node_uri() -> str | None:
 def get_tcpros_address() -> Tuple[str, int]:
     """(advertised host, port) of this process's TCPROS server (started on first use)."""
     return _default.tcpros_address()
+
+
+def master() -> MasterClient:
+    """The master of this process's node, as that node (works before init_node)."""
+    return _default.master
 
 
 def master_call(method: str, *args: Any) -> list:

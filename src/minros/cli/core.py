@@ -59,14 +59,16 @@ def _master_running(port: int) -> bool:
             pass
     except OSError:
         return False
-    from minros.wire.xmlrpc import ServerProxy
+    from minros.wire.masterapi import MasterClient
 
+    master = MasterClient(f"http://127.0.0.1:{port}/", "/roscore", timeout=1.0)
     try:
-        with ServerProxy(f"http://127.0.0.1:{port}/", timeout=1.0) as proxy:
-            code, _msg, _pid = proxy.getPid("/roscore")
-            return code == 1
+        master.get_pid()
+        return True
     except Exception:  # noqa: BLE001 - whatever listens there is not a master
         return False
+    finally:
+        master.close()
 
 
 class _Console:

@@ -68,9 +68,8 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
     use_sim_time = False
     if not disable_rostime:
         try:
-            code, _msg, value = me.master_call("getParam", "/use_sim_time")
-            use_sim_time = code == 1 and bool(value)
-        except Exception:
+            use_sim_time = bool(me.master.get_param("/use_sim_time"))
+        except Exception:  # unset (MasterError), or the master is away: wall time
             use_sim_time = False
     rostime.start_node_time(use_sim_time)
     statistics.install()  # subscriptions read /enable_statistics when they are made

@@ -28,7 +28,6 @@ import threading
 import time
 import traceback
 import warnings
-import xmlrpc.client
 from typing import Any, Callable, Dict
 
 from minros import names, node
@@ -43,12 +42,12 @@ from minros.exceptions import (
 )
 from minros.msgs import reader_for
 from minros.wire import admission, sockets, tcpros, trace
+from minros.wire.masterapi import MasterError, RemoteError
 from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
 
 # the node context (answers before init_node too)
 _caller_id = node.get_caller_id
 _is_shutdown = node.is_shutdown
-_call_master = node.master_call
 _resolve = node.resolve_name
 _wait_for_shutdown = node.wait_for_shutdown
 
@@ -346,12 +345,12 @@ def _args_kwds_to_request(request_class: type, args: tuple, kwds: dict) -> Any:
 def _lookup_service(resolved_name: str) -> str:
     """The ``rosrpc://`` URI of a service from the master (rospy's error texts)."""
     try:
-        code, msg, uri = _call_master("lookupService", resolved_name)
+        uri = node.master().lookup_service(resolved_name)
     except OSError:
         raise ServiceException("unable to contact master") from None
-    if code != 1:
-        _logger.error("[%s]: lookup service failed with message [%s]", resolved_name, msg)
-        raise ServiceException(f"service [{resolved_name}] unavailable")
+    except RemoteError as exc:
+        _logger.error("[%s]: lookup service failed with message [%s]", resolved_name, exc)
+        raise ServiceException(f"service [{resolved_name}] unavailable") from None
     try:
         parse_rosrpc_uri(uri)
     except ParameterInvalid:
@@ -497,11 +496,11 @@ class ServiceProxy:
 def _probe_service(resolved_name: str, timeout: float) -> str | None:
     """Is the service registered and accepting connections? Sends a probe header and closes."""
     try:
-        code, _msg, uri = _call_master("lookupService", resolved_name)
-    except (xmlrpc.client.Error, ValueError) as exc:  # OSError (master down) goes to the caller
-        raise TransportInitError(f"master lookup failed: {exc}") from None
-    if code != 1:
+        uri = node.master().lookup_service(resolved_name)
+    except MasterError:  # not registered (yet)
         return None
+    except RemoteError as exc:  # OSError (master down) goes to the caller
+        raise TransportInitError(f"master lookup failed: {exc}") from None
     host, port = parse_rosrpc_uri(uri)
     sock = _connect(host, port, timeout)
     try:

@@ -34,6 +34,7 @@ from minros.exceptions import (
 )
 from minros.msgs import reader_for
 from minros.wire import sockets, tcpros, trace
+from minros.wire.masterapi import RemoteError
 from minros.wire.xmlrpc import ServerProxy
 
 __all__ = [
@@ -1146,8 +1147,8 @@ def wait_for_message(topic: str, topic_type: Any, timeout: float | None = None) 
 
 def get_published_topics(namespace: str = "/") -> List[List[str]]:
     """[[topic, type], ...] published in ``namespace`` (master getPublishedTopics)."""
-    code, msg, value = _node_mod.master_call("getPublishedTopics", namespace)
-    if code != 1:
-        raise ROSException(f"unable to get published topics: {msg}")
-    return value
+    try:
+        return [list(pair) for pair in _node_mod.master().get_published_topics(namespace)]
+    except RemoteError as exc:
+        raise ROSException(f"unable to get published topics: {exc}") from None
 
