@@ -1,3 +1,3 @@
-"""rospy.msg: AnyMsg and the publish-argument convention (minros.client.topics)."""
+"""rospy.msg: AnyMsg and the publish-argument convention (minros.client.msg)."""
 
-from minros.client.topics import AnyMsg, args_kwds_to_message  # noqa: F401
+from minros.client.msg import AnyMsg, args_kwds_to_message  # noqa: F401

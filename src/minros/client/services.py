@@ -32,6 +32,7 @@ from typing import Any, Callable, Dict
 
 from minros import names, node
 from minros.client.log import logerr, loginfo, logwarn, logwarn_throttle
+from minros.client.msg import stamp_header
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -41,15 +42,11 @@ from minros.exceptions import (
     TransportTerminated,
 )
 from minros.msgs import reader_for
-from minros.wire import admission, sockets, tcpros, trace
+from minros.transport.tcpros_base import connect, negotiate
+from minros.wire import admission, sockets, tcpros
+from minros.wire.handshake import Handshake, Role, State
 from minros.wire.masterapi import MasterError, RemoteError
 from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
-
-# the node context (answers before init_node too)
-_caller_id = node.get_caller_id
-_is_shutdown = node.is_shutdown
-_resolve = node.resolve_name
-_wait_for_shutdown = node.wait_for_shutdown
 
 __all__ = [
     "Service",
@@ -59,7 +56,7 @@ __all__ = [
     "wait_for_service",
 ]
 
-DEFAULT_BUFF_SIZE = 65536
+DEFAULT_BUFF_SIZE = tcpros.DEFAULT_BUFF_SIZE
 #: how often wait_for_service retries (rospy's interval)
 WAIT_FOR_SERVICE_INTERVAL = 0.3
 #: connect timeout of a service call; the response itself may take as long as the handler
@@ -91,7 +88,7 @@ _logger = logging.getLogger("rospy.service")
 def _send_all(sock: socket.socket, data: Any) -> None:
     """Send ``data`` completely; give up at node shutdown or on a peer stalled for
     SEND_STALL_TIMEOUT seconds (TransportTerminated)."""
-    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=_is_shutdown)
+    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=node.is_shutdown)
 
 
 # --------------------------------------------------------------------------- server
@@ -140,7 +137,7 @@ class Service:
             warnings.warn(f"'{name}' is not a legal ROS graph resource name. This may cause problems "
                           "with other ROS tools", stacklevel=2)
         self.name = name
-        self.resolved_name = _resolve(name)
+        self.resolved_name = node.resolve_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
@@ -183,7 +180,7 @@ class Service:
 
     def _header_fields(self) -> Dict[str, str]:
         return {"service": self.resolved_name, "type": self.service_class._type,
-                "md5sum": self.service_class._md5sum, "callerid": _caller_id()}
+                "md5sum": self.service_class._md5sum, "callerid": node.get_caller_id()}
 
     def _handle_connection(self, sock: socket.socket, header: Dict[str, str],
                            conn: admission.Connection) -> None:
@@ -201,19 +198,19 @@ class Service:
         within the header timeout), its bytes count against the node's budget, and a
         persistent connection waiting for its next request may be closed to make room."""
         sock.settimeout(_POLL)  # every wait, sending or receiving, wakes up to check for shutdown
-        error = tcpros.service_header_error(header, self.resolved_name, self.service_class._md5sum)
-        if error is None and self.done:
-            error = f"[{_caller_id()}] is not a provider of  [{self.resolved_name}]"
-        if error is not None:
-            _send_all(sock, tcpros.encode_error_header(error))
-            logwarn(f"Could not process inbound connection: {error}{header}")
+        refuse = None
+        if self.done:
+            refuse = f"[{node.get_caller_id()}] is not a provider of  [{self.resolved_name}]"
+        handshake = Handshake(Role.SERVICE_SERVER, self._header_fields(), refuse=refuse)
+        _send_all(sock, handshake.opening_received(header))
+        if handshake.state is State.REJECTED:
+            logwarn(f"Could not process inbound connection: {handshake.error}{header}")
             return
-        _send_all(sock, tcpros.encode_header(self._header_fields()))
-        if header.get("probe") == "1":  # wait_for_service checking we are alive
+        if handshake.state is State.CLOSED:  # a probe: wait_for_service checking we are alive
             return
-        persistent = header.get("persistent", "").lower() in ("1", "true")
+        persistent = handshake.persistent
         reader = tcpros.FrameReader(buff_size=max(self.buff_size, 16), first_chunk=_FIRST_CHUNK)
-        source = sockets.FrameSource(sock, reader, stop=_is_shutdown, guard=conn)
+        source = sockets.FrameSource(sock, reader, stop=node.is_shutdown, guard=conn)
         while not self.done:
             conn.idle()
             wait_until = None if persistent else time.monotonic() + conn.limits.head_timeout
@@ -234,7 +231,7 @@ class Service:
             try:
                 _send_all(sock, self._respond(request))
             except TransportTerminated as exc:
-                if not _is_shutdown():
+                if not node.is_shutdown():
                     # the client left (or stalled) mid-response: one line, then the next one
                     # (rospy sends the error through the error handler and logs twice)
                     logerr(f"incoming connection failed: [{self.resolved_name}] response to "
@@ -251,7 +248,7 @@ class Service:
             with self._lock:
                 self.seq += 1
                 seq = self.seq
-            tcpros.stamp_header(response, seq)
+            stamp_header(response, seq)
             buff = _Buffer()
             response.serialize(buff)
             # ok byte + length, then the response as written (not copied into one buffer)
@@ -358,23 +355,13 @@ def _lookup_service(resolved_name: str) -> str:
     return uri
 
 
-def _connect(host: str, port: int, timeout: float) -> socket.socket:
-    """TCP connection to a service; every address of ``host`` is tried (localhost may be ::1)."""
-    sock = socket.create_connection((host, port), timeout=timeout)
-    try:
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    except OSError:  # not fatal: only latency
-        pass
-    return trace.watch(sock, "connect")
-
-
 class ServiceProxy:
     """A callable handle on a remote service: ``proxy(1, 2)``, ``proxy(req)``, ``proxy(a=1, b=2)``."""
 
     def __init__(self, name: str, service_class: type, persistent: bool = False,
                  headers: Dict[str, str] | None = None) -> None:
         self.name = name
-        self.resolved_name = _resolve(name)
+        self.resolved_name = node.resolve_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
@@ -399,7 +386,7 @@ class ServiceProxy:
 
     def _header_fields(self) -> Dict[str, str]:
         fields = {"service": self.resolved_name, "md5sum": self.service_class._md5sum,
-                  "callerid": _caller_id()}
+                  "callerid": node.get_caller_id()}
         fields.update({str(k): str(v) for k, v in self.headers.items()})  # user headers win, as in rospy
         return fields
 
@@ -409,17 +396,12 @@ class ServiceProxy:
         self.uri = uri
         host, port = parse_rosrpc_uri(uri)
         try:
-            sock = _connect(host, port, CONNECT_TIMEOUT)
+            sock = connect(host, port, CONNECT_TIMEOUT, nodelay=True)
         except OSError as exc:
             raise ServiceException(f"unable to connect to service: {exc}") from None
         try:
-            _send_all(sock, tcpros.encode_header(self._header_fields()))
-            header = sockets.read_header(sock)
-            if "error" in header:
-                raise TransportInitError("remote error reported: {}".format(header["error"]))
-            for required in ("md5sum", "type"):
-                if required not in header:
-                    raise TransportInitError(f"header missing required field [{required}]")
+            header = negotiate(sock, Handshake(Role.SERVICE_CLIENT, self._header_fields()),
+                               send=_send_all)
         except (TransportException, OSError) as exc:
             sockets.close(sock)
             raise ServiceException(f"unable to connect to service: {exc}") from None
@@ -427,7 +409,7 @@ class ServiceProxy:
         self._sock = sock
         self._server_header = header
         self._source = sockets.FrameSource(sock, tcpros.FrameReader(buff_size=self.buff_size, ok_byte=True),
-                                           stop=_is_shutdown)
+                                           stop=node.is_shutdown)
 
     def _drop(self) -> None:
         sock, self._sock = self._sock, None
@@ -450,7 +432,7 @@ class ServiceProxy:
             try:
                 # as rospy: a request is numbered once connected, and sent in that order
                 self.seq += 1
-                tcpros.stamp_header(request, self.seq)
+                stamp_header(request, self.seq)
                 buff = _Buffer()
                 request.serialize(buff)
                 frame = buff.frame(tcpros.frame_prefix(buff.size))
@@ -464,7 +446,7 @@ class ServiceProxy:
                 self._drop()
                 if isinstance(exc, tcpros.FrameError) and "closed" in str(exc):
                     exc = TransportTerminated(_PEER_GONE)  # rospy's words for a peer gone mid-reply
-                if _is_shutdown():
+                if node.is_shutdown():
                     raise ROSInterruptException("node shutdown interrupted service call") from None
                 raise ServiceException(f"transport error completing service call: {exc}") from None
             except BaseException:
@@ -502,10 +484,11 @@ def _probe_service(resolved_name: str, timeout: float) -> str | None:
     except RemoteError as exc:  # OSError (master down) goes to the caller
         raise TransportInitError(f"master lookup failed: {exc}") from None
     host, port = parse_rosrpc_uri(uri)
-    sock = _connect(host, port, timeout)
+    sock = connect(host, port, timeout, nodelay=True)
     try:
-        _send_all(sock, tcpros.encode_header({"probe": "1", "md5sum": "*", "callerid": _caller_id(),
-                                              "service": resolved_name}))
+        negotiate(sock, Handshake(Role.SERVICE_CLIENT, {
+            "probe": "1", "md5sum": "*", "callerid": node.get_caller_id(),
+            "service": resolved_name}), send=_send_all)
     finally:
         sockets.close(sock)
     return uri
@@ -522,10 +505,10 @@ def wait_for_service(service: str, timeout: float | None = None) -> None:
         timeout = timeout.to_sec()
     if timeout == 0.0:
         raise ValueError("timeout must be non-zero")
-    resolved_name = _resolve(service)
+    resolved_name = node.resolve_name(service)
     deadline = None if not timeout else time.monotonic() + timeout
     contact_failed = False
-    while not _is_shutdown():
+    while not node.is_shutdown():
         remaining = None if deadline is None else deadline - time.monotonic()
         if remaining is not None and remaining <= 0:
             break
@@ -542,8 +525,8 @@ def wait_for_service(service: str, timeout: float | None = None) -> None:
         pause = WAIT_FOR_SERVICE_INTERVAL
         if deadline is not None:
             pause = min(pause, max(0.0, deadline - time.monotonic()))
-        if _wait_for_shutdown(pause):
+        if node.wait_for_shutdown(pause):
             break
-    if _is_shutdown():
+    if node.is_shutdown():
         raise ROSInterruptException("rospy shutdown")
     raise ROSException(f"timeout exceeded while waiting for service {resolved_name}")

@@ -17,7 +17,7 @@ from .tval import Duration, Time, TVal
 
 __all__ = [
     "Message", "strify_message", "check_type", "DeserializationError", "SerializationError",
-    "struct_I", "isstring", "reader_for",
+    "struct_I", "isstring", "reader_for", "SERIALIZE_ERRORS",
 ]
 
 #: the uint32 of every length prefix (genpy.struct_I: genpy-generated modules use it)
@@ -60,8 +60,10 @@ _INT_WIDTHS = {
     "int64": (64, True), "char": (8, False), "uint8": (8, False), "uint16": (16, False),
     "uint32": (32, False), "uint64": (64, False),
 }
-_SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
-                     UnicodeError, IndexError, SerializationError)
+#: what a serializer raises for a field of the wrong type or range
+SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
+                    UnicodeError, IndexError, SerializationError)
+_SERIALIZE_ERRORS = SERIALIZE_ERRORS
 
 
 def _as_view(data: Any, zero_copy: bool) -> Any:

@@ -1,7 +1,8 @@
 """TCPROS as pure functions: connection headers, length-prefixed framing, service responses.
 
-No sockets here (sans-IO, like h11): the socket layer in ``minros.node`` / ``minros.client.topics`` /
-``minros.client.services`` only moves bytes in and out of these objects.
+No sockets here (sans-IO, like h11): the transports (``minros.transport``), the node's TCPROS
+server and ``minros.client.services`` only move bytes in and out of these objects; the order of
+the header exchange is :mod:`minros.wire.handshake`.
 
 Wire format (all integers little-endian ``uint32``):
 
@@ -16,7 +17,7 @@ allocated for it, and large frames grow their buffer only as their bytes actuall
 from __future__ import annotations
 
 import struct
-from typing import Any, Dict, List, Mapping, Tuple, Union
+from typing import Dict, List, Mapping, Tuple, Union
 
 from minros.exceptions import TransportException
 
@@ -34,7 +35,6 @@ __all__ = [
     "encode_service_error",
     "encode_service_response",
     "frame_prefix",
-    "stamp_header",
     "publisher_header_error",
     "read_header_block",
     "service_header_error",
@@ -207,16 +207,6 @@ def service_header_error(header: Mapping[str, str], service: str, md5sum: str) -
 
 # ---------------------------------------------------------------------------------------------
 # framing
-
-
-def stamp_header(msg: Any, seq: int) -> None:
-    """What rospy does to every message it sends (topic, request or response): a message with
-    a std_msgs/Header gets the sender's sequence number, and a None frame_id becomes "0"."""
-    if getattr(msg, "_has_header", False):
-        header = msg.header
-        header.seq = seq
-        if header.frame_id is None:
-            header.frame_id = "0"
 
 
 def frame_prefix(size: int) -> bytes:
