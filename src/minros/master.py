@@ -31,7 +31,7 @@ import os
 import signal
 import sys
 import threading
-from typing import Any, Callable, Dict, Iterable, List, Tuple
+from typing import Any, Callable, Deque, Dict, Iterable, List, OrderedDict, Set, Tuple
 
 from minros import logfiles, rosenv
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
@@ -298,7 +298,7 @@ class Registrations:
             del self.map[key]
             return [1, f"Unregistered [{caller_id}] as provider of [{key}]", 1]
         callers = self.map.get(key, [])
-        if (caller_id, caller_api) in callers:
+        if caller_api is not None and (caller_id, caller_api) in callers:
             callers.remove((caller_id, caller_api))
             if not callers:
                 del self.map[key]
@@ -425,12 +425,12 @@ class CallbackPool:
         self._call = call or self._xmlrpc_call
         self._lock = threading.Condition()
         # api -> deque of [coalesce_key, method, args, on_result]
-        self._queues: Dict[str, collections.deque] = {}
-        self._ready: collections.deque = collections.deque()  # apis with work and not in flight
-        self._busy: set = set()
+        self._queues: Dict[str, Deque[Any]] = {}
+        self._ready: Deque[str] = collections.deque()  # apis with work and not in flight
+        self._busy: Set[str] = set()
         self._threads: List[threading.Thread] = []
         self._stopped = False
-        self._proxies: collections.OrderedDict = collections.OrderedDict()
+        self._proxies: OrderedDict[str, Any] = collections.OrderedDict()
         self._proxies_lock = threading.Lock()
 
     def queue(self, api: str, method: str, args: Tuple[Any, ...], coalesce: Any | None = None,
@@ -491,8 +491,7 @@ class CallbackPool:
                     pass
             with self._lock:
                 self._busy.discard(api)
-                q = self._queues.get(api)
-                if q:
+                if self._queues.get(api):
                     self._ready.append(api)
                     self._lock.notify()
                 else:
@@ -852,13 +851,13 @@ class Master:
             host = rosenv.get_bind_address(hostname)
         self.pool = CallbackPool(workers, callback_timeout)
         self.handler = MasterHandler(self.pool)
+        self._stopped = threading.Event()
         # Stop once the reply to the shutdown call has reached the caller.
         self.handler._on_shutdown = lambda reason: xmlrpc.after_reply(self._stopped.set)
         bind = rosenv.get_bind_address() if host is None else host
         self.server = xmlrpc.XmlRpcServer(self.handler, bind, port,
                                           ipv6=":" in bind or rosenv.use_ipv6(), allowed=allowed,
                                           on_refused=_report_refusal, what="the master")
-        self._stopped = threading.Event()
         self.uri = ""
 
     def start(self) -> Master:

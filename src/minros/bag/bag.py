@@ -123,7 +123,7 @@ class Bag:
     def __enter__(self) -> Bag:
         return self
 
-    def __exit__(self, exc_type, exc_value, traceback) -> None:
+    def __exit__(self, exc_type: Any, exc_value: Any, traceback: Any) -> None:
         self.close()
 
     @property

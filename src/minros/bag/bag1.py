@@ -473,7 +473,7 @@ class Bag1Writer:
 
     def __init__(self, path: str, compression: str = Compression.NONE,
                  chunk_threshold: int = 768 * 1024, *, existing: Optional[ScanResult] = None,
-                 bio=None) -> None:
+                 bio: Any=None) -> None:
         self.path = Path(path)
         self.compression = compression
         if existing is None:
@@ -490,7 +490,7 @@ class Bag1Writer:
         self._by_key: Dict[tuple, Connection] = {c[1:7]: c for c in self._w.connections}
         self.connections: Dict[int, ConnInfo] = {c.id: _conn_info(c) for c in self._w.connections}
 
-    def _reopen(self, bio, existing: ScanResult, compression: str) -> _rb_writer.Writer:
+    def _reopen(self, bio: Any, existing: ScanResult, compression: str) -> _rb_writer.Writer:
         w = object.__new__(_rb_writer.Writer)
         w.path = self.path
         w.bio = None
@@ -551,7 +551,7 @@ class Bag1Writer:
                                                  callerid, None if latch is None else str(latch))
         return conn.id
 
-    def write(self, conn_id: int, t_ns: int, data) -> None:
+    def write(self, conn_id: int, t_ns: int, data: Any) -> None:
         self._w.write(self._w.connections[conn_id], t_ns, data)
 
     @property

@@ -28,6 +28,7 @@ import threading
 import time
 import traceback
 import warnings
+from types import TracebackType
 from typing import Any, Callable, Dict
 
 from minros import names, node
@@ -93,7 +94,7 @@ def _send_all(sock: socket.socket, data: Any) -> None:
 
 # --------------------------------------------------------------------------- server
 
-def _convert_return_to_response(response: Any, response_class: type) -> Any:
+def _convert_return_to_response(response: Any, response_class: Any) -> Any:
     """Turn what a handler returned into a response message (rospy's rules and texts)."""
     if getattr(response, "_type", None) == response_class._type and hasattr(response, "serialize"):
         return response
@@ -115,7 +116,8 @@ def _convert_return_to_response(response: Any, response_class: type) -> Any:
         raise ServiceException(f"handler returned wrong number of values: {exc}") from None
 
 
-def _default_error_handler(exc: BaseException, exc_type, exc_value, tb) -> None:
+def _default_error_handler(exc: BaseException, exc_type: type[BaseException] | None,
+                           exc_value: BaseException | None, tb: TracebackType | None) -> None:
     logerr(f"Error processing request: {exc}\n{traceback.format_exception(exc_type, exc_value, tb)}")
 
 
@@ -128,7 +130,7 @@ class Service:
     "error processing request: ..." (after ``error_handler(e, type, value, tb)`` ran).
     """
 
-    def __init__(self, name: str, service_class: type, handler: Callable[[Any], Any],
+    def __init__(self, name: str, service_class: Any, handler: Callable[[Any], Any],
                  buff_size: int = DEFAULT_BUFF_SIZE,
                  error_handler: Callable[..., None] | None = None) -> None:
         if not name or not isinstance(name, str):
@@ -320,7 +322,7 @@ class _Buffer:
 
 # --------------------------------------------------------------------------- client
 
-def _args_kwds_to_request(request_class: type, args: tuple, kwds: dict) -> Any:
+def _args_kwds_to_request(request_class: Any, args: tuple, kwds: dict) -> Any:
     """A request from call arguments: one request instance, positional fields or keywords."""
     if args and kwds:
         raise TypeError("publish() can be called with arguments or keywords, but not both.")
@@ -358,7 +360,7 @@ def _lookup_service(resolved_name: str) -> str:
 class ServiceProxy:
     """A callable handle on a remote service: ``proxy(1, 2)``, ``proxy(req)``, ``proxy(a=1, b=2)``."""
 
-    def __init__(self, name: str, service_class: type, persistent: bool = False,
+    def __init__(self, name: str, service_class: Any, persistent: bool = False,
                  headers: Dict[str, str] | None = None) -> None:
         self.name = name
         self.resolved_name = node.resolve_name(name)

@@ -63,7 +63,7 @@ def _acquire(registry: Dict[str, Any], make: Callable[[], Any], add: Callable[[A
     second handle made meanwhile finds it); the caller registers a fresh one with the master,
     outside the lock."""
     with _impl_lock:
-        impl = registry.get(resolved)
+        impl: Any = registry.get(resolved)
         fresh = impl is None or impl.closed
         if fresh:
             impl = make()

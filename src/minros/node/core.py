@@ -113,7 +113,7 @@ class Node:
         return self.lifecycle.initialized
 
     @property
-    def init_args(self) -> tuple | None:
+    def init_args(self) -> Tuple[Any, ...] | None:
         return self.lifecycle.init_args
 
     def is_shutdown(self) -> bool:
@@ -138,7 +138,7 @@ class Node:
         self.lifecycle.spin()
 
     def init(self, name: str, argv: Sequence[str] | None = None, anonymous: bool = False,
-             xmlrpc_port: int = 0, tcpros_port: int = 0, args_key: tuple = ()) -> bool:
+             xmlrpc_port: int = 0, tcpros_port: int = 0, args_key: Tuple[Any, ...] = ()) -> bool:
         """Name the node, start its servers and register it (the network half of
         ``rospy.init_node``). False when it was already initialised with the same
         ``args_key``; ROSException when with different ones."""
@@ -197,7 +197,8 @@ class Node:
         if not self.registration.started:
             return
         pubs, subs = self.registries.endpoints()
-        for endpoint in [*pubs, *subs]:
+        endpoints: List[Publication | Subscription] = [*pubs, *subs]
+        for endpoint in endpoints:
             try:
                 endpoint.close()
             except Exception:

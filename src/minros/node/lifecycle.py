@@ -12,7 +12,7 @@ import logging
 import sys
 import threading
 import traceback
-from typing import Any, Callable, List
+from typing import Any, Callable, List, Tuple
 
 from minros.exceptions import ROSException, ROSInitException
 
@@ -30,7 +30,7 @@ class Lifecycle:
         #: True once init_node registered the node (publishing is allowed from then on)
         self.initialized = False
         #: the arguments init_node was called with (a second call must repeat them)
-        self.init_args: tuple | None = None
+        self.init_args: Tuple[Any, ...] | None = None
         self._requested = False
         self._shutdown = threading.Event()  # set once is_shutdown() is true
         self._done = threading.Event()  # set when the shutdown sequence has finished
@@ -38,7 +38,7 @@ class Lifecycle:
         self._client_hooks: List[Callable[[], Any]] = []
         self._internal_hooks: List[Callable[[str], Any]] = []
 
-    def claim_init(self, args_key: tuple) -> bool:
+    def claim_init(self, args_key: Tuple[Any, ...]) -> bool:
         """Whether this init_node call is the first; False when it repeats the first one's
         arguments, ROSException when it has others."""
         with self._lock:

@@ -194,6 +194,7 @@ class Registration:
         while not self.lifecycle.wait_for_shutdown(MASTER_PROBE_INTERVAL):
             if self.closed.is_set():
                 return
+            pid: int | None
             try:
                 pid = probe.get_pid()
             except MasterIOError:

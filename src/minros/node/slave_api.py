@@ -46,7 +46,7 @@ class SlaveApi:
     def __init__(self, node: SlaveNode) -> None:
         self._node = node
 
-    def _endpoints(self) -> Tuple[list, list]:
+    def _endpoints(self) -> Tuple[List[Any], List[Any]]:
         return self._node.registries.endpoints()
 
     @api("")
@@ -65,7 +65,7 @@ class SlaveApi:
     @api([])
     def getBusInfo(self, caller_id: str) -> Tuple[int, str, Any]:
         pubs, subs = self._endpoints()
-        info: list = []
+        info: List[Any] = []
         for endpoint in pubs + subs:
             info.extend(endpoint.get_stats_info())
         return 1, "bus info", info

@@ -53,9 +53,13 @@ class Transport(abc.ABC):
 
     id: int
     header: Dict[str, str]
-    stat_bytes: int
     stat_msgs: int
     done: bool
+
+    @property
+    @abc.abstractmethod
+    def stat_bytes(self) -> int:
+        """Bytes sent (the publisher's end) or received (the subscriber's end)."""
 
     @abc.abstractmethod
     def negotiate(self, handshake: Handshake, opening: Dict[str, str] | None = None) -> None:

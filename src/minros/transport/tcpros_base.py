@@ -65,7 +65,8 @@ def connect(host: str, port: int, timeout: float = CONNECT_TIMEOUT,
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         except OSError:  # not fatal: only latency
             pass
-    return trace.watch(sock, "connect")
+    traced: socket.socket = trace.watch(sock, "connect")
+    return traced
 
 
 class TCPROSTransport(Transport):

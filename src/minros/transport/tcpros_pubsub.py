@@ -21,7 +21,7 @@ import logging
 import socket
 import threading
 import time
-from typing import Any, Callable, Dict, List, Tuple
+from typing import Any, Callable, Deque, Dict, List, Tuple
 
 from minros.transport import streams
 from minros.transport.base import Frame, ProtocolHandler, PublicationSide, Transport
@@ -76,8 +76,8 @@ class TCPROSSender(TCPROSTransport):
     def __init__(self, stream: Any, topic: str, queue_size: int | None,
                  on_close: Callable[[Transport], Any]) -> None:
         super().__init__(stream, topic)
-        self.stat_bytes = 0
-        self.queue: collections.deque = collections.deque()
+        self.bytes_sent = 0
+        self.queue: Deque[Any] = collections.deque()
         self.queue_size = queue_size
         self.sync = queue_size is None
         self.lock = threading.Lock()  # C-level `with` on the hot path; cond shares it
@@ -85,6 +85,10 @@ class TCPROSSender(TCPROSTransport):
         self.busy = False
         self.on_close = on_close
         self.thread: threading.Thread | None = None
+
+    @property
+    def stat_bytes(self) -> int:
+        return self.bytes_sent
 
     @property
     def callerid(self) -> str:
@@ -123,11 +127,11 @@ class TCPROSSender(TCPROSTransport):
                             sent = self.stream.send(frame, MSG_DONTWAIT)
                         except BlockingIOError:
                             sent = 0
-                        self.stat_bytes += sent
+                        self.bytes_sent += sent
                         if sent == len(frame):  # all of it in one call: the usual case
                             self.stat_msgs += 1
                             return
-                        rest: Any = _Partial(memoryview(frame)[sent:])  # type: ignore[arg-type]
+                        rest: Any = _Partial(memoryview(frame)[sent:])
                     else:
                         rest = self._send_nowait(frame)
                         if rest is None:
@@ -172,7 +176,7 @@ class TCPROSSender(TCPROSTransport):
                 continue
             if sent:
                 deadline = time.monotonic() + SYNC_SEND_TIMEOUT  # it is reading: keep waiting
-            self.stat_bytes += sent
+            self.bytes_sent += sent
             more = _advance(parts, sent)
             parts = list(more.parts) if more is not None else []
         self.stat_msgs += 1
@@ -187,7 +191,7 @@ class TCPROSSender(TCPROSTransport):
                 sent = stream.sendmsg(parts, (), MSG_DONTWAIT)
             except BlockingIOError:
                 sent = 0
-            self.stat_bytes += sent
+            self.bytes_sent += sent
             if sent == total:
                 self.stat_msgs += 1
                 return None
@@ -196,7 +200,7 @@ class TCPROSSender(TCPROSTransport):
             sent = stream.send(frame, MSG_DONTWAIT)
         except BlockingIOError:
             sent = 0
-        self.stat_bytes += sent
+        self.bytes_sent += sent
         if sent == len(frame):
             self.stat_msgs += 1
             return None
@@ -208,16 +212,16 @@ class TCPROSSender(TCPROSTransport):
             parts = list(frame)
             while parts:
                 sent = stream.sendmsg(parts)
-                self.stat_bytes += sent
+                self.bytes_sent += sent
                 rest = _advance(parts, sent)
                 parts = list(rest.parts) if rest is not None else []
         elif type(frame) is _Partial:
             for part in frame.parts:
                 stream.sendall(part)
-                self.stat_bytes += len(part)
+                self.bytes_sent += len(part)
         else:
             stream.sendall(frame)
-            self.stat_bytes += len(frame)
+            self.bytes_sent += len(frame)
         self.stat_msgs += 1
 
     def _writer(self) -> None:
@@ -237,7 +241,7 @@ class TCPROSSender(TCPROSTransport):
                     # many small frames: one system call for the lot
                     joined = b"".join(batch)
                     self.stream.sendall(joined)
-                    self.stat_bytes += len(joined)
+                    self.bytes_sent += len(joined)
                     self.stat_msgs += len(batch)
                 else:
                     for frame in batch:
@@ -304,7 +308,7 @@ class TCPROSReceiver(TCPROSTransport):
         # the hot path: a closure over what it calls, one Python call per recv in all
         self.receive = self._receiver()  # type: ignore[method-assign]
 
-    @property  # type: ignore[override]
+    @property
     def stat_bytes(self) -> int:
         return self.reader.bytes_received
 

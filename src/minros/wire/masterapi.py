@@ -29,7 +29,7 @@ from minros.wire.xmlrpc import ServerProxy
 
 __all__ = [
     "MasterClient", "MasterError", "MasterException", "MasterFailure", "MasterIOError",
-    "SystemState",
+    "RemoteError", "SystemState",
 ]
 
 #: rosgraph's names for the exceptions of a non-SUCCESS answer
@@ -127,7 +127,7 @@ class MasterClient:
         """``system.multicall``: one request for many calls (``{"methodName", "params"}``);
         one raw answer per call."""
         try:
-            return self._proxy().system.multicall(list(calls))
+            return list(self._proxy().system.multicall(list(calls)))
         except xmlrpc.client.Fault as exc:
             raise MasterFailure(0, f"system.multicall: {exc.faultString}") from None
         except (xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError, OSError) as exc:

@@ -174,7 +174,8 @@ def valid_type_name(name: str) -> Validator:
 # ---------------------------------------------------------------------------- the decorator
 
 
-def api(error_value: Any, validators: Sequence[Validator | None] = ()) -> Callable:
+def api(error_value: Any, validators: Sequence[Validator | None] = ()
+        ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Decorate a master or slave API method: arity and caller_id checks, validators, and the
     exact error triplets of rosmaster/rospy.
 

@@ -17,7 +17,7 @@ allocated for it, and large frames grow their buffer only as their bytes actuall
 from __future__ import annotations
 
 import struct
-from typing import Dict, List, Mapping, Tuple, Union
+from typing import Any, Dict, List, Mapping, Tuple, Union
 
 from minros.exceptions import TransportException
 
@@ -273,7 +273,7 @@ class FrameReader:
         self._big_ok = 1
         self.max_frame = max_frame
         self.ok_byte = ok_byte
-        self._ready: List = []
+        self._ready: List[Any] = []
         self.bytes_received = 0
         self._error: FrameError | None = None
         # reuse_big=True: the consumer is done with a big frame before it asks for more data
@@ -308,7 +308,7 @@ class FrameReader:
         pops the completed frames."""
         self._ready = self.received_frames(n)
 
-    def received_frames(self, n: int) -> list:
+    def received_frames(self, n: int) -> List[Any]:
         """``received(n)`` and ``frames()`` in one call (the subscriber's hot path): the frames
         completed so far. An error in the data is raised by the next call, once the good
         frames before it are out."""
@@ -332,7 +332,7 @@ class FrameReader:
             self._ready = []
         return ready
 
-    def frames(self) -> list:
+    def frames(self) -> List[Any]:
         """Pop the complete frames parsed so far (``bytes``/``bytearray``, or (ok, payload)).
 
         Raises FrameError once every good frame before a bad one has been handed out.
@@ -357,7 +357,7 @@ class FrameReader:
         prefix = 5 if self.ok_byte else 4
         if self._end - self._start < prefix:
             return None
-        return _U32.unpack_from(self._buf, self._start + prefix - 4)[0]
+        return int(_U32.unpack_from(self._buf, self._start + prefix - 4)[0])
 
     def eof(self) -> None:
         """The peer closed the stream: an error if it stopped in the middle of a frame."""
@@ -367,7 +367,7 @@ class FrameReader:
         if pending:
             raise FrameError(f"connection closed in the middle of a frame ({pending} bytes pending)")
 
-    def feed(self, data: BytesLike) -> list:
+    def feed(self, data: BytesLike) -> List[Any]:
         """Convenience for tests and non-socket users: push ``data`` and return new frames."""
         view = memoryview(data).cast("B")
         while len(view) and self._error is None:
