@@ -423,7 +423,9 @@ class CallbackPool:
         self.workers = workers
         self.timeout = timeout
         self._call = call or self._xmlrpc_call
-        self._lock = threading.Condition()
+        mutex = threading.RLock()
+        self._lock = threading.Condition(mutex)  # work to do
+        self._drained = threading.Condition(mutex)  # nothing queued or in flight
         # api -> deque of [coalesce_key, method, args, on_result]
         self._queues: Dict[str, Deque[Any]] = {}
         self._ready: Deque[str] = collections.deque()  # apis with work and not in flight
@@ -496,6 +498,8 @@ class CallbackPool:
                     self._lock.notify()
                 else:
                     self._queues.pop(api, None)
+                    if not self._busy and not self._queues:
+                        self._drained.notify_all()
 
     def _xmlrpc_call(self, api: str, method: str, args: Tuple[Any, ...]) -> Any:
         with self._proxies_lock:
@@ -517,6 +521,11 @@ class CallbackPool:
     def pending(self) -> int:
         with self._lock:
             return sum(len(q) for q in self._queues.values()) + len(self._busy)
+
+    def join(self, timeout: float | None = None) -> bool:
+        """Wait until every queued callback has been made; False if ``timeout`` ran out."""
+        with self._lock:
+            return self._drained.wait_for(lambda: not self._busy and not self._queues, timeout)
 
     def stop(self) -> None:
         with self._lock:
