@@ -253,7 +253,7 @@ class ParamDictionary:
         with self.lock:
             return self.tree.has(key)
 
-    def set_param(self, key: str, value: Any, notify_task: Callable[[list], Any] | None = None,
+    def set_param(self, key: str, value: Any, notify_task: Callable[[List[Any]], Any] | None = None,
                   caller_id: str | None = None) -> None:
         """Set ``key`` (the setter, ``caller_id``, is not told of its own change)."""
         with self.lock:
@@ -264,7 +264,7 @@ class ParamDictionary:
                 if updates:
                     notify_task(updates)
 
-    def delete_param(self, key: str, notify_task: Callable[[list], Any] | None = None) -> None:
+    def delete_param(self, key: str, notify_task: Callable[[List[Any]], Any] | None = None) -> None:
         """KeyError when ``key`` is not set; subscribers learn it as the value ``{}``."""
         with self.lock:
             self.tree.delete(key)
