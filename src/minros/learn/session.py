@@ -22,13 +22,12 @@ import subprocess
 import sys
 import threading
 import time
-import xmlrpc.client
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Optional
 
 from minros import rosenv
 from minros.learn.model import Attempt, Exercise, Process
-from minros.wire.xmlrpc import ServerProxy
+from minros.wire.masterapi import MasterClient, RemoteError
 
 __all__ = ["LearnError", "Runner", "default_base", "folder_for", "load_attempt", "read_state"]
 
@@ -277,13 +276,14 @@ class Runner:
     def _ready(self, process: Process, facts: Dict[str, Any]) -> bool:
         if process.ready[:1] == ("master",):
             port = facts["port_b"] if process.master == "b" else facts["port"]
-            proxy = ServerProxy(f"http://127.0.0.1:{port}/", timeout=2.0)
+            master = MasterClient(f"http://127.0.0.1:{port}/", "/minros_learn", timeout=2.0)
             try:
-                return proxy.getPid("/minros_learn")[0] == 1
-            except (OSError, xmlrpc.client.Error):
+                master.get_pid()
+                return True
+            except (OSError, RemoteError):  # not up yet (MasterIOError is an OSError)
                 return False
             finally:
-                proxy.close()
+                master.close()
         if len(process.ready) != 2:
             return True
         method, name = process.ready
