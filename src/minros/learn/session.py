@@ -306,15 +306,15 @@ class Runner:
             raise LearnError(f"{process.name} is not traced: its readiness needs its node name "
                              "and a register* call")
         port = facts["port_b"] if process.master == "b" else facts["port"]
-        proxy = ServerProxy(f"http://127.0.0.1:{port}/", timeout=2.0)
+        master = MasterClient(f"http://127.0.0.1:{port}/", "/minros_learn", timeout=2.0)
         try:
-            code, _status, state = proxy.getSystemState("/minros_learn")
-        except (OSError, xmlrpc.client.Error):
+            state = master.get_system_state()
+        except (OSError, RemoteError):
             return False
         finally:
-            proxy.close()
-        return code == 1 and any(entry[0] == name and process.node in entry[1]
-                                 for entry in state[column[method]])
+            master.close()
+        return any(entry[0] == name and process.node in entry[1]
+                   for entry in state[column[method]])
 
     def _node_uri(self, name: str) -> str:
         for ev in _events(self.folder / f"{name}.jsonl"):
