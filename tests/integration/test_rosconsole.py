@@ -110,3 +110,14 @@ def test_rospy_logger_level_service_caller_and_rosconsole_main(noisy: dict) -> N
                           "'get', '/noisy', 'nope'])"], env=noisy, capture_output=True,
                          text=True, timeout=60)
     assert bad.returncode == 2 and "does not contain logger nope" in bad.stderr
+
+
+def test_roslaunch_logs_names_the_running_cores_log_folder(minros_core: int, ros_home: Path) -> None:
+    env = ros_env(minros_core, ros_home)
+    out = subprocess.run([PYTHON, "-c", "from roslaunch.roslaunch_logs import logs_main; logs_main()"],
+                         env=env, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    run_id = subprocess.run([PYTHON, "-m", "minros", "param", "get", "/run_id"], env=env,
+                            capture_output=True, text=True, timeout=60).stdout.strip()
+    assert run_id and out.stdout.strip().endswith("/" + run_id)
+    assert Path(out.stdout.strip()).is_dir()  # the core logs there
