@@ -237,11 +237,12 @@ class FakeState:
 
 
 class FakeHub:
-    def __init__(self, wire=None) -> None:
+    def __init__(self, wire=None, learn=None) -> None:
         from minros.web.scene import SceneHub
 
         self.sessions = []
         self.wire = wire
+        self.learn = learn
         self.scene = SceneHub(state=None)
 
     def add(self, session):
@@ -251,13 +252,13 @@ class FakeHub:
         self.sessions.remove(session)
 
 
-def session(wire=None):
+def session(wire=None, learn=None, local=True, client_id="test"):
     from minros.web.page import PageSession
 
     outbox = Outbox()
     state = FakeState()
-    sent = PageSession("test", state, outbox, lambda reason: None, FakeHub(wire),
-                       run_async=lambda fn: fn())
+    sent = PageSession(client_id, state, outbox, lambda reason: None, FakeHub(wire, learn),
+                       run_async=lambda fn: fn(), local=local)
     return sent, outbox, state
 
 

@@ -145,8 +145,19 @@ class Bag:
     def __enter__(self) -> Bag:
         return self
 
-    def __exit__(self, exc_type, exc_value, traceback) -> None:
+    def __exit__(self, exc_type: Any, exc_value: Any, traceback: Any) -> None:
         self.close()
+
+    # rosbag's internals, which tools and tests reach for: the open file and where the file
+    # header record starts (after the version line)
+    @property
+    def _file(self) -> Optional[BinaryIO]:
+        handle = self._writer if self._writer is not None else self._reader
+        return getattr(handle, "file", None)
+
+    @property
+    def _file_header_pos(self) -> Optional[int]:
+        return len(bag1.MAGIC) if self._version // 100 == 2 else None
 
     @property
     def options(self) -> dict:

@@ -387,6 +387,11 @@ class Bag1Reader:
             raise ROSBagFormatException(f"the chunk at offset {pos} is damaged ({type(exc).__name__}: "
                                         f"{exc}): run rosbag reindex to keep the others") from None
 
+    @property
+    def file(self) -> BinaryIO:
+        """The open bag file."""
+        return self._index.bio
+
     def close(self) -> None:
         if not self._keep_open:
             self._index.bio.close()
@@ -465,6 +470,11 @@ class Bag1Writer:
         self._by_key: Dict[tuple, Connection] = {self._key(c): c for c in self._w.connections}
         self.connections: Dict[int, ConnInfo] = {c.id: _conn_info(c) for c in self._w.connections}
 
+    @property
+    def file(self) -> Optional[BinaryIO]:
+        """The open bag file (None once closed)."""
+        return self._w.bio
+
     @staticmethod
     def _key(conn: Connection) -> tuple:
         return (conn.topic, conn.msgtype, conn.msgdef, conn.digest, conn.ext)
@@ -513,7 +523,7 @@ class Bag1Writer:
                                              callerid, None if latch is None else str(latch))
         return conn.id
 
-    def write(self, conn_id: int, t_ns: int, data) -> None:
+    def write(self, conn_id: int, t_ns: int, data: Any) -> None:
         self._w.write(self._conns[conn_id], t_ns, data)
 
     def set_compression(self, compression: str) -> None:

@@ -11,7 +11,7 @@ import argparse
 import os
 import sys
 from pathlib import Path
-from typing import List, Tuple
+from typing import Any, List, Tuple
 
 from minros import names, packages
 from minros.launch.config import LaunchConfig, LaunchError
@@ -118,9 +118,12 @@ def _master_uri(options: argparse.Namespace) -> str:
 
     # as rosgraph.get_master_uri in roslaunch: the first __master:= on the command line beats
     # the environment, and one without a value is an error
-    value = remapped_master(options.positional)
+    try:
+        value = remapped_master(options.positional)
+    except ValueError as exc:
+        raise LaunchError(str(exc)) from None
     if value is not None:
-        if not value.strip() or ":=" in value:
+        if not value.strip():
             raise LaunchError(f"__master remapping argument '__master:={value}' improperly specified")
         value = value.strip()
     uri = get_master_uri(remapped=value)
@@ -213,7 +216,7 @@ def _add_core_params(config: LaunchConfig) -> None:
         config.params.setdefault(key, value)
 
 
-def _print_node_args(config: LaunchConfig, runner, wanted: str) -> int:
+def _print_node_args(config: LaunchConfig, runner: Any, wanted: str) -> int:
     """``roslaunch --args NODE``: the node's environment and command line, as roslaunch prints
     them (``ROS_NAMESPACE="/g" NAME="value" exe args remaps __name:=n``)."""
     resolved = names.script_resolve_name("roslaunch", wanted)

@@ -32,6 +32,9 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
     "sim": ("minros.cli.sim", "a 2D robot simulator with map_server and move_base (Stage-like)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
+    "clean": ("minros.cli.clean", "check the size of the ROS log files and purge them (rosclean)"),
+    "wtf": ("minros.cli.wtf", "check the ROS environment and the running graph (roswtf)"),
+    "master": ("minros.master", "run a ROS master alone, without rosout (rosmaster)"),
     "learn": ("minros.cli.learn", "exercises on the ROS wire that check themselves"),
     "zenoh": ("minros.cli.zenoh", "bridge topics and services with Zenoh (zenoh-bridge-ros1's wire)"),
 }
@@ -56,6 +59,9 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "rosbag": ("bag", []),
     "rostest": ("test", []),
     "rosconsole": ("console", []),
+    "rosclean": ("clean", []),
+    "roswtf": ("wtf", []),
+    "rosmaster": ("master", []),
 }
 
 
@@ -135,6 +141,9 @@ catkin_make = _alias("catkin_make")
 rosbag = _alias("rosbag")
 rostest = _alias("rostest")
 rosconsole = _alias("rosconsole")
+rosclean = _alias("rosclean")
+roswtf = _alias("roswtf")
+rosmaster = _alias("rosmaster")
 
 if __name__ == "__main__":
     sys.exit(main())

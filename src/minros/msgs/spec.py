@@ -58,6 +58,11 @@ class MsgSpecError(ValueError):
         super().__init__(f"{where}: {message}")
 
 
+class ConstantRangeError(ValueError):
+    """A constant's value does not fit its integer type (genmsg reports it apart from a value
+    that is not a number at all)."""
+
+
 def is_legal_base_name(name: str) -> bool:
     return bool(_BASE_NAME_RE.match(name))
 
@@ -206,7 +211,7 @@ def _convert_constant(type_: str, text: str) -> object:
         value = int(text)
         lower, upper = _INT_BOUNDS[type_]
         if not lower <= value <= upper:
-            raise ValueError(f"cannot coerce [{value}] to {type_} (out of bounds)")
+            raise ConstantRangeError(f"cannot coerce [{value}] to {type_} (out of bounds)")
         return value
     raise ValueError(f"invalid constant type: [{type_}]")
 

@@ -109,6 +109,8 @@ class OriginPolicy:
         self.allow_null = "null" in values
         self.allowed: Set[Tuple[str, str, int]] = set()
         self.names: Set[str] = set()
+        #: the machine's own names (not the allowed origins')
+        self.local_names: Set[str] = set()
         for value in values:
             parsed = parse_origin(value) if value not in ("*", "null") else None
             if parsed is not None:
@@ -117,6 +119,7 @@ class OriginPolicy:
         for name in local_names:
             if name:
                 self.names.add(name.rstrip(".").lower())
+                self.local_names.add(name.rstrip(".").lower())
 
     def host_error(self, host_header: Optional[str]) -> Optional[str]:
         """Why a request with this ``Host`` is refused, or None (no header: not a browser)."""
@@ -162,6 +165,28 @@ class OriginPolicy:
             if found is not None and found[0] == host:
                 return found[1] == port or (found[1] is None and port == _DEFAULT_PORTS[scheme])
         return False
+
+    def local_page(self, origin: Optional[str], host_header: Optional[str]) -> bool:
+        """Whether a request comes from this machine's user, for what only they may do
+        (start the Learn view's exercises, which run programs here): a client that is no page
+        (no ``Origin``), a page on localhost, or the server's own page opened by an address
+        or a name of this machine. Not a page let in by ``--allow-origin`` alone, nor, under
+        ``*`` (which turns the Host check off, so a rebound name passes as the server's
+        own), one opened by a name the machine does not have."""
+        if origin is None:
+            return True
+        parsed = parse_origin(origin)
+        if parsed is None or parsed[0] not in ("http", "https"):
+            return False  # null (file:// pages, sandboxed frames), ws:, ...
+        scheme, host, port = parsed
+        if is_loopback_name(host):
+            return True
+        found = _host_port(host_header.strip()) if host_header is not None else None
+        if found is None or found[0] != host:
+            return False
+        if found[1] != port and not (found[1] is None and port == _DEFAULT_PORTS[scheme]):
+            return False
+        return _is_ip(host) or host in self.local_names
 
     def cors_origin(self, origin: Optional[str], host_header: Optional[str]) -> Optional[str]:
         """The ``Access-Control-Allow-Origin`` value for a request (the page's own origin when

@@ -52,6 +52,7 @@ from minros import rosenv
 from minros.web import assets, video
 from minros.web import foxglove_protocol as fp
 from minros.web.foxglove import FoxgloveSession
+from minros.web.learning import LearnHub
 from minros.web.origin import OriginPolicy
 from minros.web.outbox import Outbox
 from minros.web.page import SUBPROTOCOL as PAGE_SUBPROTOCOL
@@ -306,7 +307,9 @@ class WebServer:
         self.clients: Dict[str, _Client] = {}
         #: the wire traces followed for the page's Wire view (``--trace``)
         self.wire = WireFeed(trace) if trace else None
-        self.page_hub = PageHub(state, self.wire)
+        #: the exercise a page started (the Learn view), in minros learn's folder
+        self.learn = LearnHub()
+        self.page_hub = PageHub(state, self.wire, self.learn)
         self.viewers = 0
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
@@ -629,6 +632,16 @@ class WebServer:
 
     # -- WebSocket clients -----------------------------------------------------------------
 
+    def _local_page(self, connection: Any) -> bool:
+        """The page is of this machine (may start exercises): see OriginPolicy.local_page."""
+        request = getattr(connection, "request", None)
+        if request is None:
+            return False
+        try:
+            return self.origins.local_page(_header(request, "Origin"), _header(request, "Host"))
+        except ValueError:
+            return False
+
     def _handle(self, connection: Any) -> None:
         from websockets.exceptions import ConnectionClosed
 
@@ -644,7 +657,8 @@ class WebServer:
                                              asset_patterns=self.asset_patterns)
         elif page:
             client.session = PageSession(client_id, self.state, client.outbox, client.close,
-                                         self.page_hub, rosapi=self.rosapi)
+                                         self.page_hub, rosapi=self.rosapi,
+                                         local=self._local_page(connection))
         else:
             client.session = RosbridgeSession(client_id, self.state, client.outbox, client.close,
                                               rosapi=self.rosapi)

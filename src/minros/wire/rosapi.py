@@ -5,7 +5,8 @@ Every method of both XML-RPC APIs takes the caller's ``caller_id`` first and ans
 own failure, -1 (ERROR) is the caller's mistake. ``value`` is there even on error, because
 XML-RPC cannot carry None.
 
-This module holds the convention once: the codes, :func:`unwrap` for callers, and for servers
+This module holds the convention once: the codes, :func:`unwrap` for callers (the one place a
+code is checked: :class:`CallerError` for -1, :class:`CalleeFailure` for 0), and for servers
 the :func:`api` decorator with its argument validators, which give the exact triplets rosmaster
 and rospy answer to bad calls (both use the same decorator, ``apivalidate``). Pure: no sockets.
 """
@@ -19,9 +20,10 @@ from minros.names import ANYTYPE, SEP, resolve_name
 
 __all__ = [
     "ERROR", "FAILURE", "ROSRPC", "SUCCESS",
-    "ParameterInvalid", "RemoteError", "Validator",
-    "api", "empty_or_valid_name", "is_api", "is_topic", "non_empty_str", "not_none",
-    "parse_rosrpc_uri", "triplet", "unwrap", "valid_name", "valid_type_name",
+    "CalleeFailure", "CallerError", "ParameterInvalid", "RemoteError", "Validator",
+    "api", "empty_or_valid_name", "global_name", "is_api", "is_service", "is_topic", "non_empty",
+    "non_empty_str", "not_none", "parse_rosrpc_uri", "triplet", "unwrap", "valid_name",
+    "valid_name_validator_resolved", "valid_name_validator_unresolved", "valid_type_name",
 ]
 
 #: the call did what was asked
@@ -40,7 +42,7 @@ def triplet(code: int, msg: str, value: Any) -> List[Any]:
 
 
 class RemoteError(Exception):
-    """A ROS API call answered with a code other than SUCCESS."""
+    """A ROS API call answered with a code other than SUCCESS (rosgraph's ROSMasterException)."""
 
     def __init__(self, code: int, msg: str, value: Any = None) -> None:
         super().__init__(msg)
@@ -49,14 +51,25 @@ class RemoteError(Exception):
         self.value = value
 
 
+class CallerError(RemoteError):
+    """Code -1 (ERROR): the callee says the call was wrong (unknown name, unset parameter...)."""
+
+
+class CalleeFailure(RemoteError):
+    """Code 0 (FAILURE), or an answer that is no triplet: the callee tried and failed."""
+
+
 def unwrap(result: Any) -> Any:
-    """Value of a SUCCESS triplet; raises :class:`RemoteError` otherwise (or on a malformed result)."""
+    """Value of a SUCCESS triplet; :class:`CallerError` for code -1, :class:`CalleeFailure` for
+    code 0, another code or a malformed result."""
     if not isinstance(result, (list, tuple)) or len(result) != 3:
-        raise RemoteError(FAILURE, f"malformed ROS API result: {result!r}")
+        raise CalleeFailure(FAILURE, f"malformed ROS API result: {result!r}")
     code, msg, value = result
-    if code != SUCCESS:
-        raise RemoteError(code, str(msg), value)
-    return value
+    if code == SUCCESS:
+        return value
+    if code == ERROR:
+        raise CallerError(code, str(msg), value)
+    raise CalleeFailure(code, str(msg), value)
 
 
 # ---------------------------------------------------------------------------- validators
@@ -81,6 +94,15 @@ def parse_rosrpc_uri(uri: str) -> Tuple[str, int]:
 
 #: ``validator(value, caller_id) -> canonical value``; raises ParameterInvalid
 Validator = Callable[[Any, str], Any]
+
+
+def non_empty(name: str) -> Validator:
+    """Any value that is not empty (or zero)."""
+    def check(value: Any, caller_id: str) -> Any:
+        if not value:
+            raise ParameterInvalid(f"ERROR: parameter [{name}] must be specified and non-empty")
+        return value
+    return check
 
 
 def non_empty_str(name: str) -> Validator:
@@ -111,19 +133,41 @@ def is_api(name: str) -> Validator:
     return check
 
 
-def _resolved_name(name: str, value: Any, caller_id: str) -> str:
+def valid_name_validator_unresolved(name: str, value: Any, caller_id: str) -> str:
+    """``value`` as a graph name, unresolved (ParameterInvalid when it cannot be one)."""
     if not value or not isinstance(value, str):
         raise ParameterInvalid(f"ERROR: parameter [{name}] must be a non-empty string")
     # ':' and ' ' catch the common mistake of passing a URI where a name belongs
     if ":" in value or " " in value:
         raise ParameterInvalid(f"ERROR: parameter [{name}] contains illegal chars")
-    return resolve_name(value, caller_id)
+    return value
 
 
-def valid_name(name: str) -> Validator:
-    """A graph name, resolved relative to the caller."""
+def valid_name_validator_resolved(name: str, value: Any, caller_id: str) -> str:
+    """``value`` as a graph name resolved relative to ``caller_id``."""
+    return resolve_name(valid_name_validator_unresolved(name, value, caller_id), caller_id)
+
+
+_resolved_name = valid_name_validator_resolved
+
+
+def valid_name(name: str, resolve: bool = True) -> Validator:
+    """A graph name, resolved relative to the caller (unless ``resolve`` is False)."""
     def check(value: Any, caller_id: str) -> Any:
-        return _resolved_name(name, value, caller_id)
+        if resolve:
+            return valid_name_validator_resolved(name, value, caller_id)
+        return valid_name_validator_unresolved(name, value, caller_id)
+    return check
+
+
+def global_name(name: str) -> Validator:
+    """A global graph name, as given."""
+    def check(value: Any, caller_id: str) -> Any:
+        if not value or not isinstance(value, str):
+            raise ParameterInvalid(f"ERROR: parameter [{name}] must be a non-empty string")
+        if not value.startswith(SEP):
+            raise ParameterInvalid(f"ERROR: parameter [{name}] must be a globally referenced name")
+        return value
     return check
 
 
@@ -135,6 +179,10 @@ def is_topic(name: str) -> Validator:
             raise ParameterInvalid(f"ERROR: parameter [{name}] cannot be the global namespace")
         return resolved
     return check
+
+
+#: a service name is checked as a topic name is
+is_service = is_topic
 
 
 def empty_or_valid_name(name: str) -> Validator:
@@ -162,7 +210,8 @@ def valid_type_name(name: str) -> Validator:
 # ---------------------------------------------------------------------------- the decorator
 
 
-def api(error_value: Any, validators: Sequence[Validator | None] = ()) -> Callable:
+def api(error_value: Any, validators: Sequence[Validator | None] = ()
+        ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Decorate a master or slave API method: arity and caller_id checks, validators, and the
     exact error triplets of rosmaster/rospy.
 

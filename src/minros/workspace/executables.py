@@ -22,6 +22,8 @@ from minros import packages
 #: package -> executable name -> module run with ``python -m``. Turtlesim's modules are written
 #: separately (minros.nodes.turtlesim); a missing module is reported as "not available".
 BUILTIN_NODES: Dict[str, Dict[str, str]] = {
+    # roscore's node (``minros core`` runs it too); roslaunch's API starts it as a core node
+    "rosout": {"rosout": "minros.nodes.rosout"},
     "rospy_tutorials": {
         "talker.py": "minros.nodes.rospy_tutorials.talker",
         "talker": "minros.nodes.rospy_tutorials.talker",
@@ -210,6 +212,10 @@ def resolve_executable(pkg: str, executable: str) -> List[str]:
                                   f"couldn't find executable named {absname}")
         return command_for(absname)
     unique = _executables_in(pkg, pkg_dir, executable)
+    if not unique and module and _module_exists(module):
+        # the package's sources on ROS_PACKAGE_PATH (rosout's C++, say) have no program: as
+        # ROS finds the installed one first, minros's built-in one runs
+        return [sys.executable, "-m", module]
     if not unique:
         lines = [f"[rosrun] Couldn't find executable named {executable} below {pkg_dir}"]
         others = _search(pkg_dir, executable, skip_build=False)

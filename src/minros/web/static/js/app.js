@@ -18,6 +18,7 @@ import {createServicesView} from "./views/services.js";
 import {createPublishView} from "./views/publish.js";
 import {createConsoleView} from "./views/console.js";
 import {createWireView} from "./views/wire.js";
+import {createLearnView} from "./views/learn.js";
 import {createAboutView} from "./views/about.js";
 
 const VIEWS = [
@@ -32,6 +33,7 @@ const VIEWS = [
   ["publish", "Publish", createPublishView],
   ["console", "Console", createConsoleView],
   ["wire", "Wire", createWireView],
+  ["learn", "Learn", createLearnView],
   ["about", "About", createAboutView],
 ];
 
