@@ -622,36 +622,6 @@ class Bridge:
 # -- the program ----------------------------------------------------------------------------------
 
 
-#: glibc's mallopt parameters, and the values the bridge process runs with (see keep_big_blocks)
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
-#: the largest fixed mmap threshold glibc accepts on 64-bit (HEAP_MAX_SIZE / 2)
-BIG_BLOCK = 32 << 20
-#: freed memory kept for reuse before it is returned to the system
-KEEP_FREED = 128 << 20
-
-
-def keep_big_blocks() -> bool:
-    """Let glibc's malloc reuse the big blocks of a frame instead of unmapping them.
-
-    Each 1080p frame through the bridge is a few 6 MB blocks (the received bytes, Zenoh's
-    copy, its reassembly). glibc gives such blocks back to the system when freed (munmap, or
-    trimming the heap of the thread's arena) and the next frame faults every page in again,
-    zeroed by the kernel: about 770 page faults per frame across two bridges, measured, and a
-    quarter of their CPU. A fixed mmap threshold above a frame and a high trim threshold keep
-    the memory for the next frame (at most ``KEEP_FREED`` kept per heap). Only this program's
-    process, never a library user's; False where the C library is not glibc."""
-    import ctypes
-    import ctypes.util
-
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        mallopt = libc.mallopt
-    except (OSError, AttributeError):
-        return False
-    mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
-    return bool(mallopt(_M_MMAP_THRESHOLD, BIG_BLOCK)) and bool(mallopt(_M_TRIM_THRESHOLD, KEEP_FREED))
-
-
 def master_error() -> Optional[str]:
     """Why the master cannot be used, or None."""
     from minros.tools.master import Master, MasterIOError
@@ -682,7 +652,6 @@ def run(options: Options, name: str = "minros_zenoh", announce: Callable[[str], 
         print(f"minros zenoh: error: {error}", file=sys.stderr)
         return 1
     zenoh.try_init_log_from_env()  # Zenoh's own log only when RUST_LOG asks for it
-    keep_big_blocks()
     minros.init_node(name, argv=argv, disable_signals=True)
     stop = threading.Event()
     SignalWatch(lambda _signum: stop.set(), "zenoh-signals").install((signal.SIGINT, signal.SIGTERM))
