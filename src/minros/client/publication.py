@@ -3,7 +3,10 @@ connections (rospy's _PublisherImpl).
 
 Publishing serializes a message once (Header stamped first) and hands the same frame to every
 connection's ``send``; the connections are transports of any protocol (``minros.transport``),
-added by the protocol handler that accepted the subscriber. The publication keeps what ROS
+added by the protocol handler that accepted the subscriber. A publication made with
+``intraprocess=True`` hands subscribers of this process the message object itself, through
+the connections that take objects (``takes_objects``: the intra-process links); the others
+get the frame, serialized only when one of them is there. The publication keeps what ROS
 keeps per topic: the latched message (sent first to every new subscriber), the sequence number,
 the SubscribeListeners, the user's extra header fields.
 """
@@ -38,6 +41,10 @@ class Publication:
         self.type: str = data_class._type
         self.md5sum: str = data_class._md5sum
         self.connections: List[Transport] = []
+        #: the connections that take message objects (intra-process links), also in connections
+        self.takers: List[Any] = []
+        #: subscribers of this process get the published objects themselves (shared)
+        self.intraprocess = False
         self.lock = threading.RLock()
         self.listeners: List[Any] = []
         self.headers: Dict[str, str] = {}
@@ -73,13 +80,16 @@ class Publication:
                 transport.close()
                 return
             self.connections = self.connections + [transport]
+            takes_objects = getattr(transport, "takes_objects", False)
+            if takes_objects:
+                self.takers = self.takers + [transport]
             if self.is_latch and self.latch is not None:
-                transport.send(self._serialize(self.latch))
+                self._send_one(transport, self.latch)
         for listener in list(self.listeners):
             def publish_single(*args: Any, _conn: Transport = transport, **kwds: Any) -> None:
                 msg = args_kwds_to_message(self.data_class, args, kwds)
                 with self.lock:
-                    _conn.send(self._serialize(msg))
+                    self._send_one(_conn, msg)
             try:
                 listener.peer_subscribe(self.resolved_name, self._publish_any, publish_single)
             except Exception:
@@ -91,6 +101,7 @@ class Publication:
             if transport not in self.connections:
                 return
             self.connections = [c for c in self.connections if c is not transport]
+            self.takers = [c for c in self.takers if c is not transport]
             remaining = len(self.connections)
         for listener in list(self.listeners):
             try:
@@ -102,6 +113,15 @@ class Publication:
         self.publish(args_kwds_to_message(self.data_class, args, kwds))
 
     # -- publishing --------------------------------------------------------------------------
+
+    def _send_one(self, conn: Any, msg: Any) -> None:
+        """Called with the lock held: ``msg`` to one connection."""
+        if getattr(conn, "takes_objects", False):
+            self.seq += 1
+            stamp_header(msg, self.seq)
+            conn.put(msg)
+        else:
+            conn.send(self._serialize(msg))
 
     def _serialize(self, msg: Any) -> Any:
         """Called with the lock held: Header.seq auto-fill, then one serialization."""
@@ -126,6 +146,13 @@ class Publication:
             self.seq += 1
             if getattr(msg, "_has_header", False):
                 stamp_header(msg, self.seq)
+            takers = self.takers
+            if takers:  # intra-process links: the object itself
+                for taker in takers:
+                    taker.put(msg)
+                if len(takers) == len(conns):
+                    return
+                conns = [c for c in conns if c not in takers]
             frame = serialize_frame(msg)
             self.message_data_sent += (len(frame) if frame.__class__ is bytes else frame_len(frame)) - 4
             for conn in conns:
