@@ -96,6 +96,9 @@ class IntraProcessPublisher(Transport):
             items.append(msg)
             self.stat_msgs += 1
             queue.cond.notify_all()
+        # Let the subscriber's thread have the GIL now rather than after the interpreter's
+        # switch interval (5 ms), or a publishing loop starves it (as TCPROSSender does).
+        time.sleep(0)
 
     def close(self) -> None:
         queue = self.queue

@@ -68,6 +68,8 @@ MAX_HANDSHAKES = 64
 _MAX_FDS = 4
 _ANC_SIZE = socket.CMSG_SPACE(_MAX_FDS * 4) if hasattr(socket, "CMSG_SPACE") else 0
 _U32 = struct.Struct("<I")
+#: inline messages sent in one system call at most (the writer catching up)
+_BATCH = 256
 
 _boot_id: Optional[str] = None
 
@@ -205,7 +207,7 @@ class ShmSender(Transport):
         self.control: List[Tuple[bytes, int]] = []  # SEGM/FALL records first, with their fd
         self.out: List[Any] = []  # the unsent rest of the record being sent
         self.out_fd = -1  # the descriptor to attach to out's first byte
-        self.out_item: Any = None
+        self.out_item = 0  # the messages in out
         self.failed = ""  # why shared memory failed: nothing more is sent but the FALL
         self.lock = threading.Lock()
         self.cond = threading.Condition(self.lock)
@@ -253,6 +255,25 @@ class ShmSender(Transport):
         size = len(frame) if isinstance(frame, bytes) else sum(len(p) for p in frame)
         if size < shm.INLINE_LIMIT:
             with self.lock:
+                if (isinstance(frame, bytes) and not self.busy and not self.out
+                        and not self.control and not self.slots.items and not self.sync
+                        and not self.done):
+                    # the socket is idle: one non-blocking send, as TCPROS does
+                    data = shm.INLINE + frame
+                    try:
+                        sent = self.stream.send(data, MSG_DONTWAIT)
+                    except BlockingIOError:
+                        sent = 0
+                    except OSError as exc:
+                        self._fail(exc)
+                        return
+                    self.bytes_sent += sent
+                    if sent == len(data):
+                        self.stat_msgs += 1
+                        return
+                    self.out, self.out_item = [memoryview(data)[sent:]], 1
+                    self.cond.notify_all()  # the writer thread sends the rest
+                    return
                 if self.sync and not self._wait_drained():
                     return
                 self.slots.put(("inline", frame))
@@ -377,17 +398,32 @@ class ShmSender(Transport):
         """With the lock: the next record to send into ``out``; False when nothing may go."""
         if self.control:
             record, fd = self.control.pop(0)
-            self.out, self.out_fd, self.out_item = [record], fd, None
+            self.out, self.out_fd, self.out_item = [record], fd, 0
             return True
-        if self.failed or not self.slots.ready():
+        slots = self.slots
+        if self.failed or not slots.ready():
             return False
-        item, notice = self.slots.pop()
-        if notice is None:  # inline: the frame carries its length prefix
+        item, notice = slots.pop()
+        if notice is not None:
+            self.out, self.out_item = [notice], 1
+            return True
+        # inline (the frame carries its length prefix), with the inline ones queued after it:
+        # one system call for many small messages
+        out: List[Any] = []
+        count = 0
+        while True:
             frame: Any = item[1]
-            self.out = [shm.INLINE, frame] if frame.__class__ is bytes else [shm.INLINE, *frame]
-        else:
-            self.out = [notice]
-        self.out_item = item
+            out.append(shm.INLINE)
+            if frame.__class__ is bytes:
+                out.append(frame)
+            else:
+                out.extend(frame)
+            count += 1
+            items = slots.items
+            if count >= _BATCH or not items or items[0][0] != "inline":
+                break
+            item, _ = slots.pop()
+        self.out, self.out_item = out, count
         return True
 
     def _advance(self, sent: int) -> bool:
@@ -404,9 +440,8 @@ class ShmSender(Transport):
         self.out = rest
         if rest:
             return False
-        if self.out_item is not None:
-            self.stat_msgs += 1
-            self.out_item = None
+        self.stat_msgs += self.out_item
+        self.out_item = 0
         return True
 
     def _writer(self) -> None:
@@ -574,6 +609,7 @@ class ShmReceiver(Transport):
         self.latching = False
         self.peer_pid = _peer_pid(stream)
         self.fileno = stream.fileno()
+        self.settle: Callable[[Any], None] | None = self._settle
 
     @property
     def stat_bytes(self) -> int:
@@ -590,10 +626,12 @@ class ShmReceiver(Transport):
 
     def message_reader(self, data_class: Any) -> Callable[[Any], Any]:
         """Messages read in place: their byte arrays are views of the slot."""
+        if not getattr(data_class, "_zero_copy", True):
+            self.settle = None  # no byte or numeric array anywhere: nothing to settle
         read: Callable[[Any], Any] = reader_for(data_class, in_place=True)
         return read
 
-    def settle(self, msg: Any) -> None:
+    def _settle(self, msg: Any) -> None:
         """After the callbacks: a message kept beyond them (referenced from anywhere but the
         receive loop, or latched) gets copies of its views before the slot goes back."""
         # references: the receive loop's variable, this parameter, getrefcount's argument
@@ -642,10 +680,14 @@ class ShmReceiver(Transport):
             os.close(fd)
 
     def _frames(self, notices: List[Any]) -> List[Any]:
+        if not self.fds and notices and all(n.__class__ is bytes for n in notices):
+            return notices  # only small messages: the usual case of a small-message topic
         frames: List[Any] = []
         for notice in notices:
             cls = notice.__class__
-            if cls is shm.Slot:
+            if cls is bytes:
+                frames.append(notice)
+            elif cls is shm.Slot:
                 mapping = self.maps.get(notice.generation)
                 if mapping is None:
                     raise shm.ShmError(f"a slot of segment {notice.generation}, which never came")
@@ -661,8 +703,6 @@ class ShmReceiver(Transport):
                 if _U32.unpack_from(frame)[0] != length - 4:
                     raise shm.ShmError(f"slot {notice.slot} does not hold the message announced")
                 frames.append(frame[4:])
-            elif cls is shm.Inline:
-                frames.append(bytes(notice))
             elif cls is shm.Segment:
                 if not self.fds:
                     raise shm.ShmError("a segment came without its file descriptor")

@@ -47,7 +47,7 @@ from typing import Any, Deque, Dict, List, Optional, Set, Tuple, Union
 __all__ = [
     "BOOT_ID_PATH", "DONE", "FALL", "HEADER_SIZE", "INLINE", "INLINE_LIMIT", "MAX_SLOTS",
     "PROTOCOL", "SEGM", "SEGMENT_MAGIC", "SLOT", "VERSION", "WINDOW", "Done", "DoneReader",
-    "Fallback", "Inline", "NoticeReader", "Segment", "ShmError", "Slot", "SlotQueue",
+    "Fallback", "NoticeReader", "Segment", "ShmError", "Slot", "SlotQueue",
     "answer", "check_offer", "check_segment_header", "done", "fallback", "grown_slot_size",
     "inline_head", "offer", "page_round", "parse_answer", "segment", "segment_header",
     "slot", "slot_count",
@@ -79,6 +79,7 @@ SEGMENT_MAGIC = b"MINROSHM"
 _SEGM = struct.Struct("<4sIIIQ")
 _SLOT = struct.Struct("<4sIIIIQ")
 _U32 = struct.Struct("<I")
+_HEAD = struct.Struct("<4sI")  # a record's tag and its first u32
 _DONE = struct.Struct("<4sII")
 _HEADER = struct.Struct("<8sIIIIQ")  # magic, version, generation, slots, (zero), slot_size
 
@@ -192,12 +193,6 @@ class Slot(Tuple[int, int, int, int, int]):
     seq = property(lambda self: self[4])
 
 
-class Inline(bytes):
-    """MSG: a small message's body (its frame without the length prefix)."""
-
-    __slots__ = ()
-
-
 class Fallback(str):
     """FALL: the publisher gave up on shared memory, for this reason."""
 
@@ -212,7 +207,8 @@ class Done(Tuple[int, int]):
     slot = property(lambda self: self[1])
 
 
-Notice = Union[Segment, Slot, Inline, Fallback]
+#: what NoticeReader returns: records, and small messages' bodies as ``bytes`` (MSG)
+Notice = Union[Segment, Slot, bytes, Fallback]
 
 
 def segment(generation: int, slots: int, slot_size: int) -> bytes:
@@ -276,27 +272,27 @@ class NoticeReader(_Reader):
         self.end += n
         out: List[Notice] = []
         buf, view = self.buf, self.view
+        end = self.end
         while True:
             start = self.start
-            have = self.end - start
+            have = end - start
             if have < 8:
                 break
-            tag = bytes(view[start:start + 4])
-            if tag == SLOT:
-                if have < _SLOT.size:
-                    break
-                _, generation, index, offset, length, seq = _SLOT.unpack_from(buf, start)
-                out.append(Slot((generation, index, offset, length, seq)))
-                self.start = start + _SLOT.size
-            elif tag == INLINE:
-                (size,) = _U32.unpack_from(buf, start + 4)
+            tag, size = _HEAD.unpack_from(buf, start)
+            if tag == INLINE:
                 if size + 4 > INLINE_LIMIT:
                     raise ShmError(f"an inline message of {size} bytes (the limit is "
                                    f"{INLINE_LIMIT - 4})")
                 if have < 8 + size:
                     break
-                out.append(Inline(view[start + 8:start + 8 + size]))
+                out.append(bytes(view[start + 8:start + 8 + size]))
                 self.start = start + 8 + size
+            elif tag == SLOT:
+                if have < _SLOT.size:
+                    break
+                _, generation, index, offset, length, seq = _SLOT.unpack_from(buf, start)
+                out.append(Slot((generation, index, offset, length, seq)))
+                self.start = start + _SLOT.size
             elif tag == SEGM:
                 if have < _SEGM.size:
                     break
