@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import signal
 import subprocess
 import xmlrpc.client
@@ -147,6 +148,33 @@ def test_images_go_through_shared_memory_and_sigkill_leaves_nothing(scripts, min
         for proc in (pub, pub2, sub):
             if proc is not None:
                 proc.stop()
+
+
+def _full_dev_shm(argv) -> list:
+    """``argv`` in a mount namespace of its own whose /dev/shm is a full 4 KiB tmpfs."""
+    script = ("mount -t tmpfs -o size=4k tmpfs /dev/shm && "
+              "dd if=/dev/zero of=/dev/shm/fill bs=4k count=1 2>/dev/null && "
+              "! (echo x > /dev/shm/more) 2>/dev/null && exec \"$@\"")
+    return ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh", *argv]
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("unshare"),
+                    reason="needs root and unshare for a private /dev/shm")
+def test_a_full_dev_shm_changes_nothing(scripts, minros_master, ros_home):
+    """Docker's /dev/shm is 64 MB, often full: memfd memory is not in it."""
+    pub_script, sub_script = scripts
+    sub = Proc(_full_dev_shm([PYTHON, str(sub_script)]), ros_env(minros_master, ros_home))
+    pub = None
+    try:
+        sub.read_until("subscribed", 20)
+        pub = Proc(_full_dev_shm([PYTHON, str(pub_script), "0"]),
+                   ros_env(minros_master, ros_home))
+        line = _line(sub.read_until("got 10 ", 30), r"^got 10 ")
+    finally:
+        for proc in (pub, sub):
+            if proc is not None:
+                proc.stop()
+    assert "bad 0 type memoryview transport MINROSSHM" in line, line
 
 
 def test_minros_shm_0_keeps_a_subscriber_on_tcpros(scripts, minros_master, ros_home):
