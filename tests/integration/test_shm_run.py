@@ -21,7 +21,8 @@ from support import PYTHON, Proc, ros_env, wait_until
 pytestmark = pytest.mark.skipif(not shm_transport.supported(), reason="no memfd on this system")
 
 #: publishes 640x480 mono8 images at 50 Hz, pixel value = the message's number (argv: count,
-#: 0 for endless); optionally breaks the protocol first (MINROS_TEST_GARBAGE=1)
+#: 0 for endless); optionally breaks the protocol first (MINROS_TEST_GARBAGE=1), or fills
+#: the pixels in memory from Publisher.loan() (MINROS_TEST_LOAN=1)
 PUBLISHER = r'''
 import os, resource, sys, time
 if os.environ.get("MINROS_TEST_FSIZE"):
@@ -43,8 +44,12 @@ n = 0
 rate = rospy.Rate(50)
 try:
     while not rospy.is_shutdown() and (count == 0 or n < count):
-        pub.publish(Image(height=480, width=640, encoding="mono8", step=640,
-                          data=bytes([n % 256]) * (640 * 480)))
+        if os.environ.get("MINROS_TEST_LOAN"):  # the pixels written into a loan
+            data = pub.loan(640 * 480)
+            data[:] = bytes([n % 256]) * (640 * 480)
+        else:
+            data = bytes([n % 256]) * (640 * 480)
+        pub.publish(Image(height=480, width=640, encoding="mono8", step=640, data=data))
         n += 1
         rate.sleep()
 except rospy.ROSInterruptException:  # stopped with Ctrl-C
@@ -175,6 +180,25 @@ def test_a_full_dev_shm_changes_nothing(scripts, minros_master, ros_home):
             if proc is not None:
                 proc.stop()
     assert "bad 0 type memoryview transport MINROSSHM" in line, line
+
+
+@pytest.mark.parametrize("shm_env, transport", [("1", "MINROSSHM"), ("0", "TCPROS")])
+def test_a_loaned_image_reaches_a_subscriber_of_either_transport(scripts, minros_master,
+                                                                 ros_home, shm_env, transport):
+    """Publisher.loan(): the slot's memory for a shared-memory subscriber, plain memory for
+    a TCPROS one; the pixels arrive whole either way."""
+    pub_script, sub_script = scripts
+    sub = _start(sub_script, [], minros_master, ros_home, {"MINROS_SHM": shm_env})
+    pub = None
+    try:
+        sub.read_until("subscribed", 20)
+        pub = _start(pub_script, [0], minros_master, ros_home, {"MINROS_TEST_LOAN": "1"})
+        line = _line(sub.read_until("got 20 ", 30), r"^got 20 ")
+    finally:
+        for proc in (pub, sub):
+            if proc is not None:
+                proc.stop()
+    assert "bad 0" in line and f"transport {transport}" in line, line
 
 
 def test_minros_shm_0_keeps_a_subscriber_on_tcpros(scripts, minros_master, ros_home):

@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from minros.client.msg import AnyMsg, serialize_frame
+from minros.client.msg import AnyMsg, frame_len, serialize_frame
 from minros.msgs import get_message_class, reader_for
 from minros.transport import shm as shm_transport
 from minros.transport.base import FallBack
@@ -596,3 +596,100 @@ def test_cv_bridge_gives_an_image_of_a_slot_pixels_of_its_own(pair):
     assert image.base is None and int(image[99, 999]) == 9
     assert CvBridge().imgmsg_to_cv2(img).base is not None  # bytes: a view, as before
 
+
+# --------------------------------------------------------------------------- Publisher.loan
+
+
+class _Node:
+    caller_id = "/talker"
+
+    @staticmethod
+    def is_shutdown() -> bool:
+        return False
+
+
+def publication(*conns: Any, latch: bool = False):
+    from minros.client.publication import Publication
+
+    pub = Publication(_Node(), "/t", "/t", get_message_class("sensor_msgs/Image"))
+    pub.is_latch = latch
+    for conn in conns:
+        pub.add_connection(conn)
+    return pub
+
+
+def image(data: Any):
+    Image = get_message_class("sensor_msgs/Image")
+    return Image(height=100, width=1000, encoding="mono8", step=1000, data=data)
+
+
+def test_a_loaned_array_is_published_from_its_slot_without_a_copy(pair, monkeypatch):
+    sender, receiver, _ = pair
+    pub = publication(sender)
+    view = pub.loan(100_000)
+    seg = sender.segment
+    assert seg is not None and not view.readonly and view.nbytes == 100_000
+    assert seg.slot_size >= shm.LOAN_OFFSET + 100_000 + shm.LOAN_TAIL
+    view[:] = payload(5, 100_000)  # filled in place: the slot's memory
+    assert sender.slots.counts()["writing"] == 1
+
+    def no_copy(*_args: Any) -> None:
+        raise AssertionError("a loaned message was copied into a slot")
+
+    monkeypatch.setattr(seg, "write", no_copy)
+    pub.publish(image(view))
+    frame = receive(receiver, 1, views=True)[0]
+    msg = receiver.message_reader(image(b"").__class__)(frame)
+    assert (msg.height, msg.width, msg.encoding, msg.step) == (100, 1000, "mono8", 1000)
+    assert bytes(msg.data) == payload(5, 100_000) and msg.header.seq == 1
+    assert pub.message_data_sent == frame_len(serialize_frame(image(payload(5, 100_000)))) - 4
+    assert sender.slots.counts()["writing"] == 0 and pub._loan is None
+
+
+def test_a_loan_not_published_goes_back_and_the_message_travels_as_usual(pair):
+    sender, receiver, _ = pair
+    pub = publication(sender)
+    pub.loan(100_000)
+    pub.loan(100_000)  # the first loan is cancelled
+    assert sender.slots.counts()["writing"] == 1
+    pub.publish(image(payload(3, 100_000)))  # a message that does not hold the loan
+    assert sender.slots.counts()["writing"] == 0
+    assert receive(receiver, 1)[0][-100_000:] == payload(3, 100_000)
+    view = pub.loan(100_000)
+    view[:] = payload(4, 100_000)
+    pub.publish(image(bytes(view[:50_000]) * 2))  # a copy of part of it: no loan either
+    assert sender.slots.counts()["writing"] == 0
+    assert receive(receiver, 1)[0][-100_000:] == payload(4, 100_000)
+
+
+def test_a_stale_loan_is_sent_as_any_message(pair):
+    """A larger message made a new segment after the loan: the loan's slot is of the old
+    one, so the message is copied as usual (and still correct)."""
+    sender, receiver, _ = pair
+    pub = publication(sender)
+    view = pub.loan(100_000)
+    view[:] = payload(6, 100_000)
+    sender.send(serialize_frame(AnyMsg(payload(1, 900_000))))
+    assert sender.segment.generation == 2
+    pub.publish(image(view))
+    got = receive(receiver, 2)
+    assert got[0] == payload(1, 900_000) and got[1][-100_000:] == payload(6, 100_000)
+
+
+def test_without_a_shared_memory_subscriber_a_loan_is_plain_memory(pair):
+    sender, _, _ = pair
+    for pub in (publication(), publication(sender, latch=True)):
+        view = pub.loan(1000)
+        assert view.obj.__class__ is bytearray and view.nbytes == 1000 and not view.readonly
+        assert pub._loan is None
+    with pytest.raises(ValueError, match="non-negative int"):
+        publication(sender).loan(-1)
+
+
+def test_a_loan_of_a_publication_without_subscribers_left_goes_back(pair):
+    sender, _, _ = pair
+    pub = publication(sender)
+    view = pub.loan(100_000)
+    pub.remove_connection(sender)
+    pub.publish(image(view))
+    assert sender.slots.counts()["writing"] == 0 and pub._loan is None

@@ -193,6 +193,18 @@ class Publisher(Topic):
                 "Please see http://wiki.ros.org/rospy/Overview/Publishers%20and%20Subscribers "
                 "for more information.", SyntaxWarning, stacklevel=2)
 
+    def loan(self, nbytes: int) -> memoryview:
+        """minros: writable memory for the large ``uint8[]`` array of the next message
+        (``nbytes``: ``Image.data``, ``PointCloud2.data``), to fill in place and put in the
+        message before ``publish()``. With a subscriber on shared memory it is that
+        subscriber's slot, so the message is published without a copy; otherwise plain
+        memory. Fill it before publishing and not after; one loan at a time."""
+        impl = self.impl
+        if impl is None:
+            raise ROSException("loan() on an unregistered() handle")
+        view: memoryview = impl.loan(nbytes)
+        return view
+
     def publish(self, *args: Any, **kwds: Any) -> None:
         """Publish a message instance, or build one from positional or keyword fields."""
         impl = self.impl

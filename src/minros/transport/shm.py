@@ -49,8 +49,8 @@ from minros.transport.tcpros_base import CONNECT_TIMEOUT, negotiate
 from minros.wire import shm, sockets, tcpros, trace
 from minros.wire.handshake import Handshake, Rejected, Role, refusal, route
 
-__all__ = ["ENV", "ShmHandler", "ShmReceiver", "ShmSegment", "ShmSender", "boot_id", "own",
-           "supported"]
+__all__ = ["ENV", "Loan", "ShmHandler", "ShmReceiver", "ShmSegment", "ShmSender", "boot_id",
+           "own", "supported"]
 
 _logger = logging.getLogger("minros.transport.shm")
 _rosout = logging.getLogger("rosout")
@@ -301,6 +301,50 @@ class ShmSender(Transport):
             if self.sync:
                 self._wait_drained()
 
+    # -- loans (Publisher.loan) --------------------------------------------------------------
+
+    def lend(self, nbytes: int) -> Loan | None:
+        """A slot for a message whose large array (``nbytes``) the publisher fills in place:
+        the array's memory at LOAN_OFFSET in it. None when there is none to lend (the
+        connection ended, shared memory failed, a synchronous publisher, the kernel)."""
+        with self.lock:
+            if self.done or self.failed or self.sync:
+                return None
+            index = self._slot_for(shm.LOAN_OFFSET + nbytes + shm.LOAN_TAIL)
+            seg = self.segment
+            if index is None or seg is None:
+                return None
+            start = shm.HEADER_SIZE + index * seg.slot_size + shm.LOAN_OFFSET
+            return Loan(seg, index, seg.view[start:start + nbytes])
+
+    def give_back(self, loan: Loan) -> None:
+        """A loan not published after all: its slot is free again."""
+        with self.lock:
+            if loan.segment is self.segment:
+                self.slots.abandon(loan.index)
+
+    def send_loaned(self, loan: Loan, head: bytes, tail: bytes) -> bool:
+        """Publish the message whose array is ``loan``'s memory: ``head`` (the frame's length
+        prefix and the fields before the array) and ``tail`` (the fields after it) are written
+        around it, nothing is copied. False when the loan is stale (a new segment since, the
+        connection ended): the caller then sends the message as any other."""
+        with self.lock:
+            seg = self.segment
+            if self.done or self.failed or loan.segment is not seg or seg is None:
+                return False
+            n = len(loan.view)
+            if len(head) > shm.LOAN_OFFSET or shm.LOAN_OFFSET + n + len(tail) > seg.slot_size:
+                self.slots.abandon(loan.index)
+                return False
+            base = shm.HEADER_SIZE + loan.index * seg.slot_size
+            start = base + shm.LOAN_OFFSET - len(head)
+            seg.view[start:base + shm.LOAN_OFFSET] = head
+            end = base + shm.LOAN_OFFSET + n
+            seg.view[end:end + len(tail)] = tail
+            self.slots.put(("slot", loan.index, len(head) + n + len(tail), start - base))
+            self._pump()
+        return True
+
     def _slot_for(self, size: int) -> int | None:
         """With the lock: a slot of a segment large enough for ``size`` bytes, or None (the
         frame is dropped, or shared memory failed and the FALL record is on its way)."""
@@ -542,6 +586,17 @@ class ShmSender(Transport):
             self.done = True
             self.cond.notify_all()
             self._release()
+
+
+class Loan:
+    """A slot lent to the publisher: ``view`` is the writable memory of the array it fills."""
+
+    __slots__ = ("segment", "index", "view")
+
+    def __init__(self, segment: ShmSegment, index: int, view: memoryview) -> None:
+        self.segment = segment
+        self.index = index
+        self.view = view
 
 
 def _peer_pid(stream: Any) -> int:

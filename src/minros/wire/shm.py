@@ -45,7 +45,7 @@ import struct
 from typing import Any, Deque, Dict, List, Optional, Set, Tuple, Union
 
 __all__ = [
-    "BOOT_ID_PATH", "DONE", "FALL", "HEADER_SIZE", "INLINE", "INLINE_LIMIT", "MAX_SLOTS",
+    "BOOT_ID_PATH", "DONE", "FALL", "HEADER_SIZE", "INLINE", "INLINE_LIMIT", "LOAN_OFFSET", "LOAN_TAIL", "MAX_SLOTS",
     "PROTOCOL", "SEGM", "SEGMENT_MAGIC", "SLOT", "VERSION", "WINDOW", "Done", "DoneReader",
     "Fallback", "NoticeReader", "Segment", "ShmError", "Slot", "SlotQueue",
     "answer", "check_offer", "check_segment_header", "done", "fallback", "grown_slot_size",
@@ -68,6 +68,11 @@ MAX_SLOTS = 64
 #: the segment's first page: its header
 HEADER_SIZE = 4096
 PAGE = 4096
+#: where a loaned array starts in its slot (``Publisher.loan``): the fields before it are
+#: written just below, the ones after it just after it
+LOAN_OFFSET = 4096
+#: room a loaned slot keeps for the fields after the array
+LOAN_TAIL = 4096
 #: the longest reason a FALL record may carry
 REASON_LIMIT = 1024
 #: the longest name an answer may give for the publisher's socket
