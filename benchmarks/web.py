@@ -16,7 +16,16 @@ carrying its send time; rosbridge clients subscribed through ``minros web`` meas
 rate and the latency (median, p99): roslibpy (the PyPI client) and a bare websockets client
 (the floor of a Python client). Both run interleaved in the same server.
 
-This file is also its own worker (``--role pub-image|pub-small|raw-sub``).
+Scenario 3, many topics (``--only topics``): publisher processes host 200 nodes with 10
+std_msgs/String topics each, every topic published at 1 Hz; one rosbridge client subscribes to
+all 2,000 through ``minros web``. Once every topic has delivered a message, the server's threads
+and resident memory are read from /proc, and the delivered rate is measured.
+
+``--baseline DIR`` runs every scenario a second time, right after the first, with the server
+from another source tree (an older commit: ``git archive COMMIT src stubs | tar -x -C DIR``),
+for before/after figures on one machine in one run.
+
+This file is also its own worker (``--role pub-image|pub-small|raw-sub|pub-farm``).
 """
 
 from __future__ import annotations
@@ -97,6 +106,134 @@ def role_raw_sub(topic: str, seconds: float) -> None:
         time.sleep(0.05)
     hz = (len(times) - 1) / (times[-1] - times[0]) if len(times) > 1 else 0.0
     print(json.dumps({"hz": hz, "count": len(times)}), flush=True)
+
+
+def role_pub_farm(index: int, nodes: int, per_node: int, rate: float, seconds: float) -> None:
+    """``nodes`` nodes of ``per_node`` String topics each, in this one process (Node objects
+    of their own: 200 processes would not fit the machine), each topic published at ``rate``."""
+    from minros.client.publication import Publication
+    from minros.node import Node
+    from std_msgs.msg import String
+
+    master = os.environ["ROS_MASTER_URI"]
+    pubs = []
+    for n in range(nodes):
+        node = Node(argv=["farm", f"__master:={master}", "__hostname:=127.0.0.1"])
+        name = f"farm{index}_{n}"
+        node.init(name, args_key=(name,))
+        for k in range(per_node):
+            topic = f"/{name}/t{k}"
+            impl = Publication(node, topic, topic, String)
+            impl.queue_size = 2
+            node.add_publication(impl)
+            pubs.append(impl)
+    print(json.dumps({"ready": len(pubs)}), flush=True)
+    msg, sent, start = String("x" * 20), 0, time.monotonic()
+    period = 1.0 / rate
+    while time.monotonic() - start < seconds:
+        tick = time.monotonic()
+        for impl in pubs:
+            impl.publish(msg)
+            sent += 1
+        delay = period - (time.monotonic() - tick)
+        if delay > 0:
+            time.sleep(delay)
+    print(json.dumps({"sent": sent, "hz": sent / (time.monotonic() - start)}), flush=True)
+
+
+def proc_stats(pid: int) -> dict:
+    """Threads, resident and peak resident memory (MB) of process ``pid``."""
+    status = {}
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            key, _, value = line.partition(":")
+            status[key] = value.strip()
+    return {"threads": int(status["Threads"]), "rss": int(status["VmRSS"].split()[0]) / 1024,
+            "peak": int(status["VmHWM"].split()[0]) / 1024}
+
+
+def many_topics(ws_url: str, topics: list, seconds: float, server_pid: int, out: dict) -> None:
+    """Subscribe one rosbridge client to every topic; when each has delivered a message, read
+    the server's threads and memory, then count what arrives for ``seconds``."""
+    from websockets.sync.client import connect
+
+    with connect(ws_url, open_timeout=30, max_size=None) as ws:
+        start = time.monotonic()
+        for topic in topics:
+            ws.send(json.dumps({"op": "subscribe", "topic": topic, "type": "std_msgs/String"}))
+        seen: set = set()
+        deadline = start + 120
+        while len(seen) < len(topics) and time.monotonic() < deadline:
+            try:
+                seen.add(json.loads(ws.recv(timeout=5))["topic"])
+            except TimeoutError:
+                pass
+        out["all_in"] = time.monotonic() - start
+        out["seen"] = len(seen)
+        out["settled"] = proc_stats(server_pid)
+        count, t0 = 0, time.monotonic()
+        while time.monotonic() - t0 < seconds:
+            try:
+                ws.recv(timeout=1)
+                count += 1
+            except TimeoutError:
+                pass
+        out["hz"] = count / (time.monotonic() - t0)
+        out["end"] = proc_stats(server_pid)
+
+
+def run_topics(seconds: float, nodes: int, per_node: int, farms: int, web_src: str | None) -> list:
+    home = tempfile.mkdtemp(prefix="minros-web-bench-")
+    master, web_port = free_port(), free_port()
+    env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{master}", ROS_HOSTNAME="localhost",
+               ROS_HOME=home, ROS_LOG_DIR=home, PYTHONUNBUFFERED="1")
+    me = os.path.abspath(__file__)
+    procs = [spawn([PYTHON, "-m", "minros", "core", "-p", str(master)], env)]
+    try:
+        wait_for(lambda: master_up(master), 20, "the master")
+        web = spawn([PYTHON, "-m", "minros", "web", "--port", str(web_port)], web_env(env, web_src))
+        procs.append(web)
+        wait_for(lambda: port_open(web_port), 20, "minros web")
+        idle = proc_stats(web.pid)
+        span = seconds + 200
+        farm_procs = []
+        for index in range(farms):
+            share = nodes // farms + (1 if index < nodes % farms else 0)
+            farm = spawn([PYTHON, me, "--role", "pub-farm", "--index", str(index), "--nodes",
+                          str(share), "--per-node", str(per_node), "--seconds", str(span)], env)
+            farm_procs.append((farm, share))
+            procs.append(farm)
+        for farm, _share in farm_procs:
+            line = farm.stdout.readline()
+            if not line.startswith('{"ready"'):
+                raise RuntimeError(f"a publisher farm did not start: {line}{farm.stdout.read()[-2000:]}")
+        topics = [f"/farm{i}_{n}/t{k}" for i, (_f, share) in enumerate(farm_procs)
+                  for n in range(share) for k in range(per_node)]
+        out: dict = {}
+        many_topics(f"ws://127.0.0.1:{web_port}", topics, seconds, web.pid, out)
+    finally:
+        for proc in reversed(procs):
+            stop(proc)
+    return [("idle server", 0, None, None, idle, idle),
+            (f"{nodes} nodes x {per_node} topics, 1 Hz each, one rosbridge client", len(topics),
+             out.get("all_in"), out.get("hz"), out.get("settled"), out.get("end"))]
+
+
+def print_topics(rows: list, seconds: float) -> None:
+    print(f"minros web, many topics ({seconds:.0f} s of delivery, {os.cpu_count()} cores; "
+          "threads when all deliver / at the end)")
+    print(f"| {'server':<10} | {'scenario':<56} | topics | all delivering after s | "
+          "delivered msg/s | server threads | RSS MB | peak RSS MB")
+    print(f"|{'-' * 12}|{'-' * 58}|--------|------------------------|-----------------|"
+          "----------------|--------|------------")
+    for who, (name, topics, all_in, hz, settled, end) in rows:
+        all_text = f"{all_in:.1f}" if all_in is not None else "-"
+        hz_text = f"{hz:.0f}" if hz is not None else "-"
+        threads = f"{settled['threads']} / {end['threads']}" if settled else "-"
+        rss = f"{settled['rss']:.0f}" if settled else "-"
+        peak = f"{end['peak']:.0f}" if end else "-"
+        print(f"| {who:<10} | {name:<56} | {topics:6d} | {all_text:>22} | {hz_text:>15} | "
+              f"{threads:>14} | {rss:>6} | {peak:>11}")
 
 
 # -- clients ---------------------------------------------------------------------------------
@@ -241,7 +378,13 @@ def port_open(port: int) -> bool:
         return False
 
 
-def run(seconds: float) -> list:
+def web_env(env: dict, web_src: str | None) -> dict:
+    """The environment of the server: another source tree's minros first when asked."""
+    return dict(env, PYTHONPATH=os.path.join(web_src, "src") + os.pathsep + os.path.join(
+        web_src, "stubs")) if web_src else env
+
+
+def run(seconds: float, web_src: str | None = None) -> list:
     home = tempfile.mkdtemp(prefix="minros-web-bench-")
     master, web_port = free_port(), free_port()
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{master}", ROS_HOSTNAME="localhost",
@@ -252,7 +395,7 @@ def run(seconds: float) -> list:
     try:
         wait_for(lambda: master_up(master), 20, "the master")
         procs.append(spawn([PYTHON, "-m", "minros", "web", "--port", str(web_port),
-                            "--send-timeout", str(seconds * 4 + 30)], env))
+                            "--send-timeout", str(seconds * 4 + 30)], web_env(env, web_src)))
         wait_for(lambda: port_open(web_port), 20, "minros web")
         ws_url, http = f"ws://127.0.0.1:{web_port}", f"http://127.0.0.1:{web_port}"
 
@@ -319,9 +462,22 @@ def run(seconds: float) -> list:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--only", choices=("streams", "topics"),
+                        help="run scenarios 1-2 (streams) or 3 (topics) only (default: all)")
+    parser.add_argument("--nodes", type=int, default=200, help="scenario 3: publisher nodes")
+    parser.add_argument("--per-node", type=int, default=10, help="scenario 3: topics per node")
+    parser.add_argument("--farms", type=int, default=4,
+                        help="scenario 3: processes the publisher nodes share")
+    parser.add_argument("--baseline", metavar="DIR",
+                        help="also run each scenario with the server from this source tree "
+                             "(its src/ and stubs/), e.g. an older commit git-archived there")
     parser.add_argument("--role", help=argparse.SUPPRESS)
     parser.add_argument("--topic", help=argparse.SUPPRESS)
+    parser.add_argument("--index", type=int, default=0, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.role == "pub-farm":
+        role_pub_farm(args.index, args.nodes, args.per_node, 1.0, args.seconds)
+        return 0
     if args.role == "pub-image":
         role_pub_image(args.seconds)
         return 0
@@ -332,13 +488,23 @@ def main() -> int:
         role_raw_sub(args.topic, args.seconds)
         return 0
     byte_compile_minros()
-    rows = run(args.seconds)
+    contenders = [("this tree", None)] + ([("baseline", args.baseline)] if args.baseline else [])
+    if args.only != "streams":
+        rows = [(who, row) for who, src in contenders
+                for row in run_topics(args.seconds, args.nodes, args.per_node, args.farms, src)]
+        print_topics(rows, args.seconds)
+        if args.only == "topics":
+            return 0
+    rows = [(who, row) for who, src in contenders for row in run(args.seconds, src)]
     print(f"minros web benchmark ({args.seconds:.0f} s per measurement, {os.cpu_count()} cores)")
-    print(f"| {'scenario':<62} | published Hz | raw sub Hz | delivered Hz | latency median / p99 ms | note")
-    print(f"|{'-' * 64}|--------------|------------|--------------|-------------------------|------")
-    for name, pub_hz, raw_hz, hz, lat, note in rows:
+    print(f"| {'server':<10} | {'scenario':<62} | published Hz | raw sub Hz | delivered Hz | "
+          "latency median / p99 ms | note")
+    print(f"|{'-' * 12}|{'-' * 64}|--------------|------------|--------------|"
+          "-------------------------|------")
+    for who, (name, pub_hz, raw_hz, hz, lat, note) in sorted(rows, key=lambda r: r[1][0]):
         lat_text = f"{lat[0]:.1f} / {lat[1]:.1f}" if lat else "-"
-        print(f"| {name:<62} | {pub_hz:12.1f} | {raw_hz:10.1f} | {hz:12.1f} | {lat_text:>23} | {note}")
+        print(f"| {who:<10} | {name:<62} | {pub_hz:12.1f} | {raw_hz:10.1f} | {hz:12.1f} | "
+              f"{lat_text:>23} | {note}")
     return 0
 
 

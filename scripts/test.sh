@@ -29,4 +29,55 @@ fi
 .venv/bin/ruff check src stubs tests benchmarks examples
 .venv/bin/lint-imports  # the layers of docs/architecture.md (contracts in pyproject.toml)
 .venv/bin/mypy  # the types of the modules [tool.mypy] lists in pyproject.toml
-.venv/bin/python -m pytest "$@"
+
+# Every Python the README promises: the unit and integration tests also run on the oldest and
+# the newest CPython (pyenv's, on this project's image), in venvs of their own, beside the main
+# run but at the lowest priority (nice 19), so that they use the CPU time the main run leaves
+# and its timing tests see the machine as they would alone; the tests marked `timing` run in
+# the main run only. CI requires both; elsewhere a missing one is named and skipped.
+# OTHER_PYTHONS= skips them.
+find_python() {
+  local v=$1 p
+  p=$(command -v "python$v" 2>/dev/null) && "$p" -c 'import ensurepip' 2>/dev/null && { echo "$p"; return; }
+  for p in "${PYENV_ROOT:-$HOME/.pyenv}"/versions/"$v".*/bin/python"$v"; do
+    [ -x "$p" ] && { echo "$p"; return; }
+  done
+  return 1
+}
+others=()
+for v in ${OTHER_PYTHONS-3.10 3.13}; do
+  if py=$(find_python "$v"); then
+    others+=("$v:$py")
+  elif [ -n "${CI:-}" ]; then
+    echo "error: CI runs the tests on Python $v too, and none was found (install it with pyenv)" >&2
+    exit 1
+  else
+    echo "note: no Python $v found; its run of the unit and integration tests is skipped" >&2
+  fi
+done
+pids=()
+for entry in "${others[@]}"; do
+  v=${entry%%:*}; py=${entry#*:}
+  (
+    set -e
+    [ -x ".venv-$v/bin/python" ] || "$py" -m venv ".venv-$v"
+    ".venv-$v/bin/python" -m pip install -q --upgrade pip
+    ".venv-$v/bin/python" -m pip install -q -e '.[test]'
+    nice -n 19 ".venv-$v/bin/python" -m pytest -q -p no:cacheprovider \
+      -m "not interop and not timing" tests/unit tests/integration
+  ) > ".venv-$v.log" 2>&1 &
+  pids+=("$v:$!")
+done
+status=0
+.venv/bin/python -m pytest "$@" || status=$?
+for entry in "${pids[@]}"; do
+  v=${entry%%:*}
+  if wait "${entry#*:}"; then
+    echo "Python $v: $(tail -n 1 ".venv-$v.log")"
+  else
+    echo "Python $v: unit and integration tests FAILED; the end of .venv-$v.log:" >&2
+    tail -n 60 ".venv-$v.log" >&2
+    status=1
+  fi
+done
+exit $status

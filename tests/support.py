@@ -63,6 +63,17 @@ def reference_available() -> bool:
             and os.path.exists("/usr/bin/rostopic"))
 
 
+#: where Debian's python3-*-msgs packages install the classes genpy generated
+DEBIAN_DIST_PACKAGES = Path("/usr/lib/python3/dist-packages")
+
+
+def debian_has_messages(package: str) -> bool:
+    """Whether Debian's Python has ``package``'s generated message or service classes (the
+    bundled packages Debian lacks are checked against genpy run on the same files instead)."""
+    return any((DEBIAN_DIST_PACKAGES / package / kind / "__init__.py").is_file()
+               for kind in ("msg", "srv"))
+
+
 def require_reference() -> None:
     """Skip when the reference is absent locally; in CI its absence is a failure."""
     if reference_available():
@@ -122,6 +133,33 @@ def reference_env(env: Dict[str, str]) -> Dict[str, str]:
     out.pop("PYTHONHOME", None)
     out["PATH"] = "/usr/bin:/bin:/usr/sbin:/sbin"
     return out
+
+
+#: lines Debian's tools print because of how the reference machine is set up, not because of
+#: what they do: rospkg warns on every package.xml it parses when python3-rosdep is installed
+#: but ``rosdep init`` never ran (a full desktop install). Parity tests compare without them.
+REFERENCE_NOISE = ("the rosdep view is empty: call 'sudo rosdep init' and 'rosdep update'\n",)
+
+
+def without_reference_noise(text: str) -> str:
+    """``text`` (a Debian tool's stderr) without the lines of :data:`REFERENCE_NOISE`."""
+    for line in REFERENCE_NOISE:
+        text = text.replace(line, "")
+    return text
+
+
+def rosdep_uninitialised(folder: Path) -> str:
+    """A ``rosdep2`` for PYTHONPATH that behaves as an installed rosdep never initialised (its
+    view empty), so a test sees the full reference's noise whether or not rosdep is here."""
+    package = folder / "rosdep2"
+    package.mkdir(parents=True, exist_ok=True)
+    (package / "__init__.py").write_text("")
+    (package / "rospack.py").write_text(
+        "def init_rospack_interface():\n    return object()\n\n\n"
+        "def is_view_empty(view):\n    return True\n\n\n"
+        "def is_ros_package(view, name):\n    return False\n\n\n"
+        "def is_system_dependency(view, name):\n    return False\n")
+    return str(folder)
 
 
 class Proc:

@@ -211,4 +211,155 @@ def _convert(image: np.ndarray, src: str, dst: str) -> np.ndarray:
     return out
 
 
-__all__ = ["CvBridge", "CvBridgeError", "getCvType"]
+# ---------------------------------------------------------------------------------------------
+# cv_bridge.boost.cv_bridge_boost: the functions of cv_bridge's C++ extension, in Python
+
+class CvBridgeBoostError(RuntimeError):
+    """A conversion the C++ cv_bridge refuses (its Python binding raises RuntimeError)."""
+
+
+def CV_MAT_CNWrap(cvtype: int) -> int:  # noqa: N802 - cv_bridge_boost's name
+    """The number of channels of an OpenCV type code."""
+    return ((cvtype >> 3) & 511) + 1
+
+
+def CV_MAT_DEPTHWrap(cvtype: int) -> int:  # noqa: N802 - cv_bridge_boost's name
+    """The depth code (0 = 8U ... 6 = 64F) of an OpenCV type code."""
+    return cvtype & 7
+
+
+_COLOR = ("rgb8", "bgr8", "rgba8", "bgra8", "rgb16", "bgr16", "rgba16", "bgra16")
+_MONO = ("mono8", "mono16")
+
+
+def _is_color_format(encoding: str) -> bool:
+    return encoding in _COLOR or encoding in _MONO or encoding.startswith("bayer_") or encoding == "yuv422"
+
+
+def _bit_depth(encoding: str) -> int:
+    depth, _channels = _depth_channels(encoding)
+    return {"8U": 8, "8S": 8, "16U": 16, "16S": 16, "32S": 32, "32F": 32, "64F": 64}[depth]
+
+
+def _check_conversion(src: str, dst: str) -> None:
+    """cv_bridge's refusals (its getConversionCode), with its texts."""
+    same_channels = _depth_channels(src)[1] == _depth_channels(dst)[1]
+    if not _is_color_format(src):
+        if _is_color_format(dst):
+            raise CvBridgeBoostError(f"[{src}] is not a color format. but [{dst}] is. The conversion "
+                                     "does not make sense")
+        if not same_channels:
+            raise CvBridgeBoostError(f"[{src}] and [{dst}] do not have the same number of channel")
+    elif not _is_color_format(dst) and not same_channels:
+        raise CvBridgeBoostError(f"[{src}] is a color format but [{dst}] is not so they must have "
+                                 "the same OpenCV type, CV_8UC3, CV16UC1 ....")
+
+
+def cvtColor2(image: np.ndarray, encoding_in: str, encoding_out: str) -> np.ndarray:  # noqa: N802
+    """A copy of image converted from encoding_in to encoding_out (colour layout
+    and bit depth, scaled between 8 and 16 bits)."""
+    try:
+        _check_conversion(encoding_in, encoding_out)
+        if encoding_in == encoding_out:
+            return np.array(image, copy=True)
+        return _convert(np.asarray(image), encoding_in, encoding_out)
+    except CvBridgeError as exc:
+        raise CvBridgeBoostError(str(exc)) from None
+
+
+#: the colours of label images (cv_bridge's rgb_colors: the CSS named colours in alphabetical
+#: order without paleturquoise and rebeccapurple), as RGB hex; label n gets colour n % 146.
+#: Two differ from CSS in cv_bridge's table, and so here: palevioletred (110) has
+#: paleturquoise's value and sandybrown (123) is fa a4 60
+_LABEL_COLORS = (
+    "f0f8ff faebd7 00ffff 7fffd4 f0ffff f5f5dc ffe4c4 000000 ffebcd 0000ff 8a2be2 a52a2a "
+    "deb887 5f9ea0 7fff00 d2691e ff7f50 6495ed fff8dc dc143c 00ffff 00008b 008b8b b8860b "
+    "a9a9a9 006400 a9a9a9 bdb76b 8b008b 556b2f ff8c00 9932cc 8b0000 e9967a 8fbc8f 483d8b "
+    "2f4f4f 2f4f4f 00ced1 9400d3 ff1493 00bfff 696969 696969 1e90ff b22222 fffaf0 228b22 "
+    "ff00ff dcdcdc f8f8ff ffd700 daa520 808080 008000 adff2f 808080 f0fff0 ff69b4 cd5c5c "
+    "4b0082 fffff0 f0e68c e6e6fa fff0f5 7cfc00 fffacd add8e6 f08080 e0ffff fafad2 d3d3d3 "
+    "90ee90 d3d3d3 ffb6c1 ffa07a 20b2aa 87cefa 778899 778899 b0c4de ffffe0 00ff00 32cd32 "
+    "faf0e6 ff00ff 800000 66cdaa 0000cd ba55d3 9370db 3cb371 7b68ee 00fa9a 48d1cc c71585 "
+    "191970 f5fffa ffe4e1 ffe4b5 ffdead 000080 fdf5e6 808000 6b8e23 ffa500 ff4500 da70d6 "
+    "eee8aa 98fb98 afeeee ffefd5 ffdab9 cd853f ffc0cb dda0dd b0e0e6 800080 ff0000 bc8f8f "
+    "4169e1 8b4513 fa8072 faa460 2e8b57 fff5ee a0522d c0c0c0 87ceeb 6a5acd 708090 708090 "
+    "fffafa 00ff7f 4682b4 d2b48c 008080 d8bfd8 ff6347 40e0d0 ee82ee f5deb3 ffffff f5f5f5 "
+    "ffff00 9acd32 "
+).split()
+
+
+def _label_rgb(label: int) -> Tuple[float, float, float]:
+    # cv_bridge keeps each colour's components to three significant digits
+    hex_ = _LABEL_COLORS[label % len(_LABEL_COLORS)]
+    return tuple(float(f"{int(hex_[i:i + 2], 16) / 255.0:.3g}") for i in (0, 2, 4))  # type: ignore[return-value]
+
+
+def _labels_to_bgr(labels: np.ndarray, bg_label: int = -1) -> np.ndarray:
+    table = np.array([[int(c * 255) for c in reversed(_label_rgb(i))]
+                      for i in range(len(_LABEL_COLORS))], dtype=np.uint8)
+    # C++'s % keeps the sign of the label: a negative label wraps to its own colour index
+    index = np.fmod(labels.astype(np.int64), len(_LABEL_COLORS))
+    out = table[np.where(index < 0, 0, index)]
+    out[index < 0] = table[0] * 0  # C++ reads outside the table there: black is our answer
+    out[labels == bg_label] = 0
+    return out
+
+
+def _saturate(values: np.ndarray, dtype: type) -> np.ndarray:
+    info = np.iinfo(dtype)
+    return np.clip(np.rint(np.nan_to_num(values, nan=0.0)), info.min, info.max).astype(dtype)
+
+
+def cvtColorForDisplay(source: np.ndarray, encoding_in: str, encoding_out: str,  # noqa: N802
+                       do_dynamic_scaling: bool = False, min_image_value: float = 0.0,
+                       max_image_value: float = 0.0) -> np.ndarray:
+    """An 8-bit image of source to show (cv_bridge's rules): label images (32SC1) in one
+    colour per label, single-channel images scaled from [min, max] (their own with
+    do_dynamic_scaling) to 0-255, anything else converted to encoding_out (bgr8
+    when it is empty)."""
+    image = np.asarray(source)
+    encoding = encoding_out
+    if not encoding:
+        try:
+            channels, depth = _depth_channels(encoding_in)[1], _bit_depth(encoding_in)
+        except CvBridgeError:
+            channels, depth = 0, 0
+        if (channels == 1 and (encoding_in == "32SC1" or depth in (8, 16, 32))) or (
+                channels > 1 and depth in (8, 16)):
+            encoding = "bgr8"
+        else:
+            raise CvBridgeBoostError("cv_bridge.cvtColorForDisplay() output encoding is empty and "
+                                     "cannot be guessed.")
+    elif encoding not in _COLOR + _MONO or _bit_depth(encoding) != 8:
+        raise CvBridgeBoostError("cv_bridge.cvtColorForDisplay() does not have an output encoding "
+                                 "that is color or mono, and has is bit in depth")
+    if encoding == "bgr8" and encoding_in == "32SC1":
+        return _labels_to_bgr(image)
+    low, high = float(min_image_value), float(max_image_value)
+    if do_dynamic_scaling:
+        low, high = float(np.nanmin(image)), float(np.nanmax(image))
+        if low == high:
+            return np.full(image.shape[:2] + (3,), 128, dtype=np.uint8)
+    if low != high:
+        if image.ndim == 3 and image.shape[2] != 1:
+            raise CvBridgeBoostError("cv_bridge.cvtColorForDisplay() scaling for images with more "
+                                     "than one channel is unsupported")
+        shifted = image.astype(np.float64) - low
+        if np.issubdtype(image.dtype, np.integer):  # OpenCV keeps the source type, saturated
+            shifted = _saturate(shifted, image.dtype).astype(np.float64)
+        scaled = _saturate(shifted * (255.0 / (high - low)), np.uint8)
+        return cvtColor2(scaled, "mono8", encoding)
+    # OpenCV type names taken as the colour layouts they most likely are
+    typed = {"CV_8UC1": "mono8", "16UC1": "mono16", "CV_8UC3": "bgr8", "CV_8UC4": "bgra8",
+             "CV_16UC3": "bgr16", "CV_16UC4": "bgra16"}.get(encoding_in, encoding_in)
+    if typed == encoding:
+        return image
+    try:
+        return cvtColor2(image, typed, encoding)
+    except (CvBridgeBoostError, CvBridgeError) as exc:
+        raise CvBridgeBoostError(f"cv_bridge.cvtColorForDisplay() while trying to convert image "
+                                 f"from '{encoding_in}' to '{encoding}' an exception was thrown "
+                                 f"({exc})") from None
+
+
+__all__ = ["CvBridge", "CvBridgeError", "getCvType", "cvtColorForDisplay"]

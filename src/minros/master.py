@@ -5,8 +5,9 @@ parameters; ``minros core`` adds those).
 
 Layout, from pure to I/O:
 
-* :class:`ParamTree` — the parameter dictionary (nested dicts keyed by resolved names) and
-  :func:`compute_param_updates`, which decides who gets which ``paramUpdate``;
+* :class:`ParamTree` — the parameter dictionary (nested dicts keyed by resolved names),
+  :func:`compute_param_updates`, which decides who gets which ``paramUpdate``, and
+  :class:`ParamDictionary`, the two with the subscriptions (rosmaster.paramserver's shape);
 * :class:`Registrations` / :class:`RegistrationManager` — publishers, subscribers, services,
   parameter subscriptions and the node table (same name + new URI bumps the old node);
 * :class:`CallbackPool` — asynchronous ``publisherUpdate`` / ``paramUpdate`` / ``shutdown`` calls
@@ -221,7 +222,80 @@ def _snapshot(value: Any) -> Any:
     return copy.deepcopy(value) if type(value) is dict else value
 
 
+class ParamDictionary:
+    """The parameter server's state: the tree and who subscribed to what (rosmaster's
+    ParamDictionary). ``notify_task(updates)`` receives :func:`compute_param_updates`' answer
+    after a change, under the lock (so updates reach the queue in the order of the changes)."""
+
+    def __init__(self, reg_manager: RegistrationManager, lock: Any = None) -> None:
+        self.lock = lock if lock is not None else threading.RLock()
+        self.tree = ParamTree()
+        self.reg_manager = reg_manager
+
+    @property
+    def parameters(self) -> Dict[str, Any]:
+        return self.tree.root
+
+    def get_param_names(self) -> List[str]:
+        with self.lock:
+            return self.tree.names()
+
+    def search_param(self, ns: str, key: str) -> str | None:
+        with self.lock:
+            return self.tree.search(ns, key)
+
+    def get_param(self, key: str) -> Any:
+        """KeyError when unset."""
+        with self.lock:
+            return self.tree.get(key)
+
+    def has_param(self, key: str) -> bool:
+        with self.lock:
+            return self.tree.has(key)
+
+    def set_param(self, key: str, value: Any, notify_task: Callable[[List[Any]], Any] | None = None,
+                  caller_id: str | None = None) -> None:
+        """Set ``key`` (the setter, ``caller_id``, is not told of its own change)."""
+        with self.lock:
+            self.tree.set(key, value)
+            if notify_task:
+                updates = compute_param_updates(self.reg_manager.param_subscribers, key, value,
+                                                caller_id)
+                if updates:
+                    notify_task(updates)
+
+    def delete_param(self, key: str, notify_task: Callable[[List[Any]], Any] | None = None) -> None:
+        """KeyError when ``key`` is not set; subscribers learn it as the value ``{}``."""
+        with self.lock:
+            self.tree.delete(key)
+            if notify_task:
+                updates = compute_param_updates(self.reg_manager.param_subscribers, key, {})
+                if updates:
+                    notify_task(updates)
+
+    def subscribe_param(self, key: str, registration_args: Tuple[str, str]) -> Any:
+        """Subscribe ``(caller_id, caller_api)`` to ``key``; its value now, ``{}`` if unset."""
+        key = _subscription_key(key)
+        with self.lock:
+            try:
+                value = self.tree.get(key)
+            except KeyError:
+                value = {}
+            self.reg_manager.register_param_subscriber(key, *registration_args)
+            return value
+
+    def unsubscribe_param(self, key: str, unregistration_args: Tuple[str, str]) -> List[Any]:
+        with self.lock:
+            return self.reg_manager.unregister_param_subscriber(_subscription_key(key),
+                                                               *unregistration_args)
+
+
 # ====================================================================== registrations (pure)
+
+
+class InternalException(Exception):
+    """A bug in the master's own bookkeeping (an unknown registration kind)."""
+
 
 
 class Registrations:
@@ -233,8 +307,10 @@ class Registrations:
     SERVICE = 3
     PARAM_SUBSCRIPTIONS = 4
 
-    def __init__(self, kind: int) -> None:
-        self.kind = kind
+    def __init__(self, type_: int) -> None:
+        if type_ not in _KINDS:
+            raise InternalException(f"invalid registration type: {type_}")
+        self.type = type_
         self.map: Dict[str, List[Caller]] = {}
         # None until the first service registration (rosmaster's messages depend on it)
         self.service_api_map: Dict[str, Caller] | None = None
@@ -242,7 +318,12 @@ class Registrations:
     def __bool__(self) -> bool:
         return bool(self.map)
 
+    __nonzero__ = __bool__  # rosmaster's (Python 2) name, which its tests call
+
     def __contains__(self, key: str) -> bool:
+        return key in self.map
+
+    def has_key(self, key: str) -> bool:
         return key in self.map
 
     def __getitem__(self, key: str) -> List[Caller]:
@@ -250,6 +331,8 @@ class Registrations:
 
     def keys(self) -> Iterable[str]:
         return self.map.keys()
+
+    iterkeys = keys
 
     def get_apis(self, key: str) -> List[str]:
         return [api for _id, api in self.map.get(key, ())]
@@ -269,6 +352,8 @@ class Registrations:
                 self.service_api_map = {}
             self.service_api_map[key] = (caller_id, service_api)
             return
+        if self.type == Registrations.SERVICE:
+            raise InternalException("service_api must be specified for Registrations.SERVICE")
         callers = self.map.get(key)
         if callers is None:
             self.map[key] = [(caller_id, caller_api)]
@@ -297,6 +382,8 @@ class Registrations:
             del self.service_api_map[key]
             del self.map[key]
             return [1, f"Unregistered [{caller_id}] as provider of [{key}]", 1]
+        if self.type == Registrations.SERVICE:
+            raise InternalException("service_api must be specified for Registrations.SERVICE")
         callers = self.map.get(key, [])
         if caller_api is not None and (caller_id, caller_api) in callers:
             callers.remove((caller_id, caller_api))
@@ -307,23 +394,49 @@ class Registrations:
 
 
 class NodeRef:
-    """What one node (caller_id) has registered; the node is forgotten when this is empty."""
+    """What one node (caller_id) has registered, by kind; the node is forgotten when this is
+    empty (rosmaster's attribute names)."""
 
-    def __init__(self, caller_id: str, api: str) -> None:
-        self.id = caller_id
+    def __init__(self, id: str, api: str) -> None:  # noqa: A002 - rosmaster's name
+        self.id = id
         self.api = api
-        self.keys: Dict[int, Dict[str, None]] = {
-            Registrations.TOPIC_SUBSCRIPTIONS: {}, Registrations.TOPIC_PUBLICATIONS: {},
-            Registrations.SERVICE: {}, Registrations.PARAM_SUBSCRIPTIONS: {}}
+        self.clear()
 
-    def add(self, kind: int, key: str) -> None:
-        self.keys[kind][key] = None
+    def clear(self) -> None:
+        """Forget every registration (the API stays)."""
+        self.param_subscriptions: List[str] = []
+        self.topic_subscriptions: List[str] = []
+        self.topic_publications: List[str] = []
+        self.services: List[str] = []
 
-    def remove(self, kind: int, key: str) -> None:
-        self.keys[kind].pop(key, None)
+    def _keys(self, type_: int) -> List[str]:
+        if type_ == Registrations.TOPIC_SUBSCRIPTIONS:
+            return self.topic_subscriptions
+        if type_ == Registrations.TOPIC_PUBLICATIONS:
+            return self.topic_publications
+        if type_ == Registrations.SERVICE:
+            return self.services
+        if type_ == Registrations.PARAM_SUBSCRIPTIONS:
+            return self.param_subscriptions
+        raise InternalException(f"invalid registration type: {type_}")
+
+    def add(self, type_: int, key: str) -> None:
+        keys = self._keys(type_)
+        if key not in keys:
+            keys.append(key)
+
+    def remove(self, type_: int, key: str) -> None:
+        keys = self._keys(type_)
+        if key in keys:
+            keys.remove(key)
 
     def is_empty(self) -> bool:
-        return not any(self.keys.values())
+        return not (self.param_subscriptions or self.topic_subscriptions
+                    or self.topic_publications or self.services)
+
+
+_KINDS = (Registrations.TOPIC_SUBSCRIPTIONS, Registrations.TOPIC_PUBLICATIONS,
+          Registrations.SERVICE, Registrations.PARAM_SUBSCRIPTIONS)
 
 
 class RegistrationManager:
@@ -361,7 +474,7 @@ class RegistrationManager:
     def _register(self, regs: Registrations, key: str, caller_id: str, caller_api: str,
                   service_api: str | None = None) -> None:
         node, bumped = self._register_node_api(caller_id, caller_api)
-        node.add(regs.kind, key)
+        node.add(regs.type, key)
         if bumped:
             for r in (self.publishers, self.subscribers, self.services, self.param_subscribers):
                 r.unregister_all(caller_id)
@@ -374,7 +487,7 @@ class RegistrationManager:
             return [1, f"[{caller_id}] is not a registered node", 0]
         result = regs.unregister(key, caller_id, caller_api, service_api)
         if result[2] == 1:
-            node.remove(regs.kind, key)
+            node.remove(regs.type, key)
         if node.is_empty():
             del self.nodes[caller_id]
         return result
@@ -550,7 +663,7 @@ class MasterHandler:
         self._pool = pool if pool is not None else CallbackPool()
         self._lock = threading.RLock()
         self._reg = RegistrationManager(on_bump=self._bump_node)
-        self._params = ParamTree()
+        self._params = ParamDictionary(self._reg, self._lock)
         self._topic_types: Dict[str, str] = {}
         self._shutdown_requested = threading.Event()
         self._on_shutdown: Callable[[str], None] | None = None
@@ -645,12 +758,9 @@ class MasterHandler:
         key = _resolve_name(key, caller_id)
         with self._lock:
             try:
-                self._params.delete(key)
+                self._params.delete_param(key, self._notify_param_subscribers)
             except KeyError:
                 return -1, f"parameter [{key}] is not set", 0
-            updates = compute_param_updates(self._reg.param_subscribers, key, {})
-            if updates:
-                self._notify_param_subscribers(updates)
         _log.info("-PARAM [%s] by %s", key, caller_id)
         return 1, f"parameter {key} deleted", 0
 
@@ -658,10 +768,7 @@ class MasterHandler:
     def setParam(self, caller_id: str, key: str, value: Any) -> Any:
         key = _resolve_name(key, caller_id)
         with self._lock:
-            self._params.set(key, value)
-            updates = compute_param_updates(self._reg.param_subscribers, key, value, caller_id)
-            if updates:
-                self._notify_param_subscribers(updates)
+            self._params.set_param(key, value, self._notify_param_subscribers, caller_id)
         _log.info("+PARAM [%s] by %s", key, caller_id)
         return 1, f"parameter {key} set", 0
 
@@ -670,7 +777,7 @@ class MasterHandler:
         key = _resolve_name(key, caller_id)
         with self._lock:
             try:
-                value = self._params.get(key)
+                value = self._params.get_param(key)
             except KeyError:
                 return -1, f"Parameter [{key}] is not set", 0
             # a namespace is marshalled after the lock is released: hand out a snapshot so a
@@ -680,7 +787,7 @@ class MasterHandler:
     @api(0, (non_empty_str("key"),))
     def searchParam(self, caller_id: str, key: str) -> Any:
         with self._lock:
-            found = self._params.search(caller_id, key)
+            found = self._params.search_param(caller_id, key)
         if found:
             return 1, f"Found [{found}]", found
         return -1, f"Cannot find parameter [{key}] in an upwards search", ""
@@ -689,12 +796,7 @@ class MasterHandler:
     def subscribeParam(self, caller_id: str, caller_api: str, key: str) -> Any:
         key = _resolve_name(key, caller_id)
         with self._lock:
-            sub_key = _subscription_key(key)
-            try:
-                value = _snapshot(self._params.get(sub_key))
-            except KeyError:
-                value = {}
-            self._reg.register_param_subscriber(sub_key, caller_id, caller_api)
+            value = _snapshot(self._params.subscribe_param(key, (caller_id, caller_api)))
         _log.info("+CACHEDPARAM [%s] by %s", key, caller_id)
         return 1, f"Subscribed to parameter [{key}]", value
 
@@ -702,7 +804,7 @@ class MasterHandler:
     def unsubscribeParam(self, caller_id: str, caller_api: str, key: str) -> Any:
         key = _resolve_name(key, caller_id)
         with self._lock:
-            self._reg.unregister_param_subscriber(_subscription_key(key), caller_id, caller_api)
+            self._params.unsubscribe_param(key, (caller_id, caller_api))
         _log.info("-CACHEDPARAM [%s] by %s", key, caller_id)
         return 1, f"Unsubscribe to parameter [{key}]", 1
 
@@ -710,12 +812,12 @@ class MasterHandler:
     def hasParam(self, caller_id: str, key: str) -> Any:
         key = _resolve_name(key, caller_id)
         with self._lock:
-            return 1, key, self._params.has(key)
+            return 1, key, self._params.has_param(key)
 
     @api([])
     def getParamNames(self, caller_id: str) -> Any:
         with self._lock:
-            return 1, "Parameter names", self._params.names()
+            return 1, "Parameter names", self._params.get_param_names()
 
     # -- services
 

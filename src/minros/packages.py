@@ -1,10 +1,14 @@
 """ROS package discovery: the packages on ROS_PACKAGE_PATH and the ones minros ships.
 
 A package is a folder holding a ``package.xml``; its name is the manifest's ``<name>``
-(as rospack reads it), not the folder's. Discovery walks each ROS_PACKAGE_PATH entry in
+(as rospack reads it), not the folder's (a rosbuild package, with a ``manifest.xml``, is named
+by its folder). Discovery walks each ROS_PACKAGE_PATH entry in
 order, does not descend into a package, skips folders holding ``CATKIN_IGNORE`` and hidden
-folders, and the first package found under a name wins. minros's bundled packages (message
-definitions, turtlesim, rospy_tutorials, ...) come last, so a workspace can override them.
+folders, and the first package found under a name wins. minros's bundled packages come last,
+so a workspace can override them: message definitions, turtlesim, rospy_tutorials, ..., and a
+``package.xml`` (with Debian's ROS version) for each ROS package whose Python API, nodes or
+tools minros provides (rospy, roslaunch, rosbag, ...), so ``rosversion``, ``rospack find`` and
+``roslib.load_manifest`` know them as on a real install.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from typing import Any, Dict, List, Optional
 BUILTIN_SHARE_DIRS: List[Path] = [Path(__file__).resolve().parent / "msgs" / "share"]
 
 _NAME_RE = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
+_VERSION_RE = re.compile(rb"<version(?:\s[^>]*)?>\s*([^<\s]+)\s*</version>")
 _cache: Dict[str, Dict[str, Path]] = {}
 _cache_lock = threading.Lock()
 
@@ -39,12 +44,26 @@ def manifest_name(package_dir: Path) -> Optional[str]:
     return match.group(1).decode("utf-8", "replace") if match else None
 
 
+def manifest_version(package_dir: Path) -> Optional[str]:
+    """The ``<version>`` declared in ``package_dir/package.xml``, or None (rosversion's
+    "<unversioned>")."""
+    try:
+        head = (package_dir / "package.xml").read_bytes()[:65536]
+    except OSError:
+        return None
+    match = _VERSION_RE.search(head)
+    return match.group(1).decode("utf-8", "replace") if match else None
+
+
 def _walk(root: Path, found: Dict[str, Path]) -> None:
     """Add every package below ``root`` to ``found`` (first one under a name wins)."""
     try:
         if (root / "package.xml").is_file():
             name = manifest_name(root) or root.name
             found.setdefault(name, root)
+            return
+        if (root / "manifest.xml").is_file():  # a rosbuild package: named by its folder
+            found.setdefault(root.name, root)
             return
         if (root / "CATKIN_IGNORE").exists():
             return
@@ -142,4 +161,218 @@ def find_resource(package: str, resource_name: str, filter_fn: Any = None) -> Li
             path = os.path.join(dirpath, resource_name)
             if filter_fn is None or filter_fn(path):
                 found.append(path)
+    return found
+
+
+# ---------------------------------------------------------------------------------------------
+# roslib.packages' errors and lookups, roslib.manifest and roslib.resources (rosbuild-era API
+# that catkin-era code and ROS's tests still call)
+
+MANIFEST_FILE = "manifest.xml"
+PACKAGE_FILE = "package.xml"
+
+
+class ROSPkgException(Exception):
+    """Base of roslib.packages' errors."""
+
+
+class InvalidROSPkgException(ROSPkgException):
+    """A package is missing or broken."""
+
+
+class MultipleNodesException(ROSPkgException):
+    """Several programs of one name in a package."""
+
+
+def get_pkg_dir(package: str, required: bool = True) -> Optional[str]:
+    """The folder of ``package``; InvalidROSPkgException (``required``) or None when missing,
+    naming the search path as roslib does."""
+    folder = find_package(package)
+    if folder is None:
+        if required:
+            raise InvalidROSPkgException(
+                f"Cannot locate installation of package {package}: [rospack] Error: package "
+                f"'{package}' not found. ROS_ROOT[{os.environ.get('ROS_ROOT')}] "
+                f"ROS_PACKAGE_PATH[{os.environ.get('ROS_PACKAGE_PATH', '')}]")
+        return None
+    return str(folder)
+
+
+def resource_file(package: str, subdir: str, resource_name: str) -> str:
+    """``<package>/<subdir>/<resource_name>``, whether or not the file exists."""
+    return os.path.join(get_pkg_dir(package) or "", subdir, resource_name)
+
+
+def get_dir_pkg(d: str) -> tuple:
+    """``(package folder, package name)`` of the package folder ``d`` is in, or
+    ``(None, None)`` (roslib.packages.get_dir_pkg)."""
+    d = os.path.abspath(d)
+    while True:
+        if os.path.isfile(os.path.join(d, PACKAGE_FILE)) or os.path.isfile(os.path.join(d, MANIFEST_FILE)):
+            return d, manifest_name(Path(d)) or os.path.basename(d)
+        parent = os.path.dirname(d)
+        if parent == d:
+            return None, None
+        d = parent
+
+
+def manifest_file(package: str, required: bool = True) -> Optional[str]:
+    """The ``manifest.xml`` of a rosbuild package (a catkin package has none: with
+    ``required`` that is InvalidROSPkgException, as roslib.manifest says)."""
+    folder = get_pkg_dir(package, required)
+    if folder is None:
+        return None
+    path = os.path.join(folder, MANIFEST_FILE)
+    if not os.path.isfile(path) and required:
+        raise InvalidROSPkgException(
+            f"\nPackage '{folder}' is improperly configured: no manifest file is present.\n")
+    return path
+
+
+class Depend:
+    """A manifest's ``<depend package="..."/>`` as roslib.manifest names it."""
+
+    __slots__ = ("package",)
+
+    def __init__(self, package: str) -> None:
+        self.package = package
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Depend) and other.package == self.package
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __str__(self) -> str:
+        return self.package
+
+    def __repr__(self) -> str:
+        return self.package
+
+    def xml(self) -> str:
+        return f'<depend package="{self.package}" />'
+
+
+def _roslib_depends(manifest: Any) -> Any:
+    manifest.depends = [Depend(d.name) for d in manifest.depends]
+    return manifest
+
+
+def parse_manifest_file(path: str) -> Any:
+    """A ``manifest.xml`` (or ``package.xml``) parsed by rospkg, its dependencies as
+    roslib's :class:`Depend` (``.package``)."""
+    import rospkg.manifest
+
+    return _roslib_depends(rospkg.manifest.parse_manifest_file(os.path.dirname(path) or ".",
+                                                               os.path.basename(path)))
+
+
+def parse_manifest_text(text: str, filename: str = "string") -> Any:
+    """A ``manifest.xml`` given as text, parsed as :func:`parse_manifest_file` does."""
+    import rospkg.manifest
+
+    return _roslib_depends(rospkg.manifest.parse_manifest(MANIFEST_FILE, text, filename))
+
+
+def list_package_resources_by_dir(package_dir: str, include_depends: bool, subdir: str,
+                                  rfilter: Any = os.path.isfile) -> List[str]:
+    """Names of the entries of ``<package_dir>/<subdir>`` that ``rfilter`` accepts; with
+    ``include_depends``, the dependencies' too, as ``pkg/name``."""
+    folder = os.path.join(package_dir, subdir)
+    found = sorted(name for name in (os.listdir(folder) if os.path.isdir(folder) else ())
+                   if rfilter(os.path.join(folder, name)))
+    if include_depends:
+        name = manifest_name(Path(package_dir)) or os.path.basename(package_dir)
+        for dep in rospack().get_depends(name, implicit=True):
+            dep_dir = get_pkg_dir(dep, required=False)
+            if dep_dir:
+                found += [f"{dep}/{r}" for r in
+                          list_package_resources_by_dir(dep_dir, False, subdir, rfilter)]
+    return found
+
+
+def list_package_resources(package: str, include_depends: bool, subdir: str,
+                           rfilter: Any = os.path.isfile) -> List[str]:
+    """:func:`list_package_resources_by_dir` for package ``package`` (none if it is missing)."""
+    package_dir = get_pkg_dir(package, required=False)
+    if package_dir is None:
+        return []
+    return list_package_resources_by_dir(package_dir, include_depends, subdir, rfilter)
+
+
+# ---------------------------------------------------------------------------------------------
+# rospack's and rosstack's dependency queries (roslib.rospack), answered by rospkg in-process
+
+class ROSLibException(Exception):
+    """Base of roslib's errors (roslib.exceptions)."""
+
+
+def manifest_depends(name: str) -> List[str]:
+    """The packages package ``name`` declares it depends on (every kind of dependency, as
+    rospack lists them) that can be found. Conditions are not evaluated: what they choose
+    between (python-setuptools or python3-setuptools) are system packages, never found."""
+    folder = find_package(name)
+    if folder is None:
+        raise ROSLibException(f"[rospack] Error: package '{name}' not found")
+    declared: List[str] = []
+    if (folder / PACKAGE_FILE).is_file():
+        from catkin_pkg.package import parse_package
+
+        package = parse_package(str(folder / PACKAGE_FILE))
+        for dep in (package.buildtool_depends + package.build_depends + package.run_depends
+                    + package.test_depends):
+            declared.append(dep.name)
+    elif (folder / MANIFEST_FILE).is_file():
+        declared = [d.package for d in parse_manifest_file(str(folder / MANIFEST_FILE)).depends]
+    known = list_packages()
+    return [d for d in dict.fromkeys(declared) if d in known and d != name]
+
+
+def _depends(name: str, direct: bool) -> List[str]:
+    found: List[str] = []
+    todo = [name]
+    while todo:
+        for dep in manifest_depends(todo.pop(0)):
+            if dep not in found:
+                found.append(dep)
+                if not direct:
+                    todo.append(dep)
+    return found
+
+
+def dependency_query(name: str, reverse: bool = False, direct: bool = False) -> List[str]:
+    """What package ``name`` depends on, or with ``reverse`` what depends on it; ``direct``
+    for first-order only (rospack deps/deps1/depends-on/depends-on1). Declared dependencies
+    that are not installed are passed over. ROSLibException with rospack's text for an
+    unknown package."""
+    if find_package(name) is None:
+        raise ROSLibException(f"[rospack] Error: package '{name}' not found")
+    if not reverse:
+        return _depends(name, direct)
+    found = []
+    for other in sorted(list_packages()):
+        try:
+            if other != name and name in _depends(other, direct):
+                found.append(other)
+        except Exception:  # noqa: BLE001 - an unreadable manifest depends on nothing
+            continue
+    return found
+
+
+def reachable_packages(name: str) -> List[str]:
+    """Every package ``name`` depends on, directly or not, that can be found: the packages
+    whose messages its own may embed ([] for a package that is not installed)."""
+    try:
+        return _depends(name, direct=False)
+    except ROSLibException:
+        return []
+
+
+def plugins(package: str, attrib: str = "plugin") -> List[tuple]:
+    """``(package, value)`` for each package that depends on ``package`` and exports
+    ``<package attrib="value"/>`` (rospack plugins --attrib=ATTRIB PACKAGE)."""
+    pack = rospack()
+    found = []
+    for name in [package] + dependency_query(package, reverse=True, direct=True):
+        for value in pack.get_manifest(name).get_export(package, attrib):
+            found.append((name, value))
     return found

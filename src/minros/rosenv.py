@@ -32,10 +32,14 @@ def get_master_uri(env: Optional[Mapping[str, str]] = None,
 
 
 def remapped_master(argv: Iterable[str]) -> Optional[str]:
-    """The value of the first ``__master:=`` argument (the one rosgraph reads), or None."""
+    """The value of the first ``__master:=`` argument (the one rosgraph reads), or None;
+    ValueError (rosgraph's text) for one without a value or with a second ``:=``."""
     for arg in argv:
         if arg.startswith("__master:="):
-            return arg[len("__master:="):]
+            value = arg[len("__master:="):]
+            if not value or ":=" in value:
+                raise ValueError(f"__master remapping argument '{arg}' improperly specified")
+            return value
     return None
 
 

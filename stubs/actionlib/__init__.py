@@ -13,3 +13,10 @@ from actionlib import (  # noqa: F401,E402 - the submodules scripts import by na
 )
 from minros.actionlib import *  # noqa: F401,F403
 from minros.actionlib import __all__ as __all__  # noqa: PLC0414
+from std_msgs.msg import Header  # noqa: E402,F401 - actionlib's package has it (from its client)
+
+
+def __getattr__(name: str):
+    if name == "g_goal_id":
+        return action_client.g_goal_id
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -13,3 +13,12 @@ from minros.actionlib import (  # noqa: F401
     TerminalState,
     get_name_of_constant,
 )
+from std_msgs.msg import Header  # noqa: F401 - actionlib's module imports it (from rospy)
+
+
+def __getattr__(name: str):
+    if name == "g_goal_id":  # the number the next client goal id carries
+        from minros.actionlib.client import next_goal_number
+
+        return next_goal_number()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,3 +1,10 @@
 """actionlib.simple_action_client: SimpleActionClient (minros.actionlib)."""
 
-from minros.actionlib import SimpleActionClient, SimpleGoalState  # noqa: F401
+from actionlib_msgs.msg import GoalStatus  # noqa: F401
+from minros.actionlib import (  # noqa: F401
+    ActionClient,
+    CommState,
+    SimpleActionClient,
+    SimpleGoalState,
+    get_name_of_constant,
+)

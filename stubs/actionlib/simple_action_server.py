@@ -1,3 +1,9 @@
 """actionlib.simple_action_server: SimpleActionServer (minros.actionlib)."""
 
-from minros.actionlib import SimpleActionServer  # noqa: F401
+from actionlib_msgs.msg import GoalStatus  # noqa: F401
+from minros.actionlib import (  # noqa: F401
+    ActionServer,
+    ServerGoalHandle,
+    SimpleActionServer,
+    nop_cb,
+)

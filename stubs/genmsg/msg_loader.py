@@ -1,11 +1,19 @@
 """genmsg.msg_loader: MsgContext and the loaders (minros.msgs.loader)."""
 
 from minros.msgs.loader import (  # noqa: F401
+    Constant,
+    Field,
     InvalidMsgSpec,
     MsgContext,
     MsgNotFound,
+    _load_constant_line,
+    _load_field_line,
+    _strip_comments,
+    convert_constant_value,
     get_msg_file,
     get_srv_file,
+    is_valid_msg_field_name,
+    is_valid_msg_type,
     load_depends,
     load_msg_by_type,
     load_msg_depends,

@@ -6,9 +6,21 @@ from __future__ import annotations
 from typing import Any
 
 from minros.exceptions import DeserializationError, MessageException, SerializationError
-from minros.msgs.fill import fill_message_args, get_printable_message_args
+from minros.msgs.fill import (  # noqa: F401
+    _fill_message_args,
+    _fill_val,
+    fill_message_args,
+    get_printable_message_args,
+)
 from minros.msgs.importer import install_import_hook
-from minros.msgs.message import Message, check_type, isstring, strify_message, struct_I
+from minros.msgs.message import (  # noqa: F401
+    Message,
+    RosMsgUnicodeErrors,
+    check_type,
+    isstring,
+    strify_message,
+    struct_I,
+)
 from minros.msgs.registry import import_class
 from minros.msgs.tval import Duration, Time, TVal
 

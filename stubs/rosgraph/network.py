@@ -13,17 +13,26 @@ from minros.rosenv import (  # noqa: F401
     use_ipv6,
 )
 from minros.wire.tcpros import HeaderError as ROSHandshakeException  # noqa: F401, E402
-from minros.wire.tcpros import encode_header as encode_ros_handshake_header  # noqa: F401
+from minros.wire.tcpros import encode_header
+
+
+def encode_ros_handshake_header(header: dict) -> bytes:
+    """A connection header, length prefix included; keys and values may be str or UTF-8
+    bytes, as rosgraph accepts them."""
+    def text(x):  # noqa: ANN001, ANN202
+        return x.decode("utf-8") if isinstance(x, bytes) else x
+    return encode_header({text(k): text(v) for k, v in header.items()})
 
 
 def decode_ros_handshake_header(header_str: bytes) -> dict:
-    """The fields of a connection header given with its length prefix (extra bytes ignored)."""
+    """The fields of a connection header given with its length prefix (extra bytes ignored);
+    keys lose surrounding blanks, as rosgraph strips them."""
     from minros.wire.tcpros import read_header_block
 
     found = read_header_block(header_str)
     if found is None:
         raise ROSHandshakeException(f"Incomplete header: only {len(header_str)} bytes")
-    return found[0]
+    return {key.strip(): value for key, value in found[0].items()}
 
 
 def read_ros_handshake_header(sock, b=None, buff_size: int = 65536) -> dict:  # noqa: ANN001

@@ -1,3 +1,12 @@
-"""roslaunch.parent: ROSLaunchParent (minros.launch.api)."""
+"""roslaunch.parent: ROSLaunchParent, a roslaunch run from Python (minros.launch.rosserver:
+process monitor, XML-RPC server, ROSLaunchRunner)."""
 
-from minros.launch.api import ROSLaunchParent  # noqa: F401
+from minros.launch.nodeproc import NUM_WORKERS  # noqa: F401
+from minros.launch.rosmodel import load_config_default  # noqa: F401
+from minros.launch.rosserver import (  # noqa: F401
+    DEFAULT_TIMEOUT_SIGINT,
+    DEFAULT_TIMEOUT_SIGTERM,
+    ROSLaunchParent,
+)
+
+from . import config, launch, pmon, server  # noqa: F401 - roslaunch.parent imports them

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import List
 
 from minros.launch.api import get_or_generate_uuid  # noqa: F401
+from minros.launch.rostools import check_roslaunch  # noqa: F401
 
 
 def resolve_launch_arguments(args: List[str]) -> List[str]:

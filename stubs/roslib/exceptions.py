@@ -1,5 +1,3 @@
 """roslib.exceptions."""
 
-
-class ROSLibException(Exception):
-    """Base of roslib's errors."""
+from minros.packages import ROSLibException  # noqa: F401

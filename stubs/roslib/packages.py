@@ -4,44 +4,29 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import Any, Callable, List
 
 from minros import packages
+from minros.packages import (  # noqa: F401
+    MANIFEST_FILE,
+    PACKAGE_FILE,
+    InvalidROSPkgException,
+    MultipleNodesException,
+    ROSPkgException,
+    get_dir_pkg,
+    resource_file,
+)
 from minros.workspace.executables import find_executables
 
-MANIFEST_FILE = "manifest.xml"
-PACKAGE_FILE = "package.xml"
 SRC_DIR = "src"
 ROS_PACKAGE_PATH = "ROS_PACKAGE_PATH"
 ROS_ROOT = "ROS_ROOT"
 
 
-class ROSPkgException(Exception):
-    """Base of roslib.packages' errors."""
-
-
-class InvalidROSPkgException(ROSPkgException):
-    """A package is missing or broken."""
-
-
-class MultipleNodesException(ROSPkgException):
-    """Several programs of one name in a package."""
-
-
 def get_pkg_dir(package: str, required: bool = True, ros_root: Any = None,
                 ros_package_path: Any = None) -> str | None:
     """The folder of ``package``; InvalidROSPkgException (required) or None when missing."""
-    folder = packages.find_package(package)
-    if folder is None:
-        if required:
-            rpp = os.environ.get(ROS_PACKAGE_PATH, "")
-            raise InvalidROSPkgException(
-                f"Cannot locate installation of package {package}: [rospack] Error: package "
-                f"'{package}' not found. ROS_ROOT[{os.environ.get(ROS_ROOT)}] "
-                f"ROS_PACKAGE_PATH[{rpp}]")
-        return None
-    return str(folder)
+    return packages.get_pkg_dir(package, required)
 
 
 def get_pkg_subdir(package: str, subdir: str, required: bool = True, env: Any = None) -> str | None:
@@ -53,22 +38,6 @@ def get_pkg_subdir(package: str, subdir: str, required: bool = True, env: Any = 
     if required and not os.path.isdir(path):
         os.makedirs(path, exist_ok=True)
     return path
-
-
-def resource_file(package: str, subdir: str, resource_name: str) -> str:
-    return os.path.join(get_pkg_dir(package) or "", subdir, resource_name)
-
-
-def get_dir_pkg(d: str) -> tuple:
-    """(package folder, package name) of the package holding folder ``d``, or (None, None)."""
-    d = os.path.abspath(d)
-    while True:
-        if os.path.isfile(os.path.join(d, PACKAGE_FILE)) or os.path.isfile(os.path.join(d, MANIFEST_FILE)):
-            return d, packages.manifest_name(Path(d)) or os.path.basename(d)
-        parent = os.path.dirname(d)
-        if parent == d:
-            return None, None
-        d = parent
 
 
 def list_pkgs_by_path(path: str, packages_: List[str] | None = None, cache: Any = None,

@@ -1,45 +1,37 @@
-"""Stand-in for rosmsg's Python API (minros.msgs.registry: what ``rosmsg show`` prints)."""
+"""Stand-in for rosmsg's Python API (minros.cli.msg: the code the command runs)."""
 
-from __future__ import annotations
-
-import sys
-from typing import List
-
-from minros.msgs.registry import UnknownTypeError, list_types, message_text, service_text
-
-MODE_MSG = ".msg"
-MODE_SRV = ".srv"
-
-
-class ROSMsgException(Exception):
-    """A type could not be found or read."""
-
-
-def get_msg_text(type_: str, raw: bool = False, rospack: object = None) -> str:
-    """What ``rosmsg show [-r] TYPE`` prints."""
-    try:
-        return message_text(type_, raw) + "\n"
-    except (UnknownTypeError, ValueError) as exc:
-        raise ROSMsgException(str(exc)) from None
-
-
-def get_srv_text(type_: str, raw: bool = False, rospack: object = None) -> str:
-    try:
-        return service_text(type_, raw) + "\n"
-    except (UnknownTypeError, ValueError) as exc:
-        raise ROSMsgException(str(exc)) from None
-
-
-def list_msgs(package: str, rospack: object = None) -> List[str]:
-    return list_types(package, "msg")
-
-
-def list_srvs(package: str, rospack: object = None) -> List[str]:
-    return list_types(package, "srv")
-
-
-def rosmsgmain(mode: str = MODE_MSG) -> None:
-    from minros.cli.msg import main
-
-    sys.exit(main(sys.argv[1:], prog="rosmsg" if mode == MODE_MSG else "rossrv",
-                  kind="msg" if mode == MODE_MSG else "srv"))
+from catkin.find_in_workspaces import find_in_workspaces  # noqa: F401 - rosmsg imports it
+from minros.cli.msg import (  # noqa: F401
+    MAX_DEFAULT_NON_FLOW_ITEMS,
+    MODE_MSG,
+    MODE_SRV,
+    ROSMsgException,
+    RosMsgProtoArgsException,
+    RosMsgProtoException,
+    construct_ordered_mapping,
+    construct_yaml_map_with_ordered_dict,
+    create_names_filter,
+    fullusage,
+    get_array_type_instance,
+    get_msg_text,
+    get_srv_text,
+    get_yaml_for_msg,
+    init_rosmsg_proto,
+    iterate_packages,
+    list_msgs,
+    list_srvs,
+    list_types,
+    represent_ordered_mapping,
+    rosmsg_cmd_list,
+    rosmsg_cmd_md5,
+    rosmsg_cmd_package,
+    rosmsg_cmd_packages,
+    rosmsg_cmd_prototype,
+    rosmsg_cmd_show,
+    rosmsg_debug,
+    rosmsg_md5,
+    rosmsg_search,
+    rosmsgmain,
+    spec_to_str,
+)
+from minros.msgs import generate_dynamic  # noqa: F401 - rosmsg imports it from genpy.dynamic

@@ -1,11 +1,8 @@
-"""rospy.core: shutdown state, node URI and logging functions (minros.node, minros.client.log)."""
+"""rospy.core: minros.rospy_internals.core, which *is* this module (rospy's globals here are the
+node's state, read and set through the module object)."""
 
-from minros.client.log import logdebug, logerr, logfatal, loginfo, logwarn  # noqa: F401
-from minros.node import (  # noqa: F401
-    add_shutdown_hook,
-    get_node_uri,
-    is_initialized,
-    is_shutdown,
-    is_shutdown_requested,
-    signal_shutdown,
-)
+import sys
+
+from minros.rospy_internals import core as _module
+
+sys.modules[__name__] = _module

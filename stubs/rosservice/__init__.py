@@ -1,8 +1,11 @@
 """Stand-in for rosservice's Python API (minros.cli.service: the code the command runs)."""
 
 from minros.cli.service import (  # noqa: F401
+    NAME,
     ROSServiceException,
     ROSServiceIOException,
+    has_service_args,
+    rosservice_find,
     rosservicemain,
 )
 from minros.cli.service import rosservice_call_service as call_service  # noqa: F401

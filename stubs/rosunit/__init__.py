@@ -5,8 +5,13 @@ from __future__ import annotations
 import sys
 from typing import Any, Sequence
 
+from minros.tools.junitxml import (  # noqa: F401
+    create_xml_runner,
+    print_summary,
+    rostest_name_from_path,
+    xml_results_file,
+)
 from minros.tools.testing import XML_OUTPUT_FLAG  # noqa: F401
-from minros.tools.testing import results_file as xml_results_file  # noqa: F401
 
 
 def unitrun(package: str, test_name: str, test: Any, sysargs: Sequence[str] | None = None,

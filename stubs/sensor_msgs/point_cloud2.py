@@ -6,3 +6,4 @@ from minros.point_cloud2 import (  # noqa: F401
     read_points,
     read_points_list,
 )
+from sensor_msgs.msg import PointCloud2, PointField  # noqa: F401

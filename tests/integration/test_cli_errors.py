@@ -188,3 +188,105 @@ def test_usage_and_help(graph: dict) -> None:
         assert done.returncode == 0 and "usage:" in done.stdout.lower()  # rosnode: "Usage:"
     done = run("minros", "graph", "-o", "/tmp/x.bmp", env=graph)
     assert_one_line_error(done, 1, "cannot tell the format")
+
+
+# ---------------------------------------------------------------------------------------------
+# what the master (or something in its place) answers, and parameter files: one line each
+
+def _deep_reply(levels: int) -> bytes:
+    return (b"<?xml version='1.0'?><methodResponse><params><param><value>"
+            + b"<array><data><value>" * levels + b"<int>1</int>" + b"</value></data></array>" * levels
+            + b"</value></param></params></methodResponse>")
+
+
+BAD_REPLIES = {
+    "garbage": (b"garbage \x00\xff", "(syntax error: line 1, column 0)"),
+    "dtd": (b'<?xml version="1.0"?><!DOCTYPE m [<!ENTITY a "b">]><methodResponse><params><param>'
+            b"<value>&a;</value></param></params></methodResponse>",
+            "(XML document type declarations and entities are not allowed)"),
+    "deep": (_deep_reply(100_000), "(arrays and structs nested more than 200 deep)"),
+}
+
+
+@pytest.fixture(scope="module")
+def bad_masters():
+    """``{kind: port}``: HTTP servers answering every call with ``BAD_REPLIES[kind]``."""
+    import threading
+
+    stop = threading.Event()
+    listeners, threads = {}, []
+
+    def serve(conn: socket.socket, body: bytes) -> None:
+        with conn:
+            conn.settimeout(5)
+            conn.recv(65536)
+            conn.sendall(b"HTTP/1.1 200 OK\r\nContent-Type: text/xml\r\nContent-Length: %d\r\n\r\n"
+                         % len(body) + body)
+
+    def accept(listener: socket.socket, body: bytes) -> None:
+        while not stop.is_set():
+            try:
+                conn, _ = listener.accept()
+            except socket.timeout:
+                continue
+            threading.Thread(target=serve, args=(conn, body), daemon=True).start()
+
+    for kind, (body, _reason) in BAD_REPLIES.items():
+        listener = socket.create_server(("127.0.0.1", 0))
+        listener.settimeout(0.2)
+        listeners[kind] = listener
+        threads.append(threading.Thread(target=accept, args=(listener, body), daemon=True))
+        threads[-1].start()
+    yield {kind: listener.getsockname()[1] for kind, listener in listeners.items()}
+    stop.set()
+    for thread in threads:
+        thread.join(5)
+    for listener in listeners.values():
+        listener.close()
+
+
+@pytest.mark.parametrize("kind", sorted(BAD_REPLIES))
+@pytest.mark.parametrize("tool,args", [("rosnode", ["list"]), ("rosparam", ["get", "/x"])])
+def test_a_reply_that_is_not_xmlrpc(bad_masters: dict, tool: str, args: list, kind: str,
+                                    tmp_path: Path) -> None:
+    port = bad_masters[kind]
+    done = run(tool, *args, env=ros_env(port, tmp_path))
+    assert_one_line_error(done, 1, f"ERROR: http://localhost:{port} sent a reply that is "
+                                   f"not XML-RPC {BAD_REPLIES[kind][1]}")
+
+
+def test_parameter_files_that_cannot_be_loaded(graph: dict, tmp_path: Path) -> None:
+    deep = tmp_path / "deep.yaml"
+    deep.write_text("a: " + "[" * 10_000 + "]" * 10_000 + "\n")
+    done = run("rosparam", "load", str(deep), env=graph)
+    assert_one_line_error(done, 1, "ERROR: invalid YAML: collections nested too deeply")
+    done = run("rosparam", "set", "/deep", "[" * 5_000 + "]" * 5_000, env=graph)
+    assert_one_line_error(done, 1, "ERROR: invalid YAML: collections nested too deeply")
+    latin = tmp_path / "latin.yaml"
+    latin.write_bytes(b"name: x\ncity: Z\xfcrich\n")
+    done = run("rosparam", "load", str(latin), env=graph)
+    assert_one_line_error(done, 1, f"ERROR: file [{latin}] is not UTF-8 text: byte 0xfc on line 2")
+    done = subprocess.run([str(BIN / "rosparam"), "load", "-"], env=graph, input=b"a: \xff\n",
+                          capture_output=True, timeout=20)
+    assert done.returncode == 1 and done.stderr.decode().splitlines() == [
+        "ERROR: stdin is not UTF-8 text: byte 0xff on line 1 (save it as UTF-8)"]
+
+
+# a small file whose value is 70 MB once its aliases are expanded
+HUGE_YAML = ("s: &s " + "x" * 10_000 + "\nm: &m [" + ", ".join(["*s"] * 100) + "]\n"
+             "big: [" + ", ".join(["*m"] * 70) + "]\n")
+
+
+def test_a_value_over_the_masters_limit_names_the_limit(graph: dict, tmp_path: Path) -> None:
+    huge = tmp_path / "huge.yaml"
+    huge.write_text(HUGE_YAML)
+    done = run("rosparam", "load", str(huge), "/huge", env=graph, timeout=60)
+    assert_one_line_error(done, 1, "refused a request of 70", "its limit of 67108864 bytes (64 MiB)")
+    code = ("import rospy\nrospy.init_node('big', anonymous=True)\n"
+            "try:\n    rospy.set_param('/big', 'x' * 70_000_000)\n"
+            "except Exception as exc:\n    print(type(exc).__name__, exc)\n")
+    done = subprocess.run([PYTHON, "-c", code], env=graph, capture_output=True, text=True,
+                          timeout=60)
+    assert done.stdout.startswith("CallRefused http://localhost:"), done.stdout + done.stderr
+    assert "its limit of 67108864 bytes (64 MiB) per XML-RPC call" in done.stdout
+    assert "not set" in run("rosparam", "get", "/big", env=graph).stderr

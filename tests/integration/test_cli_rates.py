@@ -53,6 +53,7 @@ def _last_rate(text: str) -> float:
 
 
 @pytest.mark.parametrize("kind,rate,echo_args", [("small", 1000, []), ("image", 30, ["--noarr"])])
+@pytest.mark.timing
 def test_hz_and_echo_keep_up(env: dict, kind: str, rate: int, echo_args: list) -> None:
     topic = "/fast" if kind == "small" else "/image"
     pub = Proc([PYTHON, PUB, kind, str(rate)], env)

@@ -368,3 +368,70 @@ def test_screen_flag_and_launch_prefix(tmp_path, pkg):
         proc.stop()
     line = next(ln for ln in text.splitlines() if ln.startswith("PROBE"))
     assert line.split()[3] == "prefixed"
+
+
+# A keyboard teleop's first moves: the terminal's attributes, raw mode, one key.
+KEYS_NODE = """#!/usr/bin/env python
+import os, termios, tty
+old = termios.tcgetattr(0)  # termios.error (25, 'Inappropriate ioctl') unless stdin is a tty
+tty.setraw(0)
+try:
+    os.write(1, b"KEYS ready\\r\\n")
+    key = os.read(0, 1)
+finally:
+    termios.tcsetattr(0, termios.TCSADRAIN, old)
+os.write(1, b"KEY %s\\n" % key)
+"""
+
+
+def test_nodes_read_the_terminal_roslaunch_runs_in(tmp_path, pkg):
+    """As ROS's roslaunch, nodes inherit its stdin: a teleop reads keys from the terminal."""
+    import fcntl
+    import pty
+    import select
+    import termios
+
+    (pkg / "scripts" / "keys.py").write_text(KEYS_NODE)
+    (pkg / "scripts" / "keys.py").chmod(0o755)
+    xml = """<launch>
+      <node pkg="launch_probe" type="keys.py" name="keys" output="screen" required="true"/>
+    </launch>"""
+    argv, env, _port = _launch_args(tmp_path, pkg, xml)
+    master_fd, slave_fd = pty.openpty()
+
+    def controlling_terminal() -> None:  # roslaunch as started from a shell in that terminal
+        fcntl.ioctl(0, termios.TIOCSCTTY, 0)
+
+    proc = subprocess.Popen(argv, env=env, stdin=slave_fd, stdout=slave_fd, stderr=slave_fd,
+                            start_new_session=True, preexec_fn=controlling_terminal)
+    os.close(slave_fd)
+    seen = b""
+
+    def read_until(needle: bytes, timeout: float) -> None:
+        nonlocal seen
+        deadline = time.monotonic() + timeout
+        while needle not in seen:
+            remaining = deadline - time.monotonic()
+            assert remaining > 0, f"{needle!r} not seen; terminal showed:\n{seen.decode(errors='replace')}"
+            if select.select([master_fd], [], [], remaining)[0]:
+                try:
+                    seen += os.read(master_fd, 4096)
+                except OSError:  # EIO: every process let go of the terminal
+                    break
+        assert needle in seen, seen.decode(errors="replace")
+
+    try:
+        read_until(b"KEYS ready", 30)
+        os.write(master_fd, b"k")
+        read_until(b"KEY k", 10)
+        assert proc.wait(30) == 0  # the required node finished: roslaunch ends
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGINT)
+            try:
+                proc.wait(20)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait(5)
+        os.close(master_fd)
+    assert b"Inappropriate ioctl" not in seen

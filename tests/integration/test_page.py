@@ -454,6 +454,7 @@ def test_console_filters_by_level_and_regex(page):
     page.shot("console")
 
 
+@pytest.mark.timing
 def test_console_takes_20000_lines_without_freezing(page, system):
     page.open("console")
     page.js("""window.frameGaps = []; (() => { let last = performance.now();

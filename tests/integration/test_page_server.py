@@ -84,3 +84,62 @@ def test_the_page_session_plots_a_real_topic(minros_core, ros_home):
         pub.stop()
         out = web.stop()
     assert "Traceback" not in out
+
+
+def test_a_dynamic_reconfigure_client_shares_a_topic_a_client_taps(minros_core, ros_home):
+    """The web node's taps live outside its Subscribers (one receive thread for all): when the
+    page's dynamic_reconfigure client subscribes to parameter_updates that a rosbridge client
+    already taps, the tap moves to a Subscriber they share, and keeps delivering."""
+    web, port = start_web(minros_core, ros_home)
+    try:
+        with connect(f"ws://127.0.0.1:{port}/", open_timeout=10) as bridge, \
+                connect(f"ws://127.0.0.1:{port}/", subprotocols=[PAGE], open_timeout=10) as page:
+            json.loads(page.recv(timeout=10))  # hello
+            # a fake server: set_parameters through rosbridge, updates published by it too
+            bridge.send(json.dumps({"op": "advertise_service", "service": "/fakedyn/set_parameters",
+                                    "type": "dynamic_reconfigure/Reconfigure"}))
+            bridge.send(json.dumps({"op": "advertise", "topic": "/fakedyn/parameter_updates",
+                                    "type": "dynamic_reconfigure/Config", "latch": True}))
+            bridge.send(json.dumps({"op": "advertise", "topic": "/fakedyn/parameter_descriptions",
+                                    "type": "dynamic_reconfigure/ConfigDescription",
+                                    "latch": True}))
+            bridge.send(json.dumps({"op": "publish", "topic": "/fakedyn/parameter_descriptions",
+                                    "latch": True, "msg": {"groups": [{
+                                        "name": "Default", "type": "", "id": 0, "parent": 0,
+                                        "parameters": [{"name": "n", "type": "int", "level": 0,
+                                                        "description": "", "edit_method": ""}]}],
+                                        "max": {"ints": [{"name": "n", "value": 9}]},
+                                        "min": {"ints": [{"name": "n", "value": 0}]},
+                                        "dflt": {"ints": [{"name": "n", "value": 1}]}}}))
+            bridge.send(json.dumps({"op": "subscribe", "topic": "/fakedyn/parameter_updates",
+                                    "type": "dynamic_reconfigure/Config"}))
+
+            def update(value: int) -> dict:
+                bridge.send(json.dumps({"op": "publish", "topic": "/fakedyn/parameter_updates",
+                                        "msg": {"ints": [{"name": "n", "value": value}]}}))
+                return frames_until(bridge, lambda m: m.get("op") == "publish", 1)
+
+            deadline = time.monotonic() + 15
+            while True:  # until the tap is connected to our own publisher
+                try:
+                    got = update(1)
+                    break
+                except (AssertionError, TimeoutError):
+                    assert time.monotonic() < deadline, "the tap never delivered"
+            assert got["msg"]["ints"] == [{"name": "n", "value": 1}]
+            page.send(json.dumps({"op": "dynrec_get", "id": "d", "server": "/fakedyn"}))
+            reply = frames_until(page, lambda m: m.get("id") == "d", 20)
+            # the page's client got the fake server's description and configuration
+            assert reply.get("config") == {"n": 1}, reply
+            deadline = time.monotonic() + 15
+            while True:  # the tap, now a shared Subscriber, delivers again
+                try:
+                    got = update(2)
+                    if got["msg"]["ints"] == [{"name": "n", "value": 2}]:
+                        break
+                except (AssertionError, TimeoutError):
+                    pass
+                assert time.monotonic() < deadline, "the tap stopped delivering"
+    finally:
+        out = web.stop()
+    assert "Traceback" not in out

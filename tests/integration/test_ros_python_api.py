@@ -136,6 +136,141 @@ def test_tool_apis_answer_as_debians_on_the_same_graph(chatter_graph) -> None:
     assert result == json.loads(theirs.stdout.strip().splitlines()[-1])
 
 
+# the tools' internals real code calls (rostopic._get_topic_type to find an action's type,
+# ROSTopicBandwidth in monitors, create_publisher, rosnode's descriptions and clean-up,
+# rosservice_find, ...); run by both interpreters against the same graph, one JSON line
+INTERNALS_SCRIPT = r'''
+import contextlib, io, json, os, sys, tempfile, time
+import rosgraph, rosnode, rosparam, rospy, rosservice, rostopic, yaml
+
+def printed(fn, *args, **kwds):
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        fn(*args, **kwds)
+    return out.getvalue()
+
+out = {}
+master = rosgraph.Master("/internals")
+rostopic._check_master()
+out["_get_topic_type"] = list(rostopic._get_topic_type("/chatter/data")[:2])
+out["_master_get_topic_types"] = ["/chatter", "std_msgs/String"] in [
+    list(x) for x in rostopic._master_get_topic_types(master)]
+pubs, subs = rostopic.get_topic_list()
+out["get_topic_list"] = [list(p) for p in pubs if p[0] == "/chatter"]
+out["find_by_type"] = "/chatter" in rostopic.find_by_type("std_msgs/String")
+uri = master.lookupNode("/chatter_pub")
+out["get_api"] = [rostopic.get_api(master, "/chatter_pub") == uri,
+                  rostopic.get_api(master, "/nobody")]
+path = os.path.join(tempfile.mkdtemp(), "msgs.yaml")
+with open(path, "w") as f:
+    f.write("data: a\n---\ndata: b\n")
+out["file_yaml_arg"] = list(rostopic.file_yaml_arg(path)())
+from std_msgs.msg import Header, String
+import genpy
+out["value_transform"] = genpy.message.strify_message(
+    rostopic.create_value_transform(True, False)(String("abc")))
+out["field_filter"] = list(rostopic.create_field_filter(False, True)(Header()))
+echo = rostopic.CallbackEcho("/chatter", None, count=2)
+out["echo"] = printed(echo.callback, String("hi"), {"topic": "/chatter"})
+out["echo_other_topic"] = printed(echo.callback, String("no"), {"topic": "/other"})
+printed(echo.callback, String("two"), {"topic": "/chatter"})
+out["echo_done"] = [echo.count, echo.done]
+field = rostopic.CallbackEcho("/chatter/data", None)
+out["echo_field"] = printed(field.callback, String("hi"), {"topic": "/chatter"})
+plot = rostopic.CallbackEcho("/chatter", None, plot=True)
+out["echo_plot"] = printed(plot.callback, String("hi"), {"topic": "/chatter"},
+                           current_time=rospy.Time(5))
+try:
+    rostopic.create_publisher("/api_pub", "nope_msgs/Nope", True)
+except rostopic.ROSTopicException as exc:
+    out["create_publisher_error"] = str(exc)
+pub, msg_class = rostopic.create_publisher("/api_pub", "std_msgs/String", True)
+out["create_publisher"] = [pub.resolved_name, msg_class._type]
+out["publish_message"] = printed(rostopic.publish_message, pub, msg_class,
+                                 [{"data": "latched"}], once=True)
+got = rospy.wait_for_message("/api_pub", String, timeout=10)
+out["latched"] = got.data
+try:
+    rostopic.publish_message(pub, msg_class, [{"nope": 1}], once=True)
+except rostopic.ROSTopicException as exc:
+    out["publish_error"] = type(exc).__name__
+try:
+    rostopic.param_publish_once(pub, msg_class, "/no_such_param", False)
+except rostopic.ROSTopicException as exc:
+    out["param_publish_error"] = str(exc)
+bw = rostopic.ROSTopicBandwidth(window_size=5)
+sub = rospy.Subscriber("/chatter", rospy.AnyMsg, bw.callback)
+deadline = time.time() + 10
+while len(bw.sizes) < 7 and time.time() < deadline:
+    time.sleep(0.05)
+sub.unregister()
+out["bw_sizes"] = bw.sizes
+out["bw_text"] = printed(bw.print_bw).split("/s")[0].startswith("average: ")
+out["node_info"] = rosnode.get_node_info_description("/chatter_pub")
+out["listnodes"] = printed(rosnode.rosnode_listnodes, namespace="/chatter_pub")
+out["listnodes_uri"] = printed(rosnode.rosnode_listnodes, namespace="/chatter_pub", list_uri=True) == uri + "\n"
+state = master.getSystemState()
+out["lookup_uri"] = rosnode.lookup_uri(master, state, "/chatter", uri) == "/chatter_pub (%s)" % uri
+conn = rosnode.get_node_connection_info_description(uri, master)
+out["connection_info"] = [conn.startswith("Pid: "), " * topic: /rosout\n" in conn]
+out["machines"] = "localhost" in rosnode.get_machines_by_nodes()
+out["nodes_by_machine"] = "/chatter_pub" in rosnode.get_nodes_by_machine("localhost")
+try:
+    rosnode.get_nodes_by_machine("no-such-host.invalid")
+except rosnode.ROSNodeException as exc:
+    out["machine_error"] = str(exc)
+out["rosnode_info_quiet"] = printed(rosnode.rosnode_info, "/chatter_pub", quiet=True)
+out["debugnode"] = rosnode.rosnode_debugnode is rosnode.rosnode_info
+ghost = rosgraph.Master("/ghost")
+ghost.registerPublisher("/ghost_topic", "std_msgs/String", "http://localhost:9/")
+printed(rosnode.cleanup_master_blacklist, master, ["/ghost"])
+out["cleanup_blacklist"] = "/ghost_topic" in [t for t, _ in master.getSystemState()[0]]
+out["has_service_args"] = [rosservice.has_service_args("/chatter_pub/get_loggers"),
+                           rosservice.has_service_args("/chatter_pub/set_logger_level")]
+out["rosservice_find"] = [s for s in rosservice.rosservice_find("roscpp/GetLoggers")
+                          if s.startswith("/chatter_pub")]
+out["param_server"] = rosparam.get_param_server().getParam("/run_id") == master.getParam("/run_id")
+out["load_str"] = rosparam.load_str("a: 1\n---\n_ns: sub\nb: rad(pi)\n", "x.yaml",
+                                    default_namespace="/ns")
+class Loader(yaml.SafeLoader):
+    pass
+Loader.add_constructor("!degrees", rosparam.construct_angle_degrees)
+Loader.add_constructor("!radians", rosparam.construct_angle_radians)
+Loader.add_constructor("tag:yaml.org,2002:binary", rosparam.construct_yaml_binary)
+loaded = yaml.load("a: !degrees 90\nb: !radians pi/2\nc: !!binary YWJj\n", Loader=Loader)
+out["angles"] = [loaded["a"], loaded["b"], loaded["c"].data.decode()]
+out["print_params"] = printed(rosparam.print_params, {"a": {"b": 1}, "c": "x"}, "/ns")
+out["names"] = [rosparam.ns_join("/a", "b"), rosparam.GLOBALNS, rosparam.NS, rostopic.NAME,
+                rosnode.ID, rosservice.NAME, rostopic.SUBSCRIBER_TIMEOUT]
+print(json.dumps(out, sort_keys=True))
+'''
+
+
+def test_tool_internals_answer_as_debians(chatter_graph) -> None:
+    """The helpers inside rostopic, rosnode, rosparam and rosservice that code calls directly
+    give Debian's answers on the same graph."""
+    _port, env = chatter_graph
+    ours = subprocess.run([PYTHON, "-c", INTERNALS_SCRIPT], env=env, capture_output=True,
+                          text=True, timeout=90)
+    assert ours.returncode == 0, ours.stderr
+    result = json.loads(ours.stdout.strip().splitlines()[-1])
+    assert result["_get_topic_type"] == ["std_msgs/String", "/chatter"]
+    assert result["get_topic_list"] == [["/chatter", "std_msgs/String", ["/chatter_pub"]]]
+    assert result["echo"] == 'data: "hi"\n---\n' and result["echo_other_topic"] == ""
+    assert result["echo_done"] == [2, True]
+    assert result["echo_plot"] == "%time,field.data\n5000000000,hi\n"
+    assert result["latched"] == "latched"
+    assert result["bw_sizes"] == [9] * 5  # window 5 of 4-byte length + "hello"
+    assert result["cleanup_blacklist"] is False
+    assert result["has_service_args"] == [False, True]
+    assert result["angles"][2] == "abc"
+    require_reference()
+    theirs = subprocess.run([REFERENCE_PYTHON, "-c", INTERNALS_SCRIPT], env=reference_env(env),
+                            capture_output=True, text=True, timeout=90)
+    assert theirs.returncode == 0, theirs.stderr
+    assert result == json.loads(theirs.stdout.strip().splitlines()[-1])
+
+
 ROSLAUNCH_SCRIPT = r'''
 import sys, time
 import roslaunch, rosnode

@@ -129,6 +129,33 @@ def test_rospack_find_and_list(tmp_path, pkg_path):
     assert missing.returncode == 1 and missing.stderr == "[rospack] Error: package 'ghost_pkg' not found\n"
 
 
+#: packages minros provides and their versions, which are Debian's ROS's
+PROVIDED = {"roslaunch": "1.15.15", "rospy": "1.15.15", "rosbag": "1.15.15", "roslib": "1.15.8",
+            "genpy": "0.6.16", "tf": "1.13.2", "actionlib": "1.14.0", "turtlesim": "0.10.2",
+            "diagnostic_updater": "1.11.0", "cv_bridge": "1.16.2"}
+
+
+def test_rosversion_and_rospack_know_the_packages_minros_provides(tmp_path):
+    env = ros_env(None, tmp_path / "home")  # no ROS_PACKAGE_PATH at all
+    for package, version in PROVIDED.items():
+        out = _run(["rosversion", package], env)
+        assert (out.returncode, out.stdout) == (0, f"{version}\n"), (package, out.stderr)
+        found = _run(["rospack", "find", package], env)
+        assert found.returncode == 0 and (Path(found.stdout.strip()) / "package.xml").is_file()
+    assert _run(["rosversion", "-d"], env).stdout == "noetic\n"
+    assert _run(["rosversion", "-d"], dict(env, ROS_DISTRO="melodic")).stdout == "melodic\n"
+    assert _run(["rosversion", "-s", "rosbag"], env).stdout == "1.15.15"
+    missing = _run(["rosversion", "nope_pkg"], env)
+    assert (missing.returncode, missing.stdout) == (1, "Cannot locate [nope_pkg]\n")
+    usage = _run(["rosversion"], env)
+    assert usage.returncode == 2 and "one of the arguments package -d/--distro -a/--all" in usage.stderr
+    listed = _run(["rosversion", "-a"], env).stdout.splitlines()
+    assert "roslaunch: 1.15.15" in listed and "std_msgs: 0.5.13" in listed
+    loaded = _run(["python", "-c", "import roslib; roslib.load_manifest('rosbag'); "
+                   "roslib.load_manifest('geometry_msgs'); print('loaded')"], env)
+    assert loaded.stdout == "loaded\n", loaded.stderr
+
+
 def test_catkin_commands_as_processes(tmp_path):
     env = dict(os.environ)
     ws = tmp_path / "ws"

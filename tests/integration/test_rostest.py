@@ -28,8 +28,20 @@ def _suite(path: Path) -> ET.Element:
 def test_rostest_runs_rospy_nodes_and_unittest_checks(ros_home: Path) -> None:
     out = _rostest(ros_home, "rostest_demo", "counter.test")
     assert out.returncode == 0, out.stdout + out.stderr
-    assert " * RESULT: SUCCESS" in out.stdout
-    assert " * TESTS: 3" in out.stdout
+    results = ros_home / "test_results" / "rostest_demo"
+    # what ROS's rostest prints (the launch's own messages go to the log file)
+    log = next((ros_home / "log").glob("rostest-*.log"))
+    assert out.stdout == (
+        f"... logging to {log}\n"
+        f"[ROSUNIT] Outputting test results to {results / 'rostest-test_counter.xml'}\n"
+        "[Testcase: testtest_counter] ... ok\n\n"
+        "[ROSTEST]" + "-" * 71 + "\n\n"
+        "[rostest_demo.rosunit-test_counter/test_counts_up_from_start][passed]\n"
+        "[rostest_demo.rosunit-test_counter/test_graph][passed]\n"
+        "[rostest_demo.rosunit-test_counter/test_parameter_from_launch_file][passed]\n\n"
+        "SUMMARY\n\033[32m * RESULT: SUCCESS\033[0m\n * TESTS: 3\n * ERRORS: 0\n * FAILURES: 0\n\n"
+        f"rostest log file is in {log}\n")
+    assert "process[counter-1]: started with pid" in log.read_text()
     results = ros_home / "test_results" / "rostest_demo"
     node = _suite(results / "rosunit-test_counter.xml")
     assert (node.get("tests"), node.get("failures"), node.get("errors")) == ("3", "0", "0")
@@ -41,9 +53,11 @@ def test_rostest_runs_rospy_nodes_and_unittest_checks(ros_home: Path) -> None:
 
 def test_rostest_by_path_reports_a_failing_check(ros_home: Path) -> None:
     out = _rostest(ros_home, str(PKGS / "rostest_demo" / "test" / "fails.test"))
-    assert out.returncode == 1, out.stdout + out.stderr
-    assert " * RESULT: FAIL" in out.stdout
-    assert "[__main__.TestFails/test_wrong][FAILURE]" in out.stdout
+    assert out.returncode == 2, out.stdout + out.stderr  # rostest's status for failed checks
+    assert "\033[1;31m * RESULT: FAIL\033[0m\n" in out.stdout
+    head = "[rostest_demo.rosunit-test_fails/test_wrong][FAILURE]"
+    assert f"\n{head}{'-' * (80 - len(head))}\nTraceback" in out.stdout
+    assert "AssertionError: 42 != 41\n" + "-" * 80 + "\n" in out.stdout
     node = _suite(ros_home / "test_results" / "rostest_demo" / "rosunit-test_fails.xml")
     assert node.get("failures") == "1"
     failure = next(node.iter("failure"))
@@ -54,12 +68,15 @@ def test_text_mode_prints_the_cases(ros_home: Path) -> None:
     out = _rostest(ros_home, "--text", "rostest_demo", "counter.test")
     assert out.returncode == 0, out.stdout + out.stderr
     assert "test_graph (__main__.TestCounter" in out.stderr + out.stdout
+    # as ROS's: no summary, which the cases printed as text cannot give
+    assert "WARNING: overall test result is not accurate when --text is enabled\n" in out.stdout
+    assert "SUMMARY" not in out.stdout
 
 
 def test_broken_test_entry_is_one_clear_error(ros_home: Path) -> None:
     out = _rostest(ros_home, "rostest_demo", "broken.test")
     assert out.returncode == 1
-    assert out.stdout == ""
+    assert out.stdout == f"... logging to {next((ros_home / 'log').glob('rostest-*.log'))}\n"
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1, out.stderr
     assert "broken.test:2: <test> tag is missing required attribute 'test-name'" in lines[0]
@@ -71,6 +88,11 @@ def test_a_test_that_writes_no_results_fails(ros_home: Path, tmp_path: Path) -> 
     test_file.write_text('<launch><test test-name="silent" pkg="rostest_demo" type="counter.py" '
                          'time-limit="2"/></launch>')
     out = _rostest(ros_home, str(test_file))
-    assert out.returncode == 1
+    assert out.returncode == 1  # rostest's status for a test that did not run properly
     assert "test [silent] timed out after 2 s" in out.stderr
-    assert " * FAILURES: 1" in out.stdout
+    assert ("[Testcase: testsilent] ... FAILURE!\nFAILURE: test [silent] timed out after 2 s\n"
+            + "-" * 80 + "\n") in out.stdout
+    assert "[testsilent][failed]\n" in out.stdout
+    assert "\033[1;31m * FAILURES: 1\033[0m" in out.stdout
+    assert out.stdout.endswith(" * testsilent\n\nrostest log file is in "
+                               f"{next((ros_home / 'log').glob('rostest-*.log'))}\n")

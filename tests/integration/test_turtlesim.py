@@ -222,6 +222,7 @@ def _read_xwd(path: Path) -> np.ndarray:
     return rows.reshape(height, bytes_per_line)[:, :width * 4].reshape(height, width, 4)[:, :, :3]
 
 
+@pytest.mark.timing
 def test_window_on_a_virtual_display(minros_core, ros_home, tmp_path):
     if not shutil.which("Xvfb"):
         if IN_CI:  # scripts/install-ros-reference.sh installs it for exactly this test

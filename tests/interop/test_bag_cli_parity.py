@@ -147,3 +147,151 @@ def test_check_and_usage_like_debian(bagdir):
                  ["bag", "record", "-o", "a", "-O", "b", "/x"], ["bag", "record", "--split", "/x"]):
         ours, theirs = both(bagdir, *argv)
         assert (ours.returncode, ours.stdout, ours.stderr) == (theirs.returncode, theirs.stdout, theirs.stderr), argv
+
+
+# a bag recorded under older definitions: std_msgs/ColorRGBA without its alpha, alone and
+# inside visualization_msgs/Marker (so that Marker's md5 sum differs too), and a current type
+OLD_BAG = r'''
+import io, sys
+from minros.bag import Bag
+from minros.msgs import Time, generate_dynamic, get_message_class
+marker = get_message_class("visualization_msgs/Marker")
+old_marker_text = marker._full_text.replace("float32 r\nfloat32 g\nfloat32 b\nfloat32 a",
+                                            "float32 r\nfloat32 g\nfloat32 b")
+color_text = "float32 r\nfloat32 g\nfloat32 b\n"
+OldMarker = generate_dynamic(marker._type, old_marker_text)[marker._type]
+OldColor = generate_dynamic("std_msgs/ColorRGBA", color_text)["std_msgs/ColorRGBA"]
+String = get_message_class("std_msgs/String")
+
+def write(bag, topic, m, text, t):
+    buff = io.BytesIO()
+    m.serialize(buff)
+    bag.write(topic, (m._type, buff.getvalue(), m._md5sum, None, type(m)), t, raw=True,
+              connection_header={"type": m._type, "md5sum": m._md5sum, "topic": topic,
+                                 "message_definition": text, "callerid": "/old"})
+
+with Bag(sys.argv[1], "w") as bag:
+    for i in range(3):
+        t = Time(10 + i, 0)
+        write(bag, "/color", OldColor(r=0.25 * i, g=0.5, b=1.0), color_text, t)
+        m = OldMarker(ns="n", id=i)
+        m.color.r = 0.25
+        m.colors = [OldColor(r=1.0, g=0.0, b=0.5)] * (i + 1)
+        write(bag, "/marker", m, old_marker_text, t)
+        bag.write("/chatter", String(data="hi %d" % i), t)
+'''
+
+READ_BAG = r'''
+import json, sys, rosbag
+out = []
+with rosbag.Bag(sys.argv[1]) as b:
+    for topic, m, t in b.read_messages():
+        colors = [[c.r, c.g, c.b, c.a] for c in getattr(m, "colors", [])]
+        color = getattr(m, "color", m if m._type == "std_msgs/ColorRGBA" else None)
+        out.append([topic, m._type, m._md5sum, t.to_nsec(), getattr(m, "data", None), colors,
+                    [color.r, color.g, color.b, color.a] if color is not None else None])
+print(json.dumps(out))
+'''
+
+
+def _classes(text: str) -> set:
+    """The rule classes of a rule file (Debian's check writes a rule once per path needing it)."""
+    return {"class " + block for block in text.split("class ")[1:]}
+
+
+def test_check_and_fix_migrate_old_definitions_like_debian(tmp_path):
+    """rosbag check lists the migrations an old bag needs and the rules missing, -g writes
+    the rules to complete (the same text as Debian's), and once completed, check says the bag
+    is ready and fix writes the bag Debian's fix writes."""
+    require_reference()
+    made = subprocess.run([PYTHON, "-c", OLD_BAG, str(tmp_path / "old.bag")], capture_output=True,
+                          text=True, timeout=60)
+    assert made.returncode == 0, made.stderr
+    ours, theirs = both(tmp_path, "bag", "check", "-n", "old.bag")
+    assert (ours.returncode, ours.stdout, ours.stderr) == (theirs.returncode, theirs.stdout, theirs.stderr)
+    assert "To generate rules, please run with -g <rulefile>" in ours.stdout
+    assert ours.stdout.count("1 rules missing:") == 2  # ColorRGBA, and Marker through it
+    for minros, name in ((True, "ours.bmr"), (False, "debian.bmr")):
+        run = _run(minros, "bag", "check", "old.bag", "-n", "-g", name, cwd=tmp_path)
+        assert run.returncode == 0, run.stderr
+        assert run.stdout.endswith(f"\nThe necessary rule files have been written to: {name}\n")
+    ours, theirs = both(tmp_path, "bag", "check", "old.bag", "-n", "-g", "ours.bmr")
+    assert (ours.returncode, ours.stderr) == (theirs.returncode, theirs.stderr) == (2, theirs.stderr)
+    rules, debian_rules = (tmp_path / "ours.bmr").read_text(), (tmp_path / "debian.bmr").read_text()
+    assert _classes(rules) == _classes(debian_rules) and len(_classes(rules)) == 1
+    assert "#No matching field name in old message\n\t\tnew_msg.a = 0.\n" in rules
+    # a person completes the rule: alpha 1, and valid
+    (tmp_path / "done.bmr").write_text(rules.replace("valid = False", "valid = True")
+                                       .replace("new_msg.a = 0.", "new_msg.a = 1.0"))
+    ours, theirs = both(tmp_path, "bag", "check", "-n", "old.bag", "done.bmr")
+    assert (ours.returncode, ours.stdout) == (theirs.returncode, theirs.stdout)
+    assert ours.stdout.endswith("\nAll rules defined.  Bag is ready to be migrated\n")
+    fixed = {}
+    for minros, name in ((True, "fixed-ours.bag"), (False, "fixed-debian.bag")):
+        run = _run(minros, "bag", "fix", "-n", "old.bag", name, "done.bmr", cwd=tmp_path)
+        assert (run.returncode, run.stdout) == (0, "Bag migrated successfully.\n"), run.stderr
+        read = subprocess.run([REFERENCE_PYTHON, "-c", READ_BAG, str(tmp_path / name)],
+                              env=reference_env({}), capture_output=True, text=True, timeout=60)
+        assert read.returncode == 0, read.stderr
+        fixed[name] = read.stdout
+    assert fixed["fixed-ours.bag"] == fixed["fixed-debian.bag"]
+    assert '"std_msgs/ColorRGBA", "a29a96539573343b1310c73607334b00"' in fixed["fixed-ours.bag"]
+    assert "[1.0, 0.0, 0.5, 1.0]" in fixed["fixed-ours.bag"]  # inside Marker.colors too
+    # without the rules, fix refuses and leaves no bag
+    ours, theirs = both(tmp_path, "bag", "fix", "-n", "old.bag", "none.bag")
+    assert (ours.returncode, ours.stdout) == (theirs.returncode, theirs.stdout) == (1, theirs.stdout)
+    assert not (tmp_path / "none.bag.tmp").exists()
+
+
+ROSBAG_MAIN = r'''
+import contextlib, io, json, os, shutil, sys
+from rosbag import Bag, Compression
+from rosbag import rosbag_main as rm
+folder, source = sys.argv[1], sys.argv[2]
+out = {}
+text = io.StringIO()
+with contextlib.redirect_stdout(text):
+    cmds = rm.RosbagCmds()
+    cmds.add_cmd("info", rm.info_cmd, "Summarize the contents of one or more bag files.")
+    cmds.help_cmd([])
+out["help"] = text.getvalue()
+out["valid"] = cmds.get_valid_cmds()
+bag = os.path.join(folder, "a.bag")
+shutil.copy(source, bag)
+compress = lambda inbag, outbag, quiet: rm.change_compression_op(inbag, outbag, Compression.BZ2, quiet)
+rm.bag_op([bag], False, True, lambda b: False, compress, None, False, True)
+with Bag(bag) as b:
+    out["compressed"] = [b.get_compression_info().compression, b.get_message_count()]
+out["backup"] = os.path.exists(os.path.join(folder, "a.orig.bag"))
+os.makedirs(os.path.join(folder, "o"))
+rm.bag_op([bag], True, True, lambda b: b.version > 102,
+          lambda i, o, quiet: rm.reindex_op(i, o, quiet), os.path.join(folder, "o"), False, True)
+with Bag(os.path.join(folder, "o", "a.bag")) as b:
+    out["reindexed"] = [b.get_message_count(), b.get_compression_info().compression]
+from rosbag import migration as mg
+out["names"] = [[mg.clean_name(n, top), mg.qualified_name(n, top)] for n, top in (
+    ("std_msgs/Header", "pkg/T"), ("pkg/Sub", "pkg/T"), ("Sub", "pkg/T"), ("Header", "a/B"),
+    ("other/X", "pkg/T"), ("float64", "pkg/T"))]
+out["defaults"] = [mg.migration_default_value(t) for t in (
+    "int8", "float32", "string", "uint8[]", "uint8[4]", "int32[]", "float64[3]", "bool",
+    "geometry_msgs/Point", "Header")]
+out["constants"] = sorted(map(list, mg.constants_from_def(
+    "p/T", "int32 A=1\nstring S=hi\nfloat64 x\n" + "=" * 80 + "\nMSG: p/U\nint8 B=2\n")))
+out["keys"] = [mg.get_message_key(Bag), mg.get_path_key(Bag, Bag)]
+print(json.dumps(out, sort_keys=True))
+'''
+
+
+def test_rosbag_main_api_like_debian(bagdir, tmp_path):
+    """rosbag.rosbag_main's pieces (the command table and its help, bag_op with
+    change_compression_op and reindex_op) do to a bag what Debian's do."""
+    results = []
+    for python, env in ((PYTHON, dict(os.environ)), (REFERENCE_PYTHON, reference_env({}))):
+        folder = tmp_path / Path(python).name
+        folder.mkdir()
+        run = subprocess.run([python, "-c", ROSBAG_MAIN, str(folder), str(bagdir / "deb.bag")],
+                             env=env, capture_output=True, text=True, timeout=60)
+        assert run.returncode == 0, run.stderr
+        results.append(run.stdout)
+    assert results[0] == results[1]
+    assert '"compressed": ["bz2", 254]' in results[0]

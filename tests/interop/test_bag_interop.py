@@ -309,3 +309,135 @@ def test_full_disk_keeps_what_was_written(debian_rosmaster, ros_home, tmp_path):
     assert len(errors) == 1 and "File too large" in errors[0] and "full.bag" in errors[0], output
     info = debian_rosbag(debian_rosmaster, ros_home, tmp_path, "info", "-y", "-k", "messages", "full.bag")
     assert info.returncode == 0 and int(info.stdout) >= 3, info.stdout + info.stderr
+
+
+def _chunk_frames(path: Path) -> List[tuple]:
+    """(compression, uncompressed size, data) of each CHUNK record of a bag v2.0 file, read
+    with nothing but struct: a second opinion on the layout, independent of minros."""
+    import struct
+
+    raw = path.read_bytes()
+    assert raw.startswith(b"#ROSBAG V2.0\n")
+    pos, out = 13, []
+    while pos < len(raw):
+        (hlen,) = struct.unpack_from("<I", raw, pos)
+        fields, at = {}, pos + 4
+        while at < pos + 4 + hlen:
+            (flen,) = struct.unpack_from("<I", raw, at)
+            name, _, value = raw[at + 4:at + 4 + flen].partition(b"=")
+            fields[name] = value
+            at += 4 + flen
+        (dlen,) = struct.unpack_from("<I", raw, at)
+        if fields[b"op"] == b"\x05":
+            out.append((fields[b"compression"].decode(), struct.unpack("<I", fields[b"size"])[0],
+                        raw[at + 4:at + 4 + dlen]))
+        pos = at + 4 + dlen
+    return out
+
+
+def _debian_roslz4(frames: List[bytes], tmp_path: Path) -> List[int]:
+    """Sizes Debian's roslz4.decompress gives for each frame."""
+    paths = []
+    for i, frame in enumerate(frames):
+        (tmp_path / f"frame{i}.lz4").write_bytes(frame)
+        paths.append(str(tmp_path / f"frame{i}.lz4"))
+    code = ("import sys, roslz4\n"
+            "print([len(roslz4.decompress(open(p, 'rb').read())) for p in sys.argv[1:]])\n")
+    result = subprocess.run([REFERENCE_PYTHON, "-c", code, *paths], env=reference_env({}),
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+def test_lz4_image_bag_multi_block_chunks_read_by_debian(debian_rosmaster, ros_home, tmp_path):
+    """`rosbag record --lz4` of 1080p images: each chunk is an LZ4 frame of several 1 MB blocks,
+    which Debian's rosbag (info, check, rosbag.Bag) and roslz4 itself decompress."""
+    require_reference()
+    script = tmp_path / "talker.py"
+    script.write_text(TALKER)
+    talker = Proc([PYTHON, str(script), "/cam", "image", "100000", "5", "0"],
+                  _env(debian_rosmaster, ros_home))
+    try:
+        result = minros_bag(debian_rosmaster, ros_home, tmp_path, "record", "--lz4", "-l", "3",
+                            "-O", "img", "/cam")
+    finally:
+        talker.stop()
+    assert result.returncode == 0, result.stdout + result.stderr
+    frames = _chunk_frames(tmp_path / "img.bag")
+    assert frames and all(c == "lz4" for c, _n, _d in frames)
+    assert max(n for _c, n, _d in frames) > 3 << 20  # more than three of roslz4's 1 MB blocks
+    assert _debian_roslz4([d for _c, _n, d in frames], tmp_path) == [n for _c, n, _d in frames]
+    info = debian_rosbag(debian_rosmaster, ros_home, tmp_path, "info", "img.bag")
+    assert info.returncode == 0, info.stderr
+    assert re.search(r"^compression:\s+lz4", info.stdout, re.M), info.stdout
+    assert re.search(r"/cam\s+3 msgs\s+: sensor_msgs/Image", info.stdout), info.stdout
+    check = debian_rosbag(debian_rosmaster, ros_home, tmp_path, "check", "img.bag")
+    assert check.returncode == 0 and "does not need any migrations" in check.stdout, check.stderr
+    code = ("import sys, json, rosbag\n"
+            "out = []\n"
+            "for _t, m, _s in rosbag.Bag(sys.argv[1]).read_messages():\n"
+            "    out.append([m.width, m.height, len(m.data), len(set(m.data))])\n"
+            "print(json.dumps(out))\n")
+    read = subprocess.run([REFERENCE_PYTHON, "-c", code, str(tmp_path / "img.bag")],
+                          env=reference_env({}), capture_output=True, text=True, timeout=60)
+    assert read.returncode == 0, read.stderr
+    assert json.loads(read.stdout) == [[1920, 1080, 1920 * 1080 * 3, 1]] * 3
+
+
+def debian_read_images(path: Path) -> List[list]:
+    code = ("import sys, json, rosbag\n"
+            "print(json.dumps([[len(m.data), t.secs] for _t, m, t in rosbag.Bag(sys.argv[1]).read_messages()]))\n")
+    result = subprocess.run([REFERENCE_PYTHON, "-c", code, str(path)], env=reference_env({}),
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+def test_lz4_bag_api_multi_block_chunks_read_by_debian(tmp_path):
+    """The Bag API's lz4 compression, chunks of 4 MB of varied bytes, read back by Debian."""
+    require_reference()
+    _write_bag(tmp_path / "api.bag", (
+        "import sys, random\nfrom sensor_msgs.msg import Image\n"
+        "rng = random.Random(7)\n"
+        "with Bag(sys.argv[1], 'w', compression='lz4', chunk_threshold=4 << 20) as b:\n"
+        "    for i in range(6):\n"
+        "        data = bytes(rng.getrandbits(8) for _ in range(4096)) * 400\n"
+        "        b.write('/img', Image(width=len(data), height=1, encoding='mono8', step=len(data),\n"
+        "                              data=data), minros.Time(10 + i, 0))\n"))
+    frames = _chunk_frames(tmp_path / "api.bag")
+    assert len(frames) >= 2 and all(n > 2 << 20 for _c, n, _d in frames)
+    assert _debian_roslz4([d for _c, _n, d in frames], tmp_path) == [n for _c, n, _d in frames]
+    messages = debian_read_images(tmp_path / "api.bag")
+    assert messages == [[4096 * 400, 10 + i] for i in range(6)]
+
+
+
+def test_debian_appends_to_and_reindexes_minros_bags(tmp_path):
+    """Debian's rosbag rewrites the file header of a bag it appends to or reindexes, in its
+    own size (4104 bytes): minros's bags have that layout, so their first chunk survives."""
+    require_reference()
+    for name in ("a.bag", "cut.bag"):
+        _write_bag(tmp_path / name, (
+            "import sys\nfrom std_msgs.msg import String\n"
+            "with Bag(sys.argv[1], 'w', chunk_threshold=1000) as b:\n"
+            "    for i in range(200):\n"
+            "        b.write('/s', String('m%03d' % i + 'x' * 40), minros.Time(100 + i, 0))\n"))
+    code = ("import sys, rospy, rosbag\nfrom std_msgs.msg import String\n"
+            "with rosbag.Bag(sys.argv[1], 'a') as b:\n"
+            "    b.write('/s', String('m200'), rospy.Time(300, 0))\n")
+    appended = subprocess.run([REFERENCE_PYTHON, "-c", code, str(tmp_path / "a.bag")],
+                              env=reference_env({}), capture_output=True, text=True, timeout=60)
+    assert appended.returncode == 0, appended.stderr
+    assert [m[2][:4] for m in debian_read(tmp_path / "a.bag")] == [f"m{i:03d}" for i in range(201)]
+    data = (tmp_path / "cut.bag").read_bytes()
+    (tmp_path / "cut.bag").write_bytes(data[:len(data) // 2])
+    reindex = debian_rosbag(0, tmp_path, tmp_path, "reindex", "-q", "cut.bag")
+    assert reindex.returncode == 0, reindex.stderr
+    messages = debian_read(tmp_path / "cut.bag")
+    assert len(messages) >= 60 and [m[2][:4] for m in messages] == [f"m{i:03d}" for i in range(len(messages))]
+    for name in ("a.bag", "cut.bag"):  # and minros reads both
+        code = ("import sys\nfrom minros.bag import Bag\n"
+                "print(len(list(Bag(sys.argv[1]).read_messages())))\n")
+        ours = subprocess.run([PYTHON, "-c", code, str(tmp_path / name)], capture_output=True,
+                              text=True, timeout=60)
+        assert ours.returncode == 0 and int(ours.stdout) == (201 if name == "a.bag" else len(messages)), ours.stderr

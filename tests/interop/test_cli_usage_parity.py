@@ -27,7 +27,9 @@ from support import (
     wait_for_master,
 )
 
-pytestmark = pytest.mark.interop
+# the module's fixture runs about 400 tool processes (bounded by TIMEOUT each): on a loaded
+# 2-CPU machine that takes longer than one test's default limit
+pytestmark = [pytest.mark.interop, pytest.mark.timeout(900)]
 
 BIN = Path(PYTHON).parent
 TIMEOUT = 20.0

@@ -68,3 +68,18 @@ def test_ros1_reads_a_minros_updater(tmp_path: Path, debian_rosmaster: int, ros_
                                'hardware_id: "none"\nvalues: []\n---\n')
     finally:
         node.stop()
+
+
+STAR = ("import json\nfrom diagnostic_updater import *\n"
+        "print(json.dumps(sorted(k for k in dir() if not k.startswith('__') and k != 'json')))\n")
+
+
+def test_star_import_gives_what_ros1s_gives() -> None:
+    """``from diagnostic_updater import *`` then ``DiagnosticStatus.OK``, ``KeyValue(...)``, as
+    ROS's examples write it: the same names as Debian's package, messages and modules included."""
+    require_reference()
+    names = [json.loads(subprocess.run([python, "-c", STAR], env=env, capture_output=True, text=True,
+                                       timeout=60, check=True).stdout)
+             for python, env in ((PYTHON, None), (REFERENCE_PYTHON, reference_env({})))]
+    assert names[0] == names[1]
+    assert {"DiagnosticStatus", "KeyValue", "DiagnosticArray", "rospy"} <= set(names[0])

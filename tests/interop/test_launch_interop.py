@@ -191,3 +191,41 @@ def test_summary_matches_debian_roslaunch(launch_dir, debian_rosmaster):
     ours, theirs = blocks
     assert ours == theirs
     assert " * /t_yaml: {'a': [1, 2.5, 'x..." in ours  # long values cut to 20 characters
+
+
+def test_debians_roscore_starts_with_minros_tools_first_on_path(tmp_path):
+    """Debian's roscore.xml runs `rosversion roslaunch` and `rosversion -d`: with minros's venv
+    first on PATH (as after `source devel/setup.bash`) they are minros's, and roscore starts."""
+    from support import free_port, wait_for_master, wait_until
+
+    require_reference()
+    port = free_port()
+    env = reference_env(ros_env(port, tmp_path / "home"))
+    env["PATH"] = f"{BIN}:{env['PATH']}"
+    assert subprocess.run(["which", "rosversion"], env=env, capture_output=True, text=True,
+                          timeout=10).stdout.strip() == str(BIN / "rosversion")
+    core = Proc(["/usr/bin/roscore", "-p", str(port)], env)
+    try:
+        wait_for_master(port, timeout=30)
+        master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{port}/")
+        wait_until(lambda: master.getParam("/t", "/rosdistro")[0] == 1, 30, what="/rosdistro set")
+        assert master.getParam("/t", "/rosversion")[2] == "1.15.15\n"
+        assert master.getParam("/t", "/rosdistro")[2] == "noetic\n"
+        wait_until(lambda: master.lookupNode("/t", "/rosout")[0] == 1, 30, what="rosout up")
+    finally:
+        text = core.stop()
+    assert "RLException" not in text and "Invalid <param> tag" not in text, text
+
+
+def test_provided_packages_carry_debians_versions():
+    """Every package minros provides that Debian installs has Debian's version."""
+    from minros import packages
+
+    require_reference()
+    compared = 0
+    for name, folder in sorted(packages.list_packages(refresh=True).items()):
+        debian = Path("/usr/share") / name / "package.xml"
+        if packages.is_builtin(folder) and debian.is_file():
+            assert packages.manifest_version(folder) == packages.manifest_version(debian.parent), name
+            compared += 1
+    assert compared >= 30

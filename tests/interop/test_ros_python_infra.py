@@ -14,18 +14,17 @@ from pathlib import Path
 from typing import Any, Dict, List
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from minros.msgs.testing import bundled_services, bundled_types
-from support import PYTHON, REFERENCE_PYTHON, reference_env, require_reference
+from support import PYTHON, REFERENCE_PYTHON, debian_has_messages, reference_env, require_reference
 
 pytestmark = pytest.mark.interop
 
-NOT_IN_DEBIAN = ("turtlesim/", "rospy_tutorials/", "rosapi/")
-DEBIAN_TYPES = [t for t in bundled_types() if not t.startswith(NOT_IN_DEBIAN)
+DEBIAN_TYPES = [t for t in bundled_types() if debian_has_messages(t.split("/")[0])
                 and not t.endswith(("Request", "Response"))]
-DEBIAN_SERVICES = [t for t in bundled_services() if not t.startswith(NOT_IN_DEBIAN)]
+DEBIAN_SERVICES = [t for t in bundled_services() if debian_has_messages(t.split("/")[0])]
 
 # One long-lived /usr/bin/python3 answering calls into Debian's packages; minros answers the
 # same requests in-process through its stand-ins (the same code, run twice).
@@ -246,9 +245,19 @@ def _fill_case(draw):
 
 @settings(max_examples=150, deadline=None, database=None, suppress_health_check=list(HealthCheck))
 @given(case=_fill_case())
+# a list or dict where a string goes, which random cases draw now and then
+@example(case=("std_msgs/Header", [{"frame_id": [1]}]))
+@example(case=("sensor_msgs/JointState", [{"name": [{"a": 1}]}]))
 def test_fill_message_args_agrees_with_debian(oracle: Oracle, case) -> None:
     type_name, args = case
     ours, theirs = oracle.both(op="fill", type=type_name, args=args)
+    if theirs.get("exc") == "AttributeError" and theirs["text"].endswith(
+            "object has no attribute 'encode'"):
+        # genpy's serializer encodes a string field before any check, so a list or dict there
+        # escapes as AttributeError; minros's check names the field
+        assert ours["ok"].startswith("serialization error: field "), ours
+        assert ours["ok"].endswith("must be of type bytes or an ascii string"), ours
+        return
     if "argument for 's' must be a bytes object" in str(theirs.get("ok")):
         # the one deliberate difference: genpy on Python 3 cannot write a str into a uint8[]
         # field (check_type allows it, struct refuses it); minros writes its latin-1 bytes

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import os
+import struct
 import time
 from pathlib import Path
 
@@ -270,3 +271,121 @@ def test_time_translator():
     assert tr.real(12_000_000_000) == 51.0
     tr.shift(0.25)
     assert tr.real(12_000_000_000) == 51.25
+
+
+def _lz4_frame_blocks(frame: bytes) -> tuple:
+    """(FLG byte, block-size id, [(stored uncompressed, block bytes)]) of one LZ4 frame."""
+    assert frame[:4] == b"\x04\x22\x4d\x18"  # LZ4 frame magic
+    flg, bd = frame[4], frame[5]
+    pos = 7  # magic, FLG, BD, header checksum (no content size: checked by the caller)
+    blocks = []
+    while True:
+        (size,) = struct.unpack_from("<I", frame, pos)
+        pos += 4
+        if size == 0:
+            break
+        n = size & 0x7FFFFFFF
+        blocks.append((bool(size >> 31), frame[pos:pos + n]))
+        pos += n
+    assert len(frame) == pos + 4  # the content checksum ends the frame
+    return flg, (bd >> 4) & 7, blocks
+
+
+def test_lz4_chunks_are_frames_roslz4_reads(tmp_path):
+    """roslz4 (ROS's LZ4 reader) accepts only frames of independent blocks, with a content
+    checksum and without a content size; chunks over one block (every image bag) need it."""
+    import lz4.block
+
+    from sensor_msgs.msg import Image
+
+    pattern = os.urandom(200_000)  # repeated: a linked block would refer to the one before
+    img = Image(height=1, width=3 * len(pattern), encoding="mono8", step=3 * len(pattern),
+                data=pattern * 3)
+    path = tmp_path / "img.bag"
+    with Bag(str(path), "w", compression="lz4", chunk_threshold=3 * 1024 * 1024) as b:
+        for i in range(5):
+            b.write("/img", img, minros.Time(1, i))
+    raw = path.read_bytes()
+    scan = bag1.scan_chunks(path)
+    (chunk,) = scan.chunks
+    datapos, size = scan.datapos[chunk.pos]
+    flg, block_id, blocks = _lz4_frame_blocks(raw[datapos:datapos + size])
+    assert flg >> 6 == 1 and flg & 0x20, "blocks must be independent (FLG bit 5)"
+    assert not flg & 0x10 and not flg & 0x08 and flg & 0x04 and not flg & 0x01  # no block checksum,
+    assert 4 <= block_id <= 7 and len(blocks) >= 3  # no content size, a content checksum
+    # each block decodes on its own: nothing refers to the block before
+    out = b"".join(data if stored else lz4.block.decompress(data, uncompressed_size=1 << (8 + 2 * block_id))
+                   for stored, data in blocks)
+    assert len(out) == chunk.uncompressed_size
+    with Bag(str(path)) as b:
+        assert [bytes(m.message.data) == img.data for m in b.read_messages()] == [True] * 5
+
+
+def test_file_header_has_ros_layout(tmp_path):
+    """ROS pads the file header's header and data to 4096 bytes (the record takes 4104); a ROS
+    tool rewriting the header of a bag padded otherwise wrote into its first chunk."""
+    path = tmp_path / "h.bag"
+    _fill(path, n=20)
+    raw = path.read_bytes()
+    (hlen,) = struct.unpack_from("<I", raw, 13)
+    (plen,) = struct.unpack_from("<I", raw, 17 + hlen)
+    assert hlen + plen == 4096 and 13 + 8 + hlen + plen == bag1.DATA_START == 4117
+    assert raw[4117 + 4:4117 + 12] == b"\x04\x00\x00\x00op=\x05"  # the first chunk starts there
+
+
+def test_bags_of_the_old_layout_read_append_and_reindex(tmp_path):
+    """Bags minros wrote with rosbags' file header (first record at 4109) keep working."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    path = tmp_path / "old.bag"
+    store = get_typestore(Stores.ROS1_NOETIC)
+    with Writer(path) as w:
+        conn = w.add_connection("/i", "std_msgs/msg/Int32", typestore=store)
+        for i in range(5):
+            w.write(conn, i * 10**9, store.serialize_ros1(store.types["std_msgs/msg/Int32"](data=i),
+                                                       "std_msgs/msg/Int32"))
+    assert path.read_bytes()[4109 + 8:4109 + 12] == b"op=\x05"
+    with Bag(str(path), "a") as b:
+        b.write("/i", Int32(5), minros.Time(5))
+    with Bag(str(path)) as b:
+        assert [m.message.data for m in b.read_messages()] == list(range(6))
+    os.truncate(path, path.stat().st_size - 30)  # into the index: reindex, keeping the layout
+    bag1.reindex_in_place(str(path))
+    assert path.read_bytes()[4109 + 8:4109 + 12] == b"op=\x05"
+    with Bag(str(path)) as b:
+        assert [m.message.data for m in b.read_messages()] == list(range(6))
+
+
+def test_a_message_that_does_not_deserialize_raises_rosbag_and_genpy_kinds(tmp_path):
+    from minros.bag.errors import ROSBagDeserializationException, ROSBagFormatException
+    from minros.exceptions import DeserializationError
+
+    path = tmp_path / "short.bag"
+    with Bag(str(path), "w") as b:
+        b.write("/i", Int32(1), minros.Time(1))
+        b.write("/i", ("std_msgs/Int32", b"\x01\x02", Int32._md5sum, Int32), minros.Time(2), raw=True)
+    with Bag(str(path)) as b:
+        read = b.read_messages()
+        assert next(read).message.data == 1
+        with pytest.raises(ROSBagDeserializationException) as info:
+            next(read)
+    assert isinstance(info.value, ROSBagFormatException) and isinstance(info.value, DeserializationError)
+    assert str(info.value).startswith("the std_msgs/Int32 message of /i at 2.000000000 does not "
+                                      "deserialize (") and "\n" not in str(info.value)
+    with Bag(str(path)) as b:  # raw reading hands the bytes over as they are
+        assert [m.message[1] for m in b.read_messages(raw=True)] == [b"\x01\0\0\0", b"\x01\x02"]
+
+
+def test_compression_may_change_between_chunks(tmp_path):
+    """As in rosbag, setting ``compression`` closes the open chunk; later chunks use it."""
+    path = tmp_path / "mixed.bag"
+    with Bag(str(path), "w") as b:
+        b.write("/i", Int32(1), minros.Time(1))
+        b.compression = "lz4"
+        b.write("/i", Int32(2), minros.Time(2))
+        b.compression = "bz2"
+        b.write("/i", Int32(3), minros.Time(3))
+    with Bag(str(path)) as b:
+        assert [c.compression for c in b._chunk_summaries()] == ["none", "lz4", "bz2"]
+        assert [m.message.data for m in b.read_messages()] == [1, 2, 3]

@@ -235,3 +235,82 @@ def test_rosparam_helpers() -> None:
         param._check_xmlrpc_value([1, 2 ** 40])
     with pytest.raises(param.ToolError, match="invalid YAML"):
         param.yaml_load("[1, 2")
+
+
+# ---------------------------------------------------------------------------------------------
+# the tools' internals as a library (rostopic.ROSTopicDelay, rosparam's YAML hooks, ...)
+
+def test_topic_delay_and_bandwidth_meters(monkeypatch) -> None:
+    from minros.cli import topic
+
+    now = [Time(100, 0)]
+    monkeypatch.setattr(topic, "_now", lambda: now[0])
+    delay = topic.ROSTopicDelay(window_size=-1)
+    assert delay.get_delay() is None
+    for i, lag in enumerate((0.5, 0.25, 0.75)):
+        now[0] = Time(100 + i, 0)
+        msg = PoseStamped()
+        msg.header.stamp = now[0] - Duration.from_sec(lag)
+        delay.callback_delay(msg)
+    mean, mn, mx, _std, window = delay.get_delay()
+    # the first message only starts the clock, as in rostopic
+    assert (mean, mn, mx, window) == (pytest.approx(0.5), 0.25, 0.75, 3)
+    assert delay.get_delay() is None  # nothing new since
+    now[0] = Time(0, 0)  # simulated time restarted: the window is cleared
+    delay.callback_delay(msg)
+    assert delay.delays == []
+    bw = topic.ROSTopicBandwidth(window_size=2)
+
+    class Raw:
+        _buff = b"x" * 10
+
+    clock = iter([1.0, 2.0, 3.0, 4.0, 5.0])
+    monkeypatch.setattr(topic.time, "time", lambda: next(clock))
+    assert bw.get_bw_text() is None
+    for _ in range(3):
+        bw.callback(Raw())
+    assert bw.sizes == [10, 10]
+    # 20 bytes from t=3 to the report at t=5
+    assert bw.get_bw_text() == "average: 10.00B/s\n\tmean: 10.00B min: 10.00B max: 10.00B window: 2"
+
+
+def test_callback_echo_offsets_filters_and_transforms(capsys) -> None:
+    from minros.cli import topic
+
+    String = get_message_class("std_msgs/String")
+    echo = topic.CallbackEcho("/a/", None, filter_fn=lambda m: m.data != "skip",
+                              value_transform_fn=topic.create_value_transform(True, False))
+    echo.callback(String("skip"), {"topic": "/a"})
+    echo.callback(String("abc"), {"topic": "/a"})
+    assert capsys.readouterr().out == 'data: "<string length: 3>"\n---\n'
+    every = topic.CallbackEcho("/a", None, echo_all_topics=True, count=1)
+    every.callback(String("x"), {"topic": "/b"})
+    every.callback(String("y"), {"topic": "/b"})
+    assert capsys.readouterr().out == 'data: "x"\n---\n' and every.done
+    sliced = topic.CallbackEcho("/p/pose/position", None)
+    sliced.callback(PoseStamped(), {"topic": "/p"})
+    assert capsys.readouterr().out == "x: 0.0\ny: 0.0\nz: 0.0\n---\n"
+    assert topic.get_nested_attribute(PoseStamped(), "pose/position/x") == 0.0
+
+
+def test_rosparam_yaml_hooks(capsys) -> None:
+    import yaml
+
+    from minros.cli import param
+
+    class Dumper(yaml.SafeDumper):
+        pass
+
+    Dumper.add_representer(xmlrpc.client.Binary, param.represent_xml_binary)
+    text = yaml.dump({"b": xmlrpc.client.Binary(b"abc")}, Dumper=Dumper)
+    assert text == "b: !!binary |-\n  YWJj\n"
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    Loader.add_constructor("!degrees", param.construct_angle_degrees)
+    with pytest.raises(param.RosParamException, match="invalid degree value: x"):
+        yaml.load("!degrees x", Loader=Loader)  # noqa: S506 - a SafeLoader subclass
+    param.print_params({"a": {"b": 1}}, "/ns")
+    assert capsys.readouterr().out == "/ns/a/b=1\n"
+    assert param.load_str("x: 1", "f.yaml", default_namespace="rel") == [({"x": 1}, "rel")]

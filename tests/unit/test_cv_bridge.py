@@ -96,3 +96,68 @@ def test_matches_debians_cv_bridge():
     assert [msg.height, msg.width, msg.encoding, msg.is_bigendian, msg.step,
             msg.data.hex()] == ref["msg"]
     assert bridge.imgmsg_to_cv2(msg, "rgb8").tobytes().hex() == ref["rgb"]
+
+
+# the same calls through Debian's C++ extension and minros's Python: each prints the result
+# (dtype, shape, bytes) or the error's type and text
+DISPLAY_CASES = r'''
+import json, sys
+import numpy as np
+from cv_bridge.boost.cv_bridge_boost import (CV_MAT_CNWrap, CV_MAT_DEPTHWrap, cvtColor2,
+                                             cvtColorForDisplay)
+rng = np.random.default_rng(7)
+depth16 = rng.integers(0, 5000, (4, 6), dtype=np.uint16)
+depth32 = rng.uniform(0.5, 4.0, (4, 6)).astype(np.float32)
+depth32[1, 2] = np.nan
+colour = rng.integers(0, 255, (4, 6, 3), dtype=np.uint8)
+labels = np.arange(-3, 300, dtype=np.int32).reshape(3, 101)
+calls = [
+    (cvtColorForDisplay, (labels, "32SC1", "")),
+    (cvtColorForDisplay, (labels, "32SC1", "bgr8")),
+    (cvtColorForDisplay, (depth16, "16UC1", "", True)),
+    (cvtColorForDisplay, (depth16, "mono16", "mono8", False, 1000.0, 3000.0)),
+    (cvtColorForDisplay, (depth32, "32FC1", "bgr8", False, 0.5, 4.0)),
+    (cvtColorForDisplay, (depth32, "32FC1", "bgr8")),
+    (cvtColorForDisplay, (np.full((2, 2), 7, np.uint16), "mono16", "", True)),
+    (cvtColorForDisplay, (colour, "rgb8", "")),
+    (cvtColorForDisplay, (colour, "bgr8", "bgr8")),
+    (cvtColorForDisplay, (colour, "CV_8UC3", "mono8")),
+    (cvtColorForDisplay, (colour, "rgb8", "32FC1")),
+    (cvtColorForDisplay, (colour, "bgr8", "mono8", False, 0.0, 10.0)),
+    (cvtColorForDisplay, (depth32, "32FC3", "")),
+    (cvtColor2, (colour, "rgb8", "mono8")),
+    (cvtColor2, (depth16, "mono16", "mono8")),
+    (cvtColor2, (depth32, "32FC1", "bgr8")),
+    (cvtColor2, (colour, "bgr8", "8UC1")),
+    (cvtColor2, (colour, "8UC3", "8UC1")),
+    (cvtColor2, (colour, "8UC3", "16UC3")),
+]
+out = []
+for fn, args in calls:
+    try:
+        r = fn(*args)
+        out.append([str(r.dtype), list(r.shape), r.tobytes().hex()])
+    except Exception as exc:
+        out.append(["RuntimeError" if isinstance(exc, RuntimeError) else type(exc).__name__, str(exc)])
+out.append([[CV_MAT_CNWrap(t), CV_MAT_DEPTHWrap(t)] for t in (0, 16, 21, 30, 6 + 8 * 3)])
+print(json.dumps(out))
+'''
+
+
+def test_display_conversion_matches_debians_extension():
+    """cv_bridge.boost's cvtColorForDisplay (label colours, scaling, guessing the output) and
+    cvtColor2 give Debian's C++ extension's pixels, and its refusals with its texts."""
+    from support import PYTHON
+
+    ours = subprocess.run([PYTHON, "-c", DISPLAY_CASES], capture_output=True, text=True,
+                          timeout=60)
+    assert ours.returncode == 0, ours.stderr
+    mine = json.loads(ours.stdout)
+    assert mine[0][:2] == ["uint8", [3, 101, 3]] and mine[10][0] == "RuntimeError"
+    require_reference()
+    out = subprocess.run([REFERENCE_PYTHON, "-c", DISPLAY_CASES], env=reference_env({}),
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    theirs = json.loads(out.stdout)
+    for i, (a, b) in enumerate(zip(mine, theirs)):
+        assert a == b, f"case {i}"

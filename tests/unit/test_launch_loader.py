@@ -283,3 +283,37 @@ def test_entity_declarations_are_refused():
     bomb = '<?xml version="1.0"?><!DOCTYPE l [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;">]><launch/>'
     with pytest.raises(LaunchError, match="entity declarations are not allowed"):
         load(bomb)
+
+
+def test_test_retry_and_time_limit_are_checked():
+    cfg = load('<launch><test test-name="t" pkg="p" type="x" retry="2" time-limit="5"/></launch>')
+    assert (cfg.tests[0].retry, cfg.tests[0].time_limit) == (2, 5.0)
+    with pytest.raises(LaunchError, match=r"'retry' must be a number: \[foo\]"):
+        load('<launch><test test-name="t" pkg="p" type="x" retry="foo"/></launch>')
+    with pytest.raises(LaunchError, match="'time-limit' must be a positive number"):
+        load('<launch><test test-name="t" pkg="p" type="x" time-limit="-1"/></launch>')
+
+
+def test_machine_attributes_and_what_roslaunch_refuses():
+    cfg = load('<launch><machine name="m" address="a" timeout="1" user="u" ssh-port="2222" '
+               'env-loader="/opt/env.sh"/></launch>')
+    m = cfg.machines["m"]
+    assert (m.timeout, m.user, m.ssh_port, m.env_loader) == (1.0, "u", 2222, "/opt/env.sh")
+    for bad, text in [('timeout=""', "'timeout' cannot be empty"),
+                      ('timeout="-1"', "'timeout' be a positive number"),
+                      ('ros-root="/r"', "ros-\\* attributes are not supported since ROS Fuerte")]:
+        with pytest.raises(LaunchError, match=text):
+            load(f'<launch><machine name="m" address="a" {bad}/></launch>')
+    with pytest.raises(LaunchError, match="<env> tag is not supported since ROS Fuerte"):
+        load('<launch><machine name="m" address="a"><env name="A" value="1"/></machine></launch>')
+
+
+def test_ignore_unset_args_keeps_what_came_before(tmp_path: Path):
+    from minros.launch.loader import Loader
+
+    text = '<launch><arg name="x"/><param name="a" value="1"/><param name="b" value="$(arg x)"/>' \
+           '<param name="c" value="3"/></launch>'
+    with pytest.raises(LaunchError, match="requires the 'x' arg to be set"):
+        load(text)
+    cfg = Loader(ignore_unset_args=True).load(write(tmp_path, "a.launch", text))
+    assert cfg.params == {"/a": 1}

@@ -84,6 +84,8 @@ def test_eval():
     assert resolve_args("$(eval optenv('NOPE', 'd'))", c) == "d"
     assert resolve_args("$(eval env('ROBOT') == 'pr2')", c) == "True"
     assert resolve_args("$(eval dirname())", c) == "/d"
+    assert resolve_args("$(eval round(sin(pi), 1))", c) == "0.0"
+    assert resolve_args("$(eval len(name) + max(1, 2))", c) == "5"
     with pytest.raises(SubstitutionError, match="double underscore"):
         resolve_args("$(eval ().__class__)", c)
     with pytest.raises(SubstitutionError, match="NameError"):
@@ -111,3 +113,11 @@ def test_convert_value_errors():
         convert_value("1", "float")
     with pytest.raises(ValueError):
         convert_value("x", "int")
+
+
+def test_find_takes_the_path_after_it_as_roslaunch():
+    c = ctx()
+    c.find = lambda pkg: Path("/w") / pkg
+    assert resolve_args("$(find a)$(find a)", c) == "/w/a//w/a"
+    assert resolve_args(r"$(find a)\x\y.xml $(find a)/z", c) == "/w/a/x/y.xml /w/a/z"
+    assert resolve_args("$(find a)/ rest", c) == "/w/a rest"

@@ -100,7 +100,44 @@ def test_missing_embedded_type_names_the_user(tmp_path: Path, monkeypatch) -> No
     with pytest.raises(UnknownTypeError) as info:
         get_message_class("typo_pkg/Typo")
     text = str(info.value)
-    assert "typo_pkg/Pionts" in text and "needed by typo_pkg/Typo" in text and "Typo.msg" in text
+    assert text.startswith(f"{pkg / 'msg' / 'Typo.msg'}:2: field [p] of typo_pkg/Typo has "
+                           "unknown type [typo_pkg/Pionts]: no file msg/Pionts.msg")
+
+
+def test_misspelled_field_type_says_which_type_file_and_line(tmp_path: Path) -> None:
+    """``from pkg.msg import M`` names the unknown type, the file and line that use it, and
+    the likely fix, where Python would say "cannot import name 'M' ... (unknown location)"."""
+    pkg = _make_package(tmp_path / "src", "typo_pkg")
+    (pkg / "msg" / "M.msg").write_text("int32 a\n# the name\nstrin data\n")
+    (pkg / "msg" / "Outer.msg").write_text("Num n\nM m\n")
+    (pkg / "srv" / "S.srv").write_text("int32 a\n---\nfloat65 b\n")
+    code = (
+        "import rospy\n"
+        "for stmt in ('from typo_pkg.msg import M', 'from typo_pkg.msg import Outer',\n"
+        "             'from typo_pkg.srv import S', 'from typo_pkg.srv import SResponse'):\n"
+        "    try:\n"
+        "        exec(stmt)\n"
+        "    except ImportError as exc:\n"
+        "        print(exc)\n"
+        "import typo_pkg.msg\n"
+        "print(hasattr(typo_pkg.msg, 'Nope'))\n"
+        "from typo_pkg.msg import Num\n"  # the package's sound types still import
+        "print(Num._type)\n"
+    )
+    out = run_python(code, {"ROS_PACKAGE_PATH": str(tmp_path / "src")})
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    msg, srv = pkg / "msg" / "M.msg", pkg / "srv" / "S.srv"
+    assert lines[0] == (f"cannot import name 'M' from 'typo_pkg.msg': {msg}:3: field [data] of "
+                        "typo_pkg/M has unknown type [typo_pkg/strin]: no file msg/strin.msg in "
+                        f"package [typo_pkg] ({pkg}); did you mean [string]?")
+    assert lines[1].startswith(f"cannot import name 'Outer' from 'typo_pkg.msg': {msg}:3: ")
+    assert lines[1].endswith("did you mean [string]? (needed by typo_pkg/Outer)")
+    for line, name in zip(lines[2:4], ("S", "SResponse")):
+        assert line.startswith(f"cannot import name '{name}' from 'typo_pkg.srv': {srv}:3: field "
+                               "[b] of typo_pkg/SResponse has unknown type [typo_pkg/float65]")
+        assert line.endswith("did you mean [float64]?")
+    assert lines[4:] == ["False", "typo_pkg/Num"]
 
 
 def test_action_files_generate_messages_like_genaction(tmp_path: Path, monkeypatch) -> None:

@@ -237,9 +237,13 @@ class FakeState:
 
 
 class FakeHub:
-    def __init__(self, wire=None) -> None:
+    def __init__(self, wire=None, learn=None) -> None:
+        from minros.web.scene import SceneHub
+
         self.sessions = []
         self.wire = wire
+        self.learn = learn
+        self.scene = SceneHub(state=None)
 
     def add(self, session):
         self.sessions.append(session)
@@ -248,13 +252,13 @@ class FakeHub:
         self.sessions.remove(session)
 
 
-def session(wire=None):
+def session(wire=None, learn=None, local=True, client_id="test"):
     from minros.web.page import PageSession
 
     outbox = Outbox()
     state = FakeState()
-    sent = PageSession("test", state, outbox, lambda reason: None, FakeHub(wire),
-                       run_async=lambda fn: fn())
+    sent = PageSession(client_id, state, outbox, lambda reason: None, FakeHub(wire, learn),
+                       run_async=lambda fn: fn(), local=local)
     return sent, outbox, state
 
 
@@ -266,7 +270,7 @@ def replies(outbox: Outbox) -> list:
             return out
         slot, item = got
         frames = item if slot is None else slot.render(item)
-        for frame in frames if isinstance(frames, list) else [frames]:
+        for frame in [frames] if isinstance(frames, (str, bytes)) else frames:
             out.append(json.loads(frame))
 
 
@@ -332,11 +336,18 @@ def test_page_files_load_offline_and_ship_in_the_wheel():
     import re
     from pathlib import Path
 
-    import tomllib
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10: the same parser, from PyPI
+        import tomli as tomllib
 
     import minros.web
 
     static = Path(minros.web.__file__).parent / "static"
+    index = (static / "index.html").read_text(encoding="utf-8")
+    # the import map names the bare modules (three.js's examples import "three")
+    imports = json.loads(re.search(r'<script type="importmap">(.*?)</script>', index, re.S).group(1))["imports"]
+    bare = {name: (static / target).resolve() for name, target in imports.items()}
     pending = [static / "index.html"]
     seen = set()
     while pending:
@@ -347,12 +358,20 @@ def test_page_files_load_offline_and_ship_in_the_wheel():
         text = path.read_text(encoding="utf-8")
         if path.parent.name not in ("uplot", "dagre"):
             assert not re.search(r"""(src|href|from)\s*=?\s*["']https?://""", text), path
-        for ref in re.findall(r"""(?:src|href)="([^"#:]+\.(?:js|css))"|from "(\.[^"]+)"|import "(\.[^"]+)\"""", text):
-            target = (path.parent / next(r for r in ref if r)).resolve()
+        refs = re.findall(r"""(?:src|href)="([^"#:]+\.(?:js|css))"|^\s*(?:import|export)\b[^;'"]*?\bfrom\s*["']([^"']+)["']|^\s*import\s*["']([^"']+)["']|\bimport\(\s*["']([^"']+)["']\s*\)""",
+                          text, re.M)
+        for ref in refs:
+            name = next(r for r in ref if r)
+            target = bare.get(name) or (path.parent / name).resolve()
+            if not ref[0]:  # a module: relative, or named by the import map
+                assert name in bare or name.startswith("."), f"{path.relative_to(static)} imports {name}"
             assert target.is_file(), f"{path.relative_to(static)} refers to a missing {target}"
             pending.append(target)
-    assert static / "js" / "views" / "console.js" in seen and static / "vendor" / "uplot" / "uPlot.esm.js" in seen
-    for lib in ("uplot", "dagre"):
+    for needed in ("js/views/console.js", "vendor/uplot/uPlot.esm.js", "js/view3d/view.js",
+                   "vendor/three/build/three.core.js",
+                   "vendor/three/examples/jsm/loaders/collada/ColladaParser.js"):
+        assert static / needed in seen, needed
+    for lib in ("uplot", "dagre", "three"):
         assert "Permission is hereby granted" in (static / "vendor" / lib / "LICENSE").read_text()
     with open(Path(__file__).resolve().parents[2] / "pyproject.toml", "rb") as f:
         package_data = tomllib.load(f)["tool"]["setuptools"]["package-data"]

@@ -328,7 +328,7 @@ def test_the_page_gets_the_steps_then_what_changes(tmp_path):
     assert len(frames) == 1 and "reset" not in frames[0]
     assert len(frames[0]["steps"]) == 3 and sorted(frames[0]["removed"]) == [
         s["id"] for s in first["steps"]]
-    assert page.wire_sent == {s["id"] for s in frames[0]["steps"]} == set(feed.model.steps)
+    assert page.wire.sent == {s["id"] for s in frames[0]["steps"]} == set(feed.model.steps)
     page.close()
     assert feed._listeners == {}
 

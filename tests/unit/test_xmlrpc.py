@@ -474,3 +474,101 @@ def test_peers_outside_the_allow_list_are_refused_with_one_reported_line():
         assert mx.ServerProxy(uri(srv)).add(1, 2) == 3
     finally:
         srv.shutdown()
+
+
+# --------------------------------------------------------------------------- failures the client explains
+
+def test_a_request_over_the_servers_limit_names_the_limit():
+    """The server answers 413 and closes while the request is still being sent: the client
+    reads that answer instead of reporting ConnectionResetError."""
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", max_body=1 << 20).start()
+    try:
+        with pytest.raises(mx.CallRefused) as info:
+            mx.ServerProxy(uri(srv), timeout=10).echo("x" * (16 << 20))
+    finally:
+        srv.shutdown()
+    assert info.value.errcode == 413 and isinstance(info.value, xmlrpc.client.ProtocolError)
+    text = str(info.value)
+    assert text.startswith(f"{uri(srv)} refused a request of 16777")
+    assert "larger than its limit of 1048576 bytes (1 MiB) per XML-RPC call" in text
+
+
+def test_an_allow_list_refusal_names_ros_allowed_hosts(monkeypatch):
+    monkeypatch.setattr(rosenv, "host_allowed", lambda *args: False)  # loopback as a stranger
+    srv = mx.XmlRpcServer(Handler(), "127.0.0.1", allowed=rosenv.parse_allowed_hosts("10.9.9.0/24"),
+                          on_refused=lambda peer, reason: None, what="the master").start()
+    try:
+        for size in (10, 8 << 20):  # the large one is still being sent when the refusal comes
+            with pytest.raises(mx.CallRefused) as info:
+                mx.ServerProxy(uri(srv), timeout=10).echo("x" * size)
+            assert info.value.errcode == 403
+            assert str(info.value) == (
+                f"{uri(srv)} refused this host: connection from 127.0.0.1 refused: not in "
+                "ROS_ALLOWED_HOSTS of the master (add this host's address to ROS_ALLOWED_HOSTS "
+                "where that server runs)")
+    finally:
+        srv.shutdown()
+
+
+def _deep(levels: int) -> bytes:
+    return (b"<?xml version='1.0'?><methodResponse><params><param><value>"
+            + b"<array><data><value>" * levels + b"<int>1</int>" + b"</value></data></array>" * levels
+            + b"</value></param></params></methodResponse>")
+
+
+def _answering(reply: bytes):
+    """A server that reads one request and sends ``reply`` (raw bytes), then closes."""
+    listener = socket.create_server(("127.0.0.1", 0))
+
+    def answer() -> None:
+        conn, _ = listener.accept()
+        with conn:
+            conn.recv(65536)
+            conn.sendall(reply)
+
+    thread = threading.Thread(target=answer, daemon=True)
+    thread.start()
+    return listener, thread
+
+
+def _http(body: bytes) -> bytes:
+    return b"HTTP/1.1 200 OK\r\nContent-Type: text/xml\r\nContent-Length: %d\r\n\r\n%s" % (len(body), body)
+
+
+@pytest.mark.parametrize("reply,reason", [
+    (_http(b"garbage \x00\xff"), "a reply that is not XML-RPC (syntax error: line 1, column 0)"),
+    (_http(b'<?xml version="1.0"?><!DOCTYPE m [<!ENTITY a "b">]><methodResponse><params><param>'
+           b"<value>&a;</value></param></params></methodResponse>"),
+     "a reply that is not XML-RPC (XML document type declarations and entities are not allowed)"),
+    (_http(_deep(100_000)), "a reply that is not XML-RPC (arrays and structs nested more than 200 deep)"),
+    (_http(b"<html><body>a web server</body></html>"),
+     "a reply that is not XML-RPC (no methodResponse value in it)"),
+    (b"SSH-2.0-OpenSSH_9.2\r\n", "a bad reply: not HTTP: b'SSH-2.0-OpenSSH_9.2\\r\\n'"),
+])
+def test_a_reply_that_is_not_xmlrpc_is_one_line(reply: bytes, reason: str):
+    listener, thread = _answering(reply)
+    address = f"http://127.0.0.1:{listener.getsockname()[1]}/"
+    try:
+        with pytest.raises(mx.BadReply) as info:
+            mx.ServerProxy(address, timeout=5).add(1, 2)
+    finally:
+        thread.join(5)
+        listener.close()
+    assert str(info.value) == f"{address} sent {reason}"
+    # what code catching Python's own exceptions expects
+    assert isinstance(info.value, (xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError))
+
+
+def test_nesting_is_bounded_and_deep_enough_for_any_parameter():
+    listener, thread = _answering(_http(_deep(mx.MAX_REPLY_DEPTH)))
+    try:
+        value = mx.ServerProxy(f"http://127.0.0.1:{listener.getsockname()[1]}/", timeout=5).add(1, 2)
+    finally:
+        thread.join(5)
+        listener.close()
+    for _ in range(mx.MAX_REPLY_DEPTH):
+        (value,) = value
+    assert value == 1
+    mx.check_nesting(b"<struct><array></array><array><struct></struct></array></struct>", 3)
+    with pytest.raises(ValueError, match="nested more than 2 deep"):
+        mx.check_nesting(b"<struct><array></array><array><struct></struct></array></struct>", 2)

@@ -2,6 +2,9 @@
 tests/integration/test_web.py: one scenario, one ``RESULT {json}`` line.
 
     python roslibpy_client.py WS_URL   (turtlesim must be running on the graph)
+    python roslibpy_client.py WS_URL connect   (connects and asks rosapi the time)
+    python roslibpy_client.py WS_URL refusing_service   (serves a service answering result false)
+    python roslibpy_client.py WS_URL latched_twice   (two clients, one latched message each)
 """
 
 from __future__ import annotations
@@ -79,5 +82,64 @@ def main(url: str) -> int:
     return 0
 
 
+def connect(url: str) -> int:
+    ros = roslibpy.Ros(url)
+    ros.run(timeout=10)
+    out = {"connected": ros.is_connected, "time": ros.get_time()}
+    ros.terminate()
+    print("RESULT " + json.dumps(out, default=dict), flush=True)
+    return 0
+
+
+def refusing_service(url: str) -> int:
+    """A service whose handler fills the response and returns False (roslibpy then sends
+    ``result: false`` with the values), called through ROS."""
+    ros = roslibpy.Ros(url)
+    ros.run(timeout=10)
+
+    def refuse(request: dict, response: dict) -> bool:
+        response["sum"] = request["a"] + request["b"]
+        return False
+
+    server = roslibpy.Service(ros, "/web_refuse", "rospy_tutorials/AddTwoInts")
+    server.advertise(refuse)
+    time.sleep(0.5)
+    out: dict = {}
+    try:
+        out["response"] = roslibpy.Service(ros, "/web_refuse", "rospy_tutorials/AddTwoInts").call(
+            roslibpy.ServiceRequest({"a": 40, "b": 2}), timeout=10)
+    except Exception as exc:
+        out["error"] = str(exc)
+    server.unadvertise()
+    ros.terminate()
+    print("RESULT " + json.dumps(out, default=dict), flush=True)
+    return 0
+
+
+def latched_twice(url: str) -> int:
+    """Two clients subscribe to /web_latched one after the other (the first still subscribed):
+    the latched message each gets, or None after 20 s."""
+    out: dict = {"received": []}
+    clients, topics = [], []
+    for _ in range(2):
+        ros = roslibpy.Ros(url)
+        ros.run(timeout=10)
+        clients.append(ros)
+        got = threading.Event()
+        received: list = []
+        topic = roslibpy.Topic(ros, "/web_latched", "std_msgs/String")
+        topic.subscribe(lambda msg, received=received, got=got: (received.append(msg), got.set()))
+        topics.append(topic)
+        got.wait(20)
+        out["received"].append(received[0] if received else None)
+    for topic in topics:
+        topic.unsubscribe()
+    clients[0].terminate()
+    print("RESULT " + json.dumps(out, default=dict), flush=True)
+    return 0
+
+
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1]))
+    scenario = sys.argv[2] if len(sys.argv) > 2 else "turtlesim"
+    sys.exit({"turtlesim": main, "connect": connect, "refusing_service": refusing_service,
+              "latched_twice": latched_twice}[scenario](sys.argv[1]))

@@ -9,7 +9,6 @@ Topics (under the action namespace, as actionlib names them): the client publish
 
 from __future__ import annotations
 
-import itertools
 import threading
 import time
 import weakref
@@ -209,8 +208,14 @@ class ClientGoalHandle:
             return GoalStatus.LOST
 
 
-_goal_counter = itertools.count(1)
+#: the number the next goal id carries (actionlib's g_goal_id)
+_next_goal_number = 1
 _goal_counter_lock = threading.Lock()
+
+
+def next_goal_number() -> int:
+    """The number the next goal id an ActionClient makes will carry."""
+    return _next_goal_number
 
 
 class GoalManager:
@@ -225,8 +230,9 @@ class GoalManager:
         self.ActionGoal, self.ActionResult, self.ActionFeedback, _ = action_types(action_spec)
 
     def _generate_id(self) -> Any:
+        global _next_goal_number
         with _goal_counter_lock:
-            number = next(_goal_counter)
+            number, _next_goal_number = _next_goal_number, _next_goal_number + 1
         now = minros.Time.now()
         return GoalID(id=f"{minros.get_caller_id()}-{number}-{now.to_sec():.3f}", stamp=now)
 

@@ -9,7 +9,6 @@ every change), ``result`` and ``feedback``. Every goal it has heard of has a
 
 from __future__ import annotations
 
-import itertools
 import threading
 from typing import Any, Callable, List
 
@@ -23,7 +22,8 @@ from .states import SERVER_REFUSALS, cancel_matches, server_transition
 class GoalIDGenerator:
     """Unique goal ids ``<name>-<count>-<secs>.<nsecs>`` for goals that came without one."""
 
-    _counter = itertools.count(1)
+    #: goal ids generated so far by every generator of the process (actionlib's s_goalcount)
+    issued = 0
     _lock = threading.Lock()
 
     def __init__(self, name: str | None = None) -> None:
@@ -35,7 +35,8 @@ class GoalIDGenerator:
     def generate_ID(self) -> Any:
         now = minros.Time.now()
         with GoalIDGenerator._lock:
-            count = next(GoalIDGenerator._counter)
+            GoalIDGenerator.issued += 1
+            count = GoalIDGenerator.issued
         return GoalID(id=f"{self.name}-{count}-{now.secs}.{now.nsecs}", stamp=now)
 
 

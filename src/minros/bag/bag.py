@@ -12,16 +12,19 @@ import io
 import os
 import sys
 import time
-from typing import Any, Callable, Dict, Iterator, List, Optional, Union
+from typing import Any, BinaryIO, Callable, Dict, Iterator, List, Optional, Union
 
 from minros.bag import bag1
 from minros.bag.bag1 import ConnInfo
 from minros.bag.errors import (
     COMPRESSIONS,
     Compression,
+    ROSBagDeserializationException,
     ROSBagException,
+    ROSBagFormatException,
     ROSBagUnindexedException,
 )
+from minros.bag.scan import rebuild
 from minros.msgs import reader_for
 from minros.names import canonicalize_name
 
@@ -56,7 +59,7 @@ def _str(value: Any) -> str:
 class Bag:
     """A bag file opened for reading ('r'), writing ('w') or appending ('a')."""
 
-    def __init__(self, f: Union[str, os.PathLike], mode: str = "r",
+    def __init__(self, f: Union[str, os.PathLike, BinaryIO], mode: str = "r",
                  compression: str = Compression.NONE, chunk_threshold: int = 768 * 1024,
                  allow_unindexed: bool = False, options: Optional[dict] = None,
                  skip_index: bool = False) -> None:
@@ -71,11 +74,17 @@ class Bag:
             raise ValueError("chunk_threshold must be greater than or equal to zero")
         if not f:
             raise ValueError("filename (or stream) is invalid")
-        if isinstance(f, io.IOBase):
-            raise ValueError("minros's Bag opens files by name: pass the path, not a stream")
         if mode not in ("r", "w", "a"):
             raise ValueError(f'mode "{mode}" is invalid')
-        self._filename = os.fspath(f)
+        #: a file object the bag was given (rosbag reads and writes those as it does files,
+        #: and closes them on close(); but not an io.BytesIO, which rosbag does not take and
+        #: which would lose the bag just written); None when it was given a file name
+        self._stream: Optional[BinaryIO] = None
+        if isinstance(f, (str, os.PathLike)):
+            self._filename: Optional[str] = os.fspath(f)
+        else:
+            _check_stream(f, mode)
+            self._stream, self._filename = f, None
         self._mode = mode
         self._compression = compression
         self._chunk_threshold = chunk_threshold
@@ -86,24 +95,37 @@ class Bag:
         self._classes: Dict[int, Any] = {}
         self._topic_conn: Dict[str, int] = {}
         self._closed = False
+        target = self._target
         if mode == "r":
-            self._reader = open_reader(self._filename, allow_unindexed)
+            self._reader = open_reader(target, allow_unindexed, self._keep_open)
             self._version = self._reader.version
         elif mode == "w":
             self._version = 200
-            self._writer = open_writer(self._filename, compression, chunk_threshold)
+            self._writer = open_writer(target, compression, chunk_threshold, self._keep_open)
         else:
             self._version = 200
             self._open_append(allow_unindexed)
 
+    @property
+    def _keep_open(self) -> bool:
+        return isinstance(self._stream, io.BytesIO)
+
+    @property
+    def _target(self) -> Union[str, BinaryIO]:
+        """What the bag reads and writes: its file object, else its file name."""
+        return self._stream if self._stream is not None else self._filename  # type: ignore[return-value]
+
     def _open_append(self, allow_unindexed: bool) -> None:
-        if not os.path.exists(self._filename):
-            self._writer = bag1.Bag1Writer(self._filename, self._compression, self._chunk_threshold)
+        target = self._target
+        if (not os.path.exists(target) if self._stream is None
+                else self._stream.seek(0, os.SEEK_END) == 0):
+            self._writer = bag1.Bag1Writer(target, self._compression, self._chunk_threshold,
+                                           keep_open=self._keep_open)
             return
-        if is_mcap(self._filename):
+        if is_mcap(target):
             raise ROSBagException("appending to MCAP files is not supported")
         try:
-            scan = bag1.summary_scan(self._filename)
+            scan = bag1.summary_scan(target)
         except ROSBagUnindexedException:
             if not allow_unindexed:
                 raise
@@ -111,8 +133,8 @@ class Bag:
             return
         except OSError as exc:
             raise ROSBagException(str(exc.strerror or exc)) from None
-        self._writer = bag1.Bag1Writer.append(self._filename, self._compression,
-                                              self._chunk_threshold, scan)
+        self._writer = bag1.Bag1Writer.append(target, self._compression, self._chunk_threshold, scan,
+                                              self._keep_open)
         self._topic_conn = {c.topic: c.id for c in self._writer.connections.values()}
 
     # -- context manager, properties ------------------------------------------------------
@@ -126,12 +148,24 @@ class Bag:
     def __exit__(self, exc_type: Any, exc_value: Any, traceback: Any) -> None:
         self.close()
 
+    # rosbag's internals, which tools and tests reach for: the open file and where the file
+    # header record starts (after the version line)
+    @property
+    def _file(self) -> Optional[BinaryIO]:
+        handle = self._writer if self._writer is not None else self._reader
+        return getattr(handle, "file", None)
+
+    @property
+    def _file_header_pos(self) -> Optional[int]:
+        return len(bag1.MAGIC) if self._version // 100 == 2 else None
+
     @property
     def options(self) -> dict:
         return {"compression": self._compression, "chunk_threshold": self._chunk_threshold}
 
     @property
-    def filename(self) -> str:
+    def filename(self) -> Optional[str]:
+        """The file name (None for a bag opened on a file object, as in rosbag)."""
         return self._filename
 
     @property
@@ -147,7 +181,12 @@ class Bag:
         self._check_open()
         if self._writer is not None:
             return self._writer.tell()
-        return os.path.getsize(self._filename)
+        if self._stream is not None:
+            pos = self._stream.tell()
+            size = self._stream.seek(0, os.SEEK_END)
+            self._stream.seek(pos)
+            return size
+        return os.path.getsize(self._filename)  # type: ignore[arg-type]
 
     def _get_compression(self) -> str:
         return self._compression
@@ -155,11 +194,14 @@ class Bag:
     def _set_compression(self, compression: str) -> None:
         if compression not in COMPRESSIONS:
             raise ValueError("compression must be one of: " + ", ".join(COMPRESSIONS))
-        if self._writer is not None and compression != self._compression:
+        if isinstance(self._writer, bag1.Bag1Writer):
+            self._writer.flush_chunk()  # as rosbag: the chunks after this one use the new one
+            self._writer.set_compression(compression)
+        elif self._writer is not None and compression != self._compression:  # MCAP
             if self._writer.connections:
                 raise ROSBagException("set the compression before writing the first message")
             self._writer.abort()
-            self._writer = open_writer(self._filename, compression, self._chunk_threshold)
+            self._writer = open_writer(self._target, compression, self._chunk_threshold)
         self._compression = compression
 
     compression = property(_get_compression, _set_compression)
@@ -238,6 +280,9 @@ class Bag:
                 cls = load_class(conn.datatype, conn.md5sum, conn.msg_def)
             except DecodeError as exc:
                 raise ROSBagException(str(exc)) from None
+            except Exception as exc:  # noqa: BLE001 - a definition damaged in the bag
+                raise ROSBagFormatException(f"the message definition of {conn.datatype} on "
+                                            f"{conn.topic} does not parse: {exc}") from None
             if conn.md5sum not in ("", "*") and cls._md5sum != conn.md5sum:
                 print(f"WARNING: For type [{conn.datatype}] stored md5sum [{conn.md5sum}] does not "
                       f"match message definition [{cls._md5sum}].", file=sys.stderr)
@@ -269,31 +314,44 @@ class Bag:
         readers = {cid: reader_for(cls) for cid, cls in classes.items()}
         ids = None if len(conns) == len(source.connections) else list(conns)
         new_time = Time.__new__
-        if not raw and not with_header:
-            # the common case in one lean loop: about 8% of a read of many small messages
-            topic_readers = {cid: (conns[cid].topic, read) for cid, read in readers.items()}
-            new_tuple = tuple.__new__  # BagMessage(...) runs a Python-level __new__
-            for cid, t, data, _pos in source.messages(ids, start, end):
-                topic, read = topic_readers[cid]
-                msg = read(data)
-                stamp = new_time(Time)  # filled in directly: two __init__ calls add up
+        cid = t = -1
+        try:
+            if not raw and not with_header:
+                # the common case in one lean loop: about 8% of a read of many small messages
+                topic_readers = {cid: (conns[cid].topic, read) for cid, read in readers.items()}
+                new_tuple = tuple.__new__  # BagMessage(...) runs a Python-level __new__
+                for cid, t, data, _pos in source.messages(ids, start, end):
+                    topic, read = topic_readers[cid]
+                    msg = read(data)
+                    stamp = new_time(Time)  # filled in directly: two __init__ calls add up
+                    stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
+                    yield new_tuple(BagMessage, (topic, msg, stamp))
+                return
+            headers = {cid: c.header for cid, c in conns.items()} if with_header else {}
+            for cid, t, data, pos in source.messages(ids, start, end):
+                conn = conns[cid]
+                cls = classes[cid]
+                if raw:
+                    msg: Any = (conn.datatype, bytes(data), conn.md5sum, pos, cls)
+                else:
+                    msg = readers[cid](data)
+                stamp = new_time(Time)  # filled in directly: two __init__ calls per message add up
                 stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
-                yield new_tuple(BagMessage, (topic, msg, stamp))
-            return
-        headers = {cid: c.header for cid, c in conns.items()} if with_header else {}
-        for cid, t, data, pos in source.messages(ids, start, end):
+                if with_header:
+                    yield BagMessageWithConnectionHeader(conn.topic, msg, stamp, headers[cid])
+                else:
+                    yield BagMessage(conn.topic, msg, stamp)
+        except ROSBagException:
+            raise
+        except Exception as exc:  # noqa: BLE001 - whatever a damaged message makes a reader raise
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            if cid not in conns:
+                raise ROSBagFormatException(f"the bag could not be read: {reason}") from None
             conn = conns[cid]
-            cls = classes[cid]
-            if raw:
-                msg: Any = (conn.datatype, bytes(data), conn.md5sum, pos, cls)
-            else:
-                msg = readers[cid](data)
-            stamp = new_time(Time)  # filled in directly: two __init__ calls per message add up
-            stamp.secs, stamp.nsecs = divmod(t, 1_000_000_000)
-            if with_header:
-                yield BagMessageWithConnectionHeader(conn.topic, msg, stamp, headers[cid])
-            else:
-                yield BagMessage(conn.topic, msg, stamp)
+            raise ROSBagDeserializationException(
+                f"the {conn.datatype} message of {conn.topic} at {t // 1_000_000_000}."
+                f"{t % 1_000_000_000:09d} does not deserialize ({reason}): the bag is damaged "
+                "there, or its message definition is wrong") from None
 
     def get_message_count(self, topic_filters: Any = None) -> int:
         counts = self._counts()
@@ -448,14 +506,20 @@ class Bag:
         return self._reindex_for_append()
 
     def _reindex_for_append(self) -> Iterator[int]:
-        from pathlib import Path
-
-        scan = bag1.ScanResult()
-        yield from bag1.iter_scan(Path(self._filename), scan)
         if self._writer is not None:
             self._writer.abort()
-        self._writer = bag1.Bag1Writer.append(self._filename, self._compression,
-                                              self._chunk_threshold, scan)
+            self._writer = None
+        if self._stream is not None:
+            scan = bag1.ScanResult()
+            yield from bag1.iter_scan(self._stream, scan)
+            rebuild(self._stream, scan)
+        else:
+            with open(self._filename, "r+b") as f:  # type: ignore[arg-type]
+                scan = bag1.ScanResult()
+                yield from bag1.iter_scan(f, scan)
+                rebuild(f, scan)
+        self._writer = bag1.Bag1Writer.append(self._target, self._compression, self._chunk_threshold,
+                                              keep_open=self._keep_open)
         self._topic_conn = {c.topic: c.id for c in self._writer.connections.values()}
         self._pending_scan = False
 
@@ -487,30 +551,47 @@ class Bag:
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
-def is_mcap(path: str) -> bool:
-    """Whether ``path`` starts with MCAP's magic bytes (else it is taken for a bag)."""
+def is_mcap(source: Union[str, BinaryIO]) -> bool:
+    """Whether ``source`` starts with MCAP's magic bytes (else it is taken for a bag)."""
     try:
-        with open(path, "rb") as f:
+        if not isinstance(source, str):
+            source.seek(0)
+            return source.read(len(MCAP_MAGIC)) == MCAP_MAGIC
+        with open(source, "rb") as f:
             return f.read(len(MCAP_MAGIC)) == MCAP_MAGIC
     except OSError:
         return False
 
 
-def open_reader(path: str, allow_unindexed: bool) -> Any:
+def _check_stream(f: Any, mode: str) -> None:
+    """A file object to read or write a bag in: binary, and able to seek (rosbag's demands)."""
+    if isinstance(f, io.TextIOBase) or "b" not in getattr(f, "mode", "b"):
+        raise ROSBagException("In Python 3 the bag file must be opened in binary mode")
+    if not all(hasattr(f, name) for name in ("read", "write", "seek", "tell")):
+        raise ValueError("filename (or stream) is invalid")
+    if getattr(f, "closed", False):
+        raise ValueError("I/O operation on closed file")
+
+
+def open_reader(source: Union[str, BinaryIO], allow_unindexed: bool, keep_open: bool = False) -> Any:
     """The reader of a bag v2.0 or MCAP file (by its first bytes)."""
-    if not os.path.exists(path):
-        raise ROSBagException(f"[Errno 2] No such file or directory: '{path}'")
-    if is_mcap(path):
+    if isinstance(source, str) and not os.path.exists(source):
+        raise ROSBagException(f"[Errno 2] No such file or directory: '{source}'")
+    if is_mcap(source):
+        if not isinstance(source, str):
+            raise ROSBagException("minros reads MCAP files by name: pass the file's name, not a file object")
         from minros.bag import mcapfile  # imported only for MCAP files: rosbag info starts faster
 
-        return mcapfile.McapReader(path, allow_unindexed)
-    return bag1.Bag1Reader(path, allow_unindexed)
+        return mcapfile.McapReader(source, allow_unindexed)
+    return bag1.Bag1Reader(source, allow_unindexed, keep_open)
 
 
-def open_writer(path: str, compression: str, chunk_threshold: int) -> Any:
-    """A new file's writer: MCAP when the name ends in .mcap (or .mcap.active), else bag v2.0."""
-    if path.endswith(".mcap") or path.endswith(".mcap.active"):
+def open_writer(path: Union[str, BinaryIO], compression: str, chunk_threshold: int,
+                keep_open: bool = False) -> Any:
+    """A new file's writer: MCAP when the name ends in .mcap (or .mcap.active), else bag v2.0
+    (always for a file object)."""
+    if isinstance(path, str) and (path.endswith(".mcap") or path.endswith(".mcap.active")):
         from minros.bag import mcapfile
 
         return mcapfile.McapWriter(path, compression, chunk_threshold)
-    return bag1.Bag1Writer(path, compression, chunk_threshold)
+    return bag1.Bag1Writer(path, compression, chunk_threshold, keep_open=keep_open)

@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+from minros.exceptions import DeserializationError
+
+__all__ = ["Compression", "ROSBagDeserializationException", "ROSBagEncryptException",
+           "ROSBagEncryptNotSupportedException", "ROSBagException", "ROSBagFormatException",
+           "ROSBagUnindexedException"]
+
 
 class ROSBagException(Exception):
     """Base class for exceptions in rosbag."""
@@ -16,6 +22,12 @@ class ROSBagException(Exception):
 
 class ROSBagFormatException(ROSBagException):
     """The bag's records do not follow the format."""
+
+
+class ROSBagDeserializationException(ROSBagFormatException, DeserializationError):
+    """A message in the bag does not deserialize with its class (the bag is damaged, or the
+    definition is wrong). Of rosbag's family, and a genpy DeserializationError, the kind
+    ROS's rosbag lets through from ``read_messages``."""
 
 
 class ROSBagUnindexedException(ROSBagException):

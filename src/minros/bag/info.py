@@ -62,7 +62,8 @@ def _compression_stats(bag: Any) -> Tuple[Dict[str, int], Dict[str, int], Dict[s
 
 
 def info_text(bag: Any, with_freq: bool = False) -> str:
-    rows: List[Tuple[str, str]] = [("path", bag.filename), ("version", _version_str(bag))]
+    rows: List[Tuple[str, str]] = [("path", bag.filename)] if bag.filename else []  # a file object has none
+    rows.append(("version", _version_str(bag)))
     rng = bag._time_range()
     if rng is None:
         rows.append(("size", human_size(bag.size)))
@@ -126,7 +127,8 @@ def info_text(bag: Any, with_freq: bool = False) -> str:
 
 
 def info_yaml(bag: Any, key: Optional[str] = None, with_freq: bool = False) -> Optional[str]:
-    s = f"path: {bag.filename}\nversion: {_version_str(bag)}\n"
+    s = f"path: {bag.filename}\n" if bag.filename else ""
+    s += f"version: {_version_str(bag)}\n"
     rng = bag._time_range()
     if rng is None:
         s += "size: %d\nindexed: False\n" % bag.size

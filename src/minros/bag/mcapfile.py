@@ -8,6 +8,7 @@ as the profile specifies. The same reader and writer interface as :mod:`minros.b
 
 from __future__ import annotations
 
+import struct
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Optional, Tuple
 
@@ -17,6 +18,10 @@ from mcap.writer import CompressionType, Writer
 
 from minros.bag.bag1 import ChunkSummary, ConnInfo
 from minros.bag.errors import ROSBagException, ROSBagFormatException, ROSBagUnindexedException
+
+#: what the mcap library raises on a damaged file besides its own McapError (struct on short
+#: records, the decompressors' kinds)
+_DAMAGE = (McapError, ValueError, EOFError, OSError, struct.error, KeyError, IndexError, RuntimeError)
 
 PROFILE = "ros1"
 SCHEMA_ENCODING = "ros1msg"
@@ -50,15 +55,15 @@ class McapReader:
             self._reader = make_reader(self._f)
             try:
                 summary = self._reader.get_summary()
-            except (McapError, ValueError, OSError, EOFError):
-                summary = None  # cut short: no footer
+            except _DAMAGE:
+                summary = None  # cut short or damaged: no usable summary
             if summary is None or summary.statistics is None:
                 if not allow_unindexed:
                     raise ROSBagUnindexedException()
                 self._load_by_streaming()
             else:
                 self._load_summary(summary)
-        except (McapError, ValueError) as exc:
+        except _DAMAGE as exc:
             self._f.close()
             raise ROSBagFormatException(f"not a readable MCAP file: {exc}") from None
         except BaseException:
@@ -91,7 +96,7 @@ class McapReader:
                     self.connections[channel.id] = _conn(channel, schema)
                 self.counts[channel.id] = self.counts.get(channel.id, 0) + 1
                 streamed.append((message.log_time, channel.id, message.data))
-        except (McapError, ValueError, EOFError, OSError):
+        except _DAMAGE:
             pass  # the damaged tail
         streamed.sort(key=lambda m: m[0])
         self._streamed = streamed
@@ -122,8 +127,8 @@ class McapReader:
                     topics=topics, starting_at=start, ending_at=end, log_time_order=True):
                 if wanted is None or channel.id in wanted:
                     yield channel.id, message.log_time, message.data, (0, 0)
-        except McapError as exc:
-            raise ROSBagFormatException(str(exc)) from None
+        except _DAMAGE as exc:
+            raise ROSBagFormatException(f"the MCAP file is damaged ({type(exc).__name__}: {exc})") from None
 
     def close(self) -> None:
         self._f.close()

@@ -120,9 +120,13 @@ def _copy_messages(inbag: Bag, outbag: Bag, quiet: bool) -> None:
 
 def _reindex_into(path: str, quiet: bool) -> None:
     meter = None if quiet else ProgressMeter(path, os.path.getsize(path))
-    bag1.reindex_in_place(path, None if meter is None else meter.step)
+    scan = bag1.reindex_in_place(path, None if meter is None else meter.step)
     if meter is not None:
         meter.finish()
+    if scan.skipped:  # damage in the middle (a file that is only cut short is the usual case)
+        more = f" and {len(scan.skipped) - 1} more place(s)" if len(scan.skipped) > 1 else ""
+        kept = sum(sum(c.counts.values()) for c in scan.chunks)
+        _err(f"WARNING {path}: skipped damaged data ({scan.skipped[0]}){more}; kept {kept} messages")
 
 
 def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
@@ -131,14 +135,16 @@ def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
     when writing in place (rosbag's bag_op)."""
     for path in paths:
         reindex = op == "reindex"
-        try:
-            probe = Bag(path, "r", allow_unindexed=reindex)
-            probe.close()
-        except (ROSBagException, OSError) as exc:
-            _read_error(path, exc)
-            continue
         if reindex and is_mcap(path):
             _err(f"ERROR reading {path}: reindexing MCAP files is not supported by minros")
+            continue
+        try:
+            if reindex:  # the scan reads the whole file: here only what makes it a bag
+                bag1.check_version(path)
+            else:
+                Bag(path, "r").close()
+        except (ROSBagException, OSError) as exc:
+            _read_error(path, exc)
             continue
         out = path if output_dir is None else os.path.join(output_dir, os.path.basename(path))
         source = path
@@ -188,38 +194,4 @@ def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
             raise
         except (ROSBagException, OSError) as exc:
             _err(f"ERROR operating on {path}: {exc}")
-    return 0
-
-
-def check(path: str) -> int:
-    """Which connections' types differ from the installed ones (``rosbag check``)."""
-    try:
-        bag = Bag(path)
-    except ROSBagException as exc:
-        _read_error(path, exc)
-        return 1
-    from minros.msgs import get_message_class
-
-    needed = []
-    seen = set()
-    for conn in bag._connections.values():
-        if (conn.datatype, conn.md5sum) in seen:
-            continue
-        seen.add((conn.datatype, conn.md5sum))
-        try:
-            installed = get_message_class(conn.datatype)
-        except Exception:
-            installed = None
-        if installed is None or installed._md5sum != conn.md5sum:
-            needed.append((conn, installed))
-    bag.close()
-    if not needed:
-        print("Bag file does not need any migrations.")
-        return 0
-    print("The following migrations need to occur:")
-    for conn, installed in needed:
-        print(f" * From: {conn.datatype} [{conn.md5sum}]")
-        print("   To:   " + (f"{installed._type} [{installed._md5sum}]" if installed else "Unknown"))
-    print("\nminros writes no migration rules (rosbag fix is not available); the bag still "
-          "plays and reads with the definitions it stores.")
     return 0

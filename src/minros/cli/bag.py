@@ -6,7 +6,9 @@ is done by :mod:`minros.bag`.
 
 from __future__ import annotations
 
+import collections
 import optparse
+import os
 import sys
 from typing import Any, Callable, Dict, List, Optional
 
@@ -79,7 +81,7 @@ def record_parser(prog: str, node: bool = False) -> optparse.OptionParser:
     return p
 
 
-def record_cmd(argv: List[str], prog: str, node: bool = False) -> int:
+def record_cmd(argv: List[str], prog: str = "rosbag", node: bool = False) -> int:
     p = record_parser(prog, node)
     options, args = p.parse_args(strip_ros_args(argv))
     if node:
@@ -163,7 +165,7 @@ def play_parser(prog: str) -> optparse.OptionParser:
     return p
 
 
-def play_cmd(argv: List[str], prog: str) -> int:
+def play_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = play_parser(prog)
     options, args = p.parse_args(strip_ros_args(argv))
     if options.bags:
@@ -189,7 +191,7 @@ def play_cmd(argv: List[str], prog: str) -> int:
 # ---------------------------------------------------------------------------------------------
 # file commands
 
-def info_cmd(argv: List[str], prog: str) -> int:
+def info_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = _parser(prog, "rosbag info [options] BAGFILE1 [BAGFILE2 BAGFILE3 ...]", DESCRIPTIONS["info"])
     p.add_option("-y", "--yaml", dest="yaml", default=False, action="store_true", help="print information in YAML format")
     p.add_option("-k", "--key", dest="key", default=None, action="store", help="print information on the given key")
@@ -204,7 +206,7 @@ def info_cmd(argv: List[str], prog: str) -> int:
     return info(args, options.yaml, options.key, options.freq)
 
 
-def filter_cmd(argv: List[str], prog: str) -> int:
+def filter_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = _parser(prog, """rosbag filter [options] INBAG OUTBAG EXPRESSION
 
 EXPRESSION can be any Python-legal expression.
@@ -236,7 +238,7 @@ def _file_op_parser(prog: str, name: str, verb: str) -> optparse.OptionParser:
     return p
 
 
-def compress_cmd(argv: List[str], prog: str) -> int:
+def compress_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = _file_op_parser(prog, "compress", "Compress")
     p.add_option("-j", "--bz2", action="store_const", dest="compression", help="use BZ2 compression", const="bz2", default="bz2")
     p.add_option("--lz4", action="store_const", dest="compression", help="use lz4 compression", const="lz4")
@@ -249,7 +251,7 @@ def compress_cmd(argv: List[str], prog: str) -> int:
                   bool(options.quiet))
 
 
-def decompress_cmd(argv: List[str], prog: str) -> int:
+def decompress_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = _file_op_parser(prog, "decompress", "Decompress")
     options, args = p.parse_args(argv)
     if not args:
@@ -259,7 +261,7 @@ def decompress_cmd(argv: List[str], prog: str) -> int:
     return bag_op(args, "decompress", "none", options.output_dir, bool(options.force), bool(options.quiet))
 
 
-def reindex_cmd(argv: List[str], prog: str) -> int:
+def reindex_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = _file_op_parser(prog, "reindex", "Reindexes")
     p.description = DESCRIPTIONS["reindex"]
     options, args = p.parse_args(argv)
@@ -270,7 +272,42 @@ def reindex_cmd(argv: List[str], prog: str) -> int:
     return bag_op(args, "reindex", "none", options.output_dir, bool(options.force), bool(options.quiet))
 
 
-def check_cmd(argv: List[str], prog: str) -> int:
+def print_trans(old: Any, new: Any, indent: int) -> None:
+    """One migration as rosbag check prints it: ``* From: type [md5]`` / ``To: ...``."""
+    to_text = f"{new._type} [{new._md5sum}]" if new is not None else "Unknown"
+    print("    " * indent + f" * From: {old._type} [{old._md5sum}]")
+    print("    " * indent + f"   To:   {to_text}")
+
+
+def _print_migrations(migrations: list) -> None:
+    for path, missing in migrations:
+        print_trans(path[0].old_class, path[-1].new_class, 0)
+        if missing:
+            print(f"    {len(missing)} rules missing:")
+            for r in missing:
+                print_trans(r.old_class, r.new_class, 1)
+
+
+def _open_checked(path: str) -> Optional[int]:
+    """The exit status when ``path`` is not a bag the migrator can read, else None."""
+    from minros.bag import Bag, ROSBagException, ROSBagUnindexedException
+
+    try:
+        Bag(path).close()
+    except ROSBagUnindexedException:
+        return _fail(f"ERROR bag unindexed: {path}.  Run rosbag reindex.")
+    except (ROSBagException, OSError) as exc:
+        return _fail(f"ERROR reading {path}: {exc}")
+    return None
+
+
+def _migrator(rules: List[str], plugins: bool) -> Any:
+    from minros.bag.migration import MessageMigrator
+
+    return MessageMigrator(rules, plugins)
+
+
+def check_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = _parser(prog, "rosbag check BAG [-g RULEFILE] [EXTRARULES1 EXTRARULES2 ...]", DESCRIPTIONS["check"])
     p.add_option("-g", "--genrules", action="store", dest="rulefile", default=None, help="generate a rulefile named RULEFILE")
     p.add_option("-a", "--append", action="store_true", dest="append", help="append to the end of an existing rulefile after loading it")
@@ -280,12 +317,125 @@ def check_cmd(argv: List[str], prog: str) -> int:
         p.error("You must specify a bag file to check.")
     if options.append and options.rulefile is None:
         p.error("Cannot specify -a without also specifying -g.")
-    if options.rulefile is not None or len(args) > 1:
-        return _fail("ERROR: migration rule files are not supported by minros (rosbag check "
-                     "without -g and rule files reports what would need migrating)")
-    from minros.bag.ops import check
+    if options.rulefile is not None:
+        exists = os.path.isfile(options.rulefile)
+        if exists and not options.append:
+            p.error(f"The file {options.rulefile} already exists.  Include -a if you intend to append.")
+        if not exists and options.append:
+            p.error(f"The file {options.rulefile} does not exist, and so -a is invalid.")
+    status = _open_checked(args[0])
+    if status is not None:
+        return status
+    from minros.bag import ROSBagException
+    from minros.bag.migration import BagMigrationException, checkbag
 
-    return check(args[0])
+    try:
+        migrator = _migrator(args[1:] + ([options.rulefile] if options.append else []),
+                             not options.noplugins)
+        migrations = checkbag(migrator, args[0])
+    except BagMigrationException as exc:
+        return _fail(f"ERROR: {exc}")
+    except ROSBagException as exc:
+        return _fail(f"ERROR reading {args[0]}: {exc}")
+    if not migrations:
+        print("Bag file does not need any migrations.")
+        return 0
+    print("The following migrations need to occur:")
+    _print_migrations(migrations)
+    missing = [r for _path, rules in migrations for r in rules]
+    if options.rulefile is None:
+        print("\nAll rules defined.  Bag is ready to be migrated" if not missing
+              else "\nTo generate rules, please run with -g <rulefile>")
+        return 0
+    left = migrator.filter_rules_unique(missing)
+    if not left:
+        print(f"\nNo additional rule files needed to be generated.  {options.rulefile} not created.")
+        return 0
+    output = ""
+    while left:
+        extra = []
+        for r in left:
+            if r.new_class is not None:
+                output += r.get_class_def()
+                continue
+            # the type moved and no rule says where: ask, as rosbag check does
+            new_class = _ask_moved_type(r.old_class._type)
+            if new_class is None:
+                return _fail("ERROR: no type given for the moved message; no rule file written")
+            factory = migrator.make_update_rule(r.old_class, new_class)
+            rule = factory(migrator, "GENERATED." + factory.__name__)
+            rule.find_sub_paths()
+            needed = [x for x in migrator.expand_rules(rule.sub_rules) if not x.valid]
+            extra.extend(needed)
+            print(f"Creating the migration rule for {new_class._type} requires additional missing rules:")
+            for x in needed:
+                print_trans(x.old_class, x.new_class, 1)
+            output += rule.get_class_def()
+        left = migrator.filter_rules_unique(extra)
+    with open(options.rulefile, "a") as f:
+        f.write(output)
+    print(f"\nThe necessary rule files have been written to: {options.rulefile}")
+    return 0
+
+
+def _ask_moved_type(old_type: str) -> Any:
+    from minros.msgs import get_message_class
+
+    print(f"The message type {old_type} appears to have moved.  Please enter the type to migrate it to.")
+    while True:
+        sys.stdout.write(">")
+        sys.stdout.flush()
+        line = sys.stdin.readline()
+        if not line:
+            return None
+        try:
+            return get_message_class(line.strip())
+        except Exception:  # noqa: BLE001 - any type that cannot be loaded: ask again
+            print(f"'{line.strip()}' could not be found in your system.  Please make sure it is built.")
+
+
+def fix_cmd(argv: List[str], prog: str = "rosbag") -> int:
+    p = _parser(prog, "rosbag fix INBAG OUTBAG [EXTRARULES1 EXTRARULES2 ...]", DESCRIPTIONS["fix"])
+    p.add_option("-n", "--noplugins", action="store_true", dest="noplugins", help="do not load rulefiles via plugins")
+    p.add_option("--force", action="store_true", dest="force", help="proceed with migrations, even if not all rules defined")
+    options, args = p.parse_args(argv)
+    if not args:
+        p.error("You must pass input and output bag files.")
+    if len(args) < 2:
+        p.error("You must pass an output bag file.")
+    inbag, outbag, rules = args[0], args[1], args[2:]
+    ext = os.path.splitext(outbag)[1]
+    if ext == ".bmr":
+        p.error("Input file should be a bag file, not a rule file.")
+    if ext != ".bag":
+        p.error("Output file must be a bag file.")
+    status = _open_checked(inbag)
+    if status is not None:
+        return status
+    tmp = outbag + ".tmp"
+    for path in (outbag, tmp):
+        if os.path.exists(path) and not os.access(path, os.W_OK):
+            return _fail(f"Don't have permissions to access {path}")
+    from minros.bag import ROSBagException
+    from minros.bag.migration import BagMigrationException, fixbag2
+
+    try:
+        migrations = fixbag2(_migrator(rules, not options.noplugins), inbag, tmp, bool(options.force))
+    except (BagMigrationException, ROSBagException, OSError) as exc:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        return _fail(f"ERROR: {exc}")
+    if not migrations:
+        os.replace(tmp, outbag)
+        print("Bag migrated successfully.")
+        return 0
+    print("Bag could not be migrated.  The following migrations could not be performed:")
+    _print_migrations(migrations)
+    print("Try running 'rosbag check' to create the necessary rule files or run 'rosbag fix' "
+          "with the '--force' option.")
+    if os.path.exists(tmp):
+        os.remove(tmp)
+    return 1
 
 
 def _unavailable(name: str, why: str) -> Callable[[List[str], str], int]:
@@ -302,8 +452,7 @@ COMMANDS: Dict[str, Callable[[List[str], str], int]] = {
     "decrypt": _unavailable("decrypt", "encrypted bags are not supported"),
     "encrypt": _unavailable("encrypt", "encrypted bags are not supported"),
     "filter": filter_cmd,
-    "fix": _unavailable("fix", "it has no message migration rules; the bag plays and reads with "
-                               "the definitions it stores"),
+    "fix": fix_cmd,
     "info": info_cmd, "play": play_cmd, "record": record_cmd, "reindex": reindex_cmd,
 }
 
@@ -373,6 +522,169 @@ def play_node_main() -> int:
         return play_cmd(sys.argv[1:], "rosbag")
     except SystemExit as exc:
         return int(exc.code or 0)
+
+
+# ---------------------------------------------------------------------------------------------
+# rosbag.rosbag_main's Python API (the stand-in re-exports it): the commands above take
+# argv without the command name, as rosbag's do, and return the exit status; these are the
+# pieces they are built from
+
+handle_split = _handle_split
+handle_topics = _collect("topics")
+handle_pause_topics = _collect("pause_topics")
+encrypt_cmd = COMMANDS["encrypt"]
+decrypt_cmd = COMMANDS["decrypt"]
+
+
+def bag_op(inbag_filenames: List[str], allow_unindexed: bool, open_inbag: bool,
+           copy_fn: Callable[[Any], bool], op: Callable[..., None],
+           output_dir: Optional[str] = None, force: bool = False, quiet: bool = False) -> None:
+    """Run ``op(inbag, outbag, quiet=quiet)`` on each bag, writing in place (the input kept
+    as ``NAME.orig.EXT``) or into ``output_dir``. ``copy_fn(bag)`` says whether to start
+    from a copy of the input (opened for appending) rather than an empty bag; without
+    ``open_inbag``, ``op`` gets the input's file name."""
+    import shutil
+
+    from minros.bag import Bag, ROSBagException, ROSBagUnindexedException
+
+    for name in inbag_filenames:
+        copy = False
+        if open_inbag:
+            try:
+                with Bag(name, "r", allow_unindexed=allow_unindexed) as inbag:
+                    copy = bool(copy_fn(inbag))
+            except ROSBagUnindexedException:
+                _fail(f"ERROR bag unindexed: {name}.  Run rosbag reindex.")
+                continue
+            except (ROSBagException, OSError) as exc:
+                _fail(f"ERROR reading {name}: {exc}")
+                continue
+        out_name = name if output_dir is None else os.path.join(output_dir, os.path.basename(name))
+        backup = None
+        source = name
+        if out_name == name:
+            root, ext = os.path.splitext(name)
+            backup = f"{root}.orig{ext}"
+            if not force and os.path.exists(backup):
+                if not quiet:
+                    _fail(f"Skipping {name}. Backup path {backup} already exists.")
+                continue
+            try:
+                (shutil.copy if copy else os.rename)(name, backup)
+            except OSError as exc:
+                _fail(f"ERROR {'copying' if copy else 'moving'} {name} to {backup}: {exc}")
+                continue
+            source = backup
+        elif copy:
+            shutil.copy(name, out_name)
+            source = out_name
+        try:
+            try:
+                outbag = Bag(out_name, "a" if copy else "w", allow_unindexed=allow_unindexed)
+            except (ROSBagException, OSError) as exc:
+                _fail(f"ERROR writing to {out_name}: {exc}")
+                continue
+            inbag = Bag(source, "r", allow_unindexed=allow_unindexed) if open_inbag else source
+            try:
+                op(inbag, outbag, quiet=quiet)
+            except ROSBagException as exc:
+                _fail(f"\nERROR operating on {source}: {exc}")
+            finally:
+                outbag.close()
+                if open_inbag:
+                    inbag.close()
+        except KeyboardInterrupt:
+            if backup is not None:
+                try:
+                    if copy:
+                        os.remove(backup)
+                    else:
+                        os.rename(backup, name)
+                except OSError:
+                    pass
+            raise
+        except (ROSBagException, OSError) as exc:
+            _fail(f"ERROR operating on {name}: {exc}")
+
+
+def change_compression_op(inbag: Any, outbag: Any, compression: str, quiet: bool) -> None:
+    """Copy every message of ``inbag`` into ``outbag`` with ``compression`` (as recorded:
+    raw bytes, connection headers kept), with rosbag's progress bar unless ``quiet``."""
+    from minros.bag.progress import ProgressMeter
+
+    outbag.compression = compression
+    meter = None if quiet else ProgressMeter(outbag.filename, inbag._uncompressed_size)
+    total = 0
+    for topic, msg, t, header in inbag.read_messages(raw=True, return_connection_header=True):
+        outbag.write(topic, msg, t, raw=True, connection_header=header)
+        if meter is not None:
+            total += len(msg[1])
+            meter.step(total)
+    if meter is not None:
+        meter.finish()
+
+
+def reindex_op(inbag: Any, outbag: Any, quiet: bool) -> None:
+    """Rebuild ``outbag``'s index (a copy of ``inbag`` opened for appending) from its chunks."""
+    from minros.bag import ROSBagEncryptException, ROSBagEncryptNotSupportedException
+    from minros.bag.progress import ProgressMeter
+
+    meter = None if quiet else ProgressMeter(outbag.filename, outbag.size)
+    try:
+        for offset in outbag.reindex():
+            if meter is not None:
+                meter.step(offset)
+    except (ROSBagEncryptNotSupportedException, ROSBagEncryptException):
+        raise
+    except Exception:  # noqa: BLE001 - damage past the last good chunk ends the scan, as in rosbag
+        pass
+    if meter is not None:
+        meter.finish()
+
+
+class RosbagCmds(collections.UserDict):
+    """rosbag's command table: name -> function(argv), ``help`` included."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._description: Dict[str, str] = {}
+        self["help"] = self.help_cmd
+
+    def add_cmd(self, name: str, function: Callable[[List[str]], Any], description: str) -> None:
+        self[name] = function
+        self._description[name] = description
+
+    def get_valid_cmds(self) -> str:
+        text = "Available subcommands:\n"
+        for name in sorted(self.keys()):
+            text += f"   {name}  "
+            if name in self._description:
+                text += f"\t{self._description[name]}"
+            text += "\n"
+        return text
+
+    def help_cmd(self, argv: List[str]) -> None:
+        argv = [a for a in argv if a not in ("-h", "--help")]
+        if not argv:
+            print("Usage: rosbag <subcommand> [options] [args]")
+            print()
+            print("A bag is a file format in ROS for storing ROS message data. The rosbag command "
+                  "can record, replay and manipulate bags.")
+            print()
+            print(self.get_valid_cmds())
+            print("For additional information, see http://wiki.ros.org/rosbag")
+            print()
+            return
+        if argv[0] in self:
+            self[argv[0]](["-h"])
+        else:
+            print(f"Unknown command: '{argv[0]}'", file=sys.stderr)
+            print(self.get_valid_cmds(), file=sys.stderr)
+
+
+def rosbagmain(argv: Optional[List[str]] = None) -> None:
+    """The rosbag command (``argv`` as sys.argv, program name first)."""
+    sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
 
 
 if __name__ == "__main__":  # rosrun rosbag rosbag / <node pkg="rosbag" type="rosbag">

@@ -21,11 +21,11 @@ from typing import Any, List
 from urllib.parse import urlparse
 
 from minros import logfiles
+from minros.cli import rosversion
+from minros.cli.rosversion import ROSDISTRO
 from minros.rosenv import renew_latest_log_dir
 from minros.signals import SignalWatch
 
-#: minros implements the Noetic protocols; tools that ask for the distro get a real one.
-ROSDISTRO = "noetic"
 DEFAULT_PORT = 11311
 ROSCORE_PARAMS = ("/rosdistro", "/rosversion", "/run_id")
 DISK_USAGE_WARNING = 1 << 30
@@ -209,11 +209,13 @@ def main(argv: List[str], prog: str = "minros core") -> int:
 
     run_id = str(uuid.uuid1())
     version = _version()
+    # roscore.xml sets /rosversion to `rosversion roslaunch`: the ros_comm release minros speaks
+    ros_version = rosversion.version_of("roslaunch") or version
     try:
         core = master_mod.Master(port, hostname=args.host, **kwargs)
         # set before the server starts, so that no client ever sees a master without them
         core.handler.setParam("/roscore", "/rosdistro", ROSDISTRO + "\n")
-        core.handler.setParam("/roscore", "/rosversion", version + "\n")
+        core.handler.setParam("/roscore", "/rosversion", ros_version + "\n")
         core.handler.setParam("/roscore", "/run_id", run_id)
         core.start()
     except OSError as exc:
@@ -255,7 +257,7 @@ def main(argv: List[str], prog: str = "minros core") -> int:
         else:
             out.write("Done checking log file disk usage. Usage is <1GB.\n")
     out.write(f"\nminros version {version}\n\n\nSUMMARY\n========\n\nPARAMETERS\n"
-              f" * /rosdistro: {ROSDISTRO}\n * /rosversion: {version}\n\nNODES\n\n"
+              f" * /rosdistro: {ROSDISTRO}\n * /rosversion: {ros_version}\n\nNODES\n\n"
               "auto-starting new master\n"
               f"{style.bold}process[master]: started with pid [{os.getpid()}]{style.end}\n"
               f"{style.bold}ROS_MASTER_URI={core.uri}{style.end}\n\n"

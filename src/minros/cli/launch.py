@@ -118,9 +118,12 @@ def _master_uri(options: argparse.Namespace) -> str:
 
     # as rosgraph.get_master_uri in roslaunch: the first __master:= on the command line beats
     # the environment, and one without a value is an error
-    value = remapped_master(options.positional)
+    try:
+        value = remapped_master(options.positional)
+    except ValueError as exc:
+        raise LaunchError(str(exc)) from None
     if value is not None:
-        if not value.strip() or ":=" in value:
+        if not value.strip():
             raise LaunchError(f"__master remapping argument '__master:={value}' improperly specified")
         value = value.strip()
     uri = get_master_uri(remapped=value)

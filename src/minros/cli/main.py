@@ -24,12 +24,19 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "srv": ("minros.cli.srv", "show and hash service types (rossrv)"),
     "graph": ("minros.cli.graph", "draw the node/topic graph as DOT, SVG or PNG (rqt_graph)"),
     "pkg": ("minros.cli.pkg", "find and list packages (rospack)"),
+    "version": ("minros.cli.rosversion", "print a package's version or the ROS distribution (rosversion)"),
     "ws": ("minros.cli.ws", "catkin workspaces: init, create_pkg, make"),
     "web": ("minros.cli.web", "rosbridge, rosapi, Foxglove and video for browsers, on one port"),
     "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
     "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
+    "sim": ("minros.cli.sim", "a 2D robot simulator with map_server and move_base (Stage-like)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
+    "clean": ("minros.cli.clean", "check the size of the ROS log files and purge them (rosclean)"),
+    "wtf": ("minros.cli.wtf", "check the ROS environment and the running graph (roswtf)"),
+    "master": ("minros.master", "run a ROS master alone, without rosout (rosmaster)"),
+    "learn": ("minros.cli.learn", "exercises on the ROS wire that check themselves"),
+    "zenoh": ("minros.cli.zenoh", "bridge topics and services with Zenoh (zenoh-bridge-ros1's wire)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -45,12 +52,16 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "rossrv": ("srv", []),
     "rqt_graph": ("graph", []),
     "rospack": ("pkg", []),
+    "rosversion": ("version", []),
     "catkin_init_workspace": ("ws", ["init"]),
     "catkin_create_pkg": ("ws", ["create_pkg"]),
     "catkin_make": ("ws", ["make"]),
     "rosbag": ("bag", []),
     "rostest": ("test", []),
     "rosconsole": ("console", []),
+    "rosclean": ("clean", []),
+    "roswtf": ("wtf", []),
+    "rosmaster": ("master", []),
 }
 
 
@@ -123,12 +134,16 @@ rosmsg = _alias("rosmsg")
 rossrv = _alias("rossrv")
 rqt_graph = _alias("rqt_graph")
 rospack = _alias("rospack")
+rosversion = _alias("rosversion")
 catkin_init_workspace = _alias("catkin_init_workspace")
 catkin_create_pkg = _alias("catkin_create_pkg")
 catkin_make = _alias("catkin_make")
 rosbag = _alias("rosbag")
 rostest = _alias("rostest")
 rosconsole = _alias("rosconsole")
+rosclean = _alias("rosclean")
+roswtf = _alias("roswtf")
+rosmaster = _alias("rosmaster")
 
 if __name__ == "__main__":
     sys.exit(main())

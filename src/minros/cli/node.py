@@ -523,13 +523,148 @@ def rosnode_get_api_uri(master: Any, caller_id: str, skip_cache: bool = False) -
     return _library(lambda: _Graph().node_uri(caller_id, skip_cache))
 
 
-def rosnode_info(node_name: str) -> None:
-    print(_library(lambda: info_description(Master(ID), node_name)))
-
-
 def rosnodemain(argv: List[str] | None = None) -> None:
     """The rosnode command (``argv`` as sys.argv, program name first)."""
     sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
+
+
+# -- more of rosnode's Python API: the pieces its commands print, and the clean-up helpers
+
+def _graph_of(master: Any) -> _Graph:
+    """A _Graph asking ``master`` (a rosgraph.Master) when it is minros's, else the
+    environment's master."""
+    graph = _Graph()
+    if isinstance(master, Master):
+        graph.master = master
+    return graph
+
+
+def rosnode_listnodes(namespace: str | None = None, list_uri: bool = False,
+                      list_all: bool = False) -> None:
+    """Print the nodes (under ``namespace``), their URIs (``list_uri``) or both."""
+    print(_library(lambda: _list_text(_Graph(), namespace, list_uri, list_all)))
+
+
+def lookup_uri(master: Any, system_state: Any, topic: str, uri: str) -> str:
+    """``'node (uri)'`` for the node of ``topic`` whose API is ``uri``, else ``uri``."""
+    return _library(lambda: _lookup_uri(_graph_of(master), system_state, topic, uri))
+
+
+def get_node_info_description(node_name: str) -> str:
+    """The publications, subscriptions and services ``rosnode info`` prints for a node."""
+    return _library(lambda: info_description(Master(ID), node_name))
+
+
+def get_node_connection_info_description(node_api: str, master: Any) -> str:
+    """The pid and connections of the node at ``node_api``, asked of the node itself."""
+    def run() -> str:
+        try:
+            return connection_description(_graph_of(master), node_api)
+        except ToolError as exc:
+            raise ROSNodeIOException(exc.text) from None
+
+    return _library(run)
+
+
+def rosnode_info_api(node_name: str, quiet: bool = False) -> None:
+    """Print what ``rosnode info [-q] NODE`` prints."""
+    def run() -> None:
+        graph = _Graph()
+        node = resolve(NAME, node_name)
+        print("-" * 80)
+        print(info_description(graph.master, node))
+        uri = graph.node_uri(node)
+        if not uri:
+            sys.stdout.flush()
+            print(f"cannot contact [{node}]: unknown node", file=sys.stderr)
+            return
+        if not quiet:
+            print(f"\ncontacting node {uri} ...")
+            print(connection_description(graph, uri))
+
+    _library(run)
+
+
+def _hosts_of(graph: _Graph) -> List[Tuple[str, str]]:
+    """``(node, host)`` of every node the master can name a URI for."""
+    out = []
+    for node in get_node_names(graph.master):
+        uri = graph.node_uri(node)
+        host = urlparse(uri).hostname if uri else None
+        if host:
+            out.append((node, host))
+    return out
+
+
+def get_machines_by_nodes() -> List[str]:
+    """The host names in the URIs of the running nodes (one master lookup per node)."""
+    def run() -> List[str]:
+        machines: List[str] = []
+        for _node, host in _hosts_of(_Graph()):
+            if host not in machines:
+                machines.append(host)
+        return machines
+
+    return _library(run)
+
+
+def get_nodes_by_machine(machine: str) -> List[str]:
+    """The nodes whose URI's host is ``machine`` or resolves to one of its addresses."""
+    def addresses(host: str) -> set:
+        return {info[4][0] for info in socket.getaddrinfo(host, 0, 0, 0, socket.SOL_TCP)}
+
+    try:
+        wanted = addresses(machine)
+    except (OSError, UnicodeError):
+        raise ROSNodeException(f"cannot resolve machine name [{machine}] to address") from None
+
+    def run() -> List[str]:
+        found = []
+        for node, host in _hosts_of(_Graph()):
+            if host == machine or host in wanted:
+                found.append(node)
+                continue
+            try:
+                if addresses(host) & wanted:
+                    found.append(node)
+            except (OSError, UnicodeError):
+                continue
+        return found
+
+    return _library(run)
+
+
+def cleanup_master_blacklist(master: Any, blacklist: List[str]) -> None:
+    """Unregister every topic and service the nodes of ``blacklist`` registered."""
+    _library(lambda: cleanup_master(_graph_of(master), list(blacklist)))
+
+
+def cleanup_master_whitelist(master: Any, whitelist: List[str]) -> None:
+    """Unregister every registration of the nodes not in ``whitelist``."""
+    def run() -> None:
+        graph = _graph_of(master)
+        pubs, subs, srvs = graph.master.system_state()
+        for method, section in (("unregisterPublisher", pubs), ("unregisterSubscriber", subs)):
+            for topic, nodes in section:
+                for node in nodes:
+                    if node not in whitelist:
+                        Master(node, graph.master.uri).raw(method, topic, graph.node_uri(node) or "")
+        for service, nodes in srvs:
+            for node in nodes:
+                if node not in whitelist:
+                    try:
+                        service_uri = graph.master.lookupService(service)
+                    except MasterException:
+                        continue
+                    Master(node, graph.master.uri).raw("unregisterService", service, service_uri)
+
+    _library(run)
+
+
+def rosnode_cleanup() -> None:
+    """``rosnode cleanup``: ping every node, then (asking y/n on stdin) purge the master's
+    registrations of those that did not answer."""
+    _library(lambda: _cmd_cleanup([], "rosnode cleanup"))
 
 
 if __name__ == "__main__":  # rosrun rosnode rosnode

@@ -60,6 +60,22 @@ def yaml_load(text: str) -> Any:
         return load_yaml(text)  # YAML errors come back as ValueError, like bad angle values
     except ValueError as exc:
         raise ToolError(f"invalid YAML: {_one_line(exc)}") from None
+    except RecursionError:
+        raise ToolError(f"invalid YAML: {TOO_DEEP}") from None
+
+
+#: PyYAML composes nested collections recursively: past ~300 levels it runs out of stack
+TOO_DEEP = "collections nested too deeply to be a parameter (keep it under 200 levels)"
+
+
+def read_text(data: bytes, source: str) -> str:
+    """The text of a parameter file (UTF-8, as YAML is), or one line saying where it is not."""
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise ToolError(f"{source} is not UTF-8 text: byte 0x{data[exc.start]:02x} on line {line} "
+                        "(save it as UTF-8)") from None
 
 
 def _one_line(exc: BaseException) -> str:
@@ -126,6 +142,8 @@ def load_documents(text: str, default_ns: str, verbose: bool = False) -> List[Tu
         docs = list(yaml.load_all(text, Loader=_loader()))  # noqa: S506 - SafeLoader subclass
     except (yaml.YAMLError, ValueError) as exc:
         raise ToolError(f"invalid YAML: {_one_line(exc)}") from None
+    except RecursionError:
+        raise ToolError(f"invalid YAML: {TOO_DEEP}") from None
     out = []
     for doc in docs:
         if doc is None:
@@ -271,8 +289,9 @@ def _cmd_set(argv: List[str], prog: str) -> int:
     if args.text_file:
         if not os.path.isfile(args.text_file):
             p.error(f"file '{args.text_file}' does not exist")
-        with open(args.text_file) as f:
-            set_param_raw(master, name, f.read(), args.verbose)
+        with open(args.text_file, "rb") as f:
+            text = read_text(f.read(), f"file [{args.text_file}]")
+        set_param_raw(master, name, text, args.verbose)
     elif args.bin_file:
         try:
             with open(args.bin_file, "rb") as f:
@@ -301,14 +320,14 @@ def _cmd_load(argv: List[str], prog: str) -> int:
     if args.file == "-":
         if args.verbose:
             print("reading parameters from stdin")
-        text = sys.stdin.read()
+        text = read_text(sys.stdin.buffer.read(), "stdin")
     else:
         if not os.path.isfile(args.file):
             raise ToolError(f"file [{args.file}] does not exist")
         if args.verbose:
             print(f"reading parameters from [{args.file}]")
-        with open(args.file) as f:
-            text = f.read()
+        with open(args.file, "rb") as f:
+            text = read_text(f.read(), f"file [{args.file}]")
     master = _master()
     for params, ns in load_documents(text, default_ns, args.verbose):
         if ns == "/" and not isinstance(params, dict):
@@ -385,11 +404,11 @@ def load_file(filename: str, default_namespace: str | None = None,
     def run() -> List[Tuple[Any, str]]:
         ns = resolve(NAME, default_namespace or "")
         try:
-            with open(filename) as f:
-                text = f.read()
+            with open(filename, "rb") as f:
+                data = f.read()
         except OSError as exc:
             raise ToolError(f"file [{filename}] does not exist: {exc.strerror}") from None
-        return load_documents(text, ns, verbose)
+        return load_documents(read_text(data, f"file [{filename}]"), ns, verbose)
 
     return _library(run)
 
@@ -442,6 +461,63 @@ def dump_params(filename: str, param: str, verbose: bool = False) -> None:
 def yamlmain(argv: List[str] | None = None) -> None:
     """The rosparam command (``argv`` as sys.argv, program name first)."""
     sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
+
+
+# -- more of rosparam's Python API: its YAML hooks and helpers (the angle and binary tags are
+# minros.launch.rosparam_yaml's, on a loader of their own: importing rosparam patches nothing)
+
+#: the key of a YAML document that names the namespace it loads into
+NS = "_ns"
+
+
+def get_param_server() -> Master:
+    """The master client rosparam's calls go through (caller id ``/rosparam-<pid>``)."""
+    return _master()
+
+
+def load_str(text: str, filename: str | None, default_namespace: str | None = None,
+             verbose: bool = False) -> List[Tuple[Any, str]]:
+    """``[(values, namespace), ...]`` for the YAML documents in ``text`` (``_ns`` keys
+    honoured; ``filename`` only names the source)."""
+    def run() -> List[Tuple[Any, str]]:
+        return load_documents(text, default_namespace or names.get_ros_namespace(), verbose)
+
+    return _library(run)
+
+
+def construct_angle_radians(loader: Any, node: Any) -> float:
+    """YAML constructor of ``!radians 2*pi`` / ``rad(pi/2)``: the value in radians."""
+    from minros.launch.rosparam_yaml import RosparamLoader
+
+    try:
+        return RosparamLoader.yaml_constructors["!radians"](loader, node)
+    except ValueError as exc:
+        raise RosParamException(str(exc)) from None
+
+
+def construct_angle_degrees(loader: Any, node: Any) -> float:
+    """YAML constructor of ``!degrees 180`` / ``deg(90)``: the value in radians."""
+    from minros.launch.rosparam_yaml import RosparamLoader
+
+    try:
+        return RosparamLoader.yaml_constructors["!degrees"](loader, node)
+    except ValueError as exc:
+        raise RosParamException(str(exc)) from None
+
+
+def construct_yaml_binary(loader: Any, node: Any) -> xmlrpc.client.Binary:
+    """YAML constructor of ``!!binary``: an XML-RPC Binary, as the parameter server stores it."""
+    return xmlrpc.client.Binary(loader.construct_yaml_binary(node))
+
+
+def represent_xml_binary(dumper: Any, data: xmlrpc.client.Binary) -> Any:
+    """YAML representer of an XML-RPC Binary: ``!!binary`` base64 text."""
+    return _represent_binary(dumper, data)
+
+
+def represent_foo(dumper: Any, data: Any) -> Any:
+    """rosparam's representer writing ``data`` as a scalar tagged ``#``."""
+    return dumper.represent_scalar("#", data)
 
 
 if __name__ == "__main__":  # rosrun rosparam rosparam / <node pkg="rosparam" type="rosparam">

@@ -396,5 +396,22 @@ def rosservicemain(argv: List[str] | None = None) -> None:
     sys.exit(main(list(sys.argv if argv is None else argv)[1:]))
 
 
+# -- more of rosservice's Python API
+
+def has_service_args(service_name: str, service_class: Any = None) -> bool:
+    """Whether the service's request has fields (``service_class`` saves asking the
+    service for its type)."""
+    def run() -> bool:
+        cls = service_class or get_service_class_by_name(_master(), resolve(NAME, service_name))
+        return len(cls._request_class.__slots__) > 0
+
+    return _library(run)
+
+
+def rosservice_find(service_type: str) -> List[str]:
+    """The services of type ``service_type`` (``rosservice find``)."""
+    return _library(lambda: find_services(_master(), service_type))
+
+
 if __name__ == "__main__":  # rosrun rosservice rosservice
     sys.exit(main(sys.argv[1:]))

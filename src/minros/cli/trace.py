@@ -3,6 +3,7 @@
     minros trace [-o FILE] [--messages] -- COMMAND [ARGS...]   run COMMAND traced
     minros trace show [--follow] [--topic T] [--service S] FILE...
     minros trace pcap FILE... -o OUT.pcap
+    minros trace dissector [-o minros.lua] [--type TYPE] [FILE...]
 
 The first form runs COMMAND with ``MINROS_TRACE=FILE`` in its environment, so it and every
 minros process it starts (a launch file's nodes, a core's rosout) append their events to FILE
@@ -21,10 +22,13 @@ from typing import Any, List, Optional
 USAGE = """usage: minros trace [-o FILE] [--messages] [--frames N] [--bytes N] [--] COMMAND [ARGS...]
        minros trace show [--follow] [--topic T] [--service S] [--node N] [--frames N|all] [--all] FILE...
        minros trace pcap FILE... [-o OUT.pcap]
+       minros trace dissector [-o minros.lua] [--type TYPE]... [FILE...]
 
 Record what minros processes say on the ROS wire (XML-RPC calls, TCPROS connection headers,
-message frames), then read it as the numbered sequence courses teach, or open it in Wireshark.
-Run 'minros trace show --help' or 'minros trace pcap --help' for their options."""
+message frames), then read it as the numbered sequence courses teach, or open it in Wireshark
+(with the Lua dissector 'dissector' writes, message bodies are decoded by type).
+Run 'minros trace show --help', 'minros trace pcap --help' or 'minros trace dissector --help'
+for their options."""
 
 
 def main(argv: List[str], prog: Optional[str] = None) -> int:
@@ -33,6 +37,8 @@ def main(argv: List[str], prog: Optional[str] = None) -> int:
         return _show(argv[1:], f"{prog} show")
     if argv and argv[0] == "pcap":
         return _pcap(argv[1:], f"{prog} pcap")
+    if argv and argv[0] == "dissector":
+        return _dissector(argv[1:], f"{prog} dissector")
     return _record(argv, prog)
 
 
@@ -235,4 +241,75 @@ def _pcap(argv: List[str], prog: str) -> int:
         print("  " + " ".join(shlex.quote(arg) for arg in pcap.tshark_command(args.output, ports)))
         print("  (Wireshark: Analyze > Decode As..., TCP port, TCPROS; the tcpros_tcp heuristic "
               "alone finds only messages that start with a Header)")
+        print("  or decode the message bodies by type: minros trace dissector -o minros.lua "
+              f"{' '.join(map(shlex.quote, args.files))}; "
+              f"tshark -X lua_script:minros.lua -r {shlex.quote(args.output)} -V")
+    return 0
+
+
+# --------------------------------------------------------------------------- dissector
+
+
+def _dissector(argv: List[str], prog: str) -> int:
+    from minros.tools.trace import dissector
+
+    parser = argparse.ArgumentParser(
+        prog=prog, description="Write a Lua dissector for Wireshark and tshark that finds TCPROS "
+                               "connections by themselves and decodes message bodies by type, "
+                               "from the message_definition of the connection headers in the "
+                               "same capture (nested types, arrays, strings, time). Service "
+                               "headers carry no definition: the service types named with "
+                               "--type or found in the trace files given are written into it.",
+        epilog="Then: tshark -X lua_script:minros.lua -r run.pcap -V (or copy minros.lua into "
+               "Wireshark's personal Lua plugins folder, Help > About > Folders).")
+    parser.add_argument("files", nargs="*", metavar="FILE",
+                        help="trace files whose service types the dissector should know")
+    parser.add_argument("-o", "--output", default="minros.lua", metavar="OUT",
+                        help="the Lua file to write (default minros.lua; '-' for stdout)")
+    parser.add_argument("--type", action="append", default=[], metavar="TYPE", dest="types",
+                        help="a message or service type to embed (repeatable), e.g. "
+                             "rospy_tutorials/AddTwoInts")
+    args = parser.parse_args(argv)
+    files = _load(args.files, prog) if args.files else []
+    if files is None:
+        return 1
+    try:
+        known = dissector.known_types(args.types)
+    except dissector.UnknownType as exc:
+        print(f"{prog}: {exc}; check the name with 'rosmsg show' or 'rossrv show'",
+              file=sys.stderr)
+        return 1
+    found = dissector.types_in_events(ev for trace_file in files for ev in trace_file.events)
+    extra = dissector.known_types([name for name in found if name not in known.services],
+                                  quiet=True)
+    known.services.update(extra.services)
+    missing = [name for name in found if name not in known.services]
+    try:
+        from importlib.metadata import version
+
+        minros_version = version("minros")
+    except Exception:  # noqa: BLE001 - a source checkout without metadata
+        minros_version = ""
+    text = dissector.lua_source(known, minros_version)
+    if args.output == "-":
+        sys.stdout.write(text)
+    else:
+        try:
+            with open(args.output, "w", encoding="utf-8") as out:
+                out.write(text)
+        except OSError as exc:
+            print(f"{prog}: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
+            return 1
+    _report_stops(files, prog)
+    names = sorted(known.services) + sorted(known.messages)
+    where = sys.stderr if args.output == "-" else sys.stdout
+    if args.output != "-":
+        print(f"wrote {args.output}: TCPROS with message bodies decoded from the capture's "
+              "connection headers" + (f", and the types {', '.join(names)}" if names else ""),
+              file=where)
+        print(f"  tshark -X lua_script:{shlex.quote(args.output)} -r run.pcap -V", file=where)
+    if missing:
+        print(f"{prog}: the service types {', '.join(missing)} are not known here: their "
+              "bodies will show as bytes (ROS_PACKAGE_PATH names the packages that define them)",
+              file=sys.stderr)
     return 0

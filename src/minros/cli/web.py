@@ -1,8 +1,10 @@
 """``minros web``: rosbridge v2 with rosapi, Foxglove WebSocket and video endpoints on one port.
 
-``minros web [--port 9090] [--host 127.0.0.1] [--token TOKEN] [--trace PATH...] ...`` runs
-until Ctrl-C as the node ``/minros_web`` (``__name:=`` renames it); ``--trace`` names the wire
-traces (``minros trace -o FILE -- COMMAND``) the page's Wire view follows. roslaunch users
+``minros web [--port 9090] [--host 127.0.0.1] [--token TOKEN] [--allow-origin ORIGIN]
+[--trace PATH...] ...`` runs until Ctrl-C as the node ``/minros_web`` (``__name:=`` renames
+it); ``--allow-origin`` (or MINROS_WEB_ALLOW_ORIGIN) lets pages of another site use the server;
+``--trace`` names the wire traces (``minros trace -o FILE -- COMMAND``) the page's Wire view
+follows. roslaunch users
 start the same server with ``roslaunch rosbridge_server rosbridge_websocket.launch`` or
 ``roslaunch foxglove_bridge foxglove_bridge.launch``.
 """
@@ -28,6 +30,14 @@ def _parser(prog: str) -> argparse.ArgumentParser:
                              "0.0.0.0 for every interface)")
     parser.add_argument("--token", help="a secret every client must present, as ?token=... in "
                                         "the URL or an 'Authorization: Bearer' header")
+    parser.add_argument("--allow-origin", action="append", default=[], metavar="ORIGIN",
+                        help="let pages of ORIGIN (scheme://host[:port], e.g. "
+                             "https://app.foxglove.dev for a Foxglove, Lichtblick or webviz app "
+                             "hosted there) use the server; repeatable, and added to the "
+                             "comma-separated list of $MINROS_WEB_ALLOW_ORIGIN. By default only "
+                             "the server's own pages and pages on localhost may (clients that "
+                             "are not web pages always may). 'null' allows file:// pages, '*' "
+                             "any page: then any web site you visit can drive your robot")
     parser.add_argument("--name", default="minros_web", help="node name (default minros_web)")
     parser.add_argument("--topics-glob", default="", metavar="GLOBS",
                         help="only these topics, e.g. '[/turtle1/*, /rosout]' (default: all)")
@@ -55,13 +65,23 @@ def _parser(prog: str) -> argparse.ArgumentParser:
 
 
 def main(argv: List[str], prog: str | None = None) -> int:
+    import os
+
     from minros.tools.common import strip_ros_args
     from minros.web.node import Settings, parse_globs, run
+    from minros.web.origin import ENV_VAR, OriginError, normalize, split_values
 
-    args = _parser(prog or "minros web").parse_args(strip_ros_args(list(argv)))
+    name = prog or "minros web"
+    args = _parser(name).parse_args(strip_ros_args(list(argv)))
     if not 0 <= args.port <= 65535:
-        print(f"{prog or 'minros web'}: error: --port {args.port} is not a TCP port (0-65535)",
-              file=sys.stderr)
+        print(f"{name}: error: --port {args.port} is not a TCP port (0-65535)", file=sys.stderr)
+        return 2
+    origins = split_values(os.environ.get(ENV_VAR, "")) + args.allow_origin
+    try:
+        for origin in origins:
+            normalize(origin)
+    except OriginError as exc:
+        print(f"{name}: error: {exc}", file=sys.stderr)
         return 2
     settings = Settings(host=args.host, port=args.port, token=args.token, name=args.name,
                         topics_glob=parse_globs(args.topics_glob),
@@ -70,5 +90,5 @@ def main(argv: List[str], prog: str | None = None) -> int:
                         graph_interval=max(0.05, args.graph_interval),
                         send_timeout=max(0.5, args.send_timeout),
                         max_message_size=args.max_message_size, compression=args.compression,
-                        trace=args.trace)
+                        trace=args.trace, allow_origins=origins)
     return run(settings, announce=lambda text: print(text, flush=True))

@@ -10,7 +10,8 @@ logger:
 * the /rosout handler (:mod:`minros.client.rosout_log`, installed by ``init_node`` unless
   ``disable_rosout``) publishes a ``rosgraph_msgs/Log`` per record.
 
-The console line itself is built by the pure function :func:`format_console_line`.
+The console line itself is built by the pure function :func:`format_console_line` and printed
+by rosgraph.roslogging's handler (:mod:`minros.roslogging`).
 """
 
 from __future__ import annotations
@@ -27,6 +28,12 @@ from typing import Any, Dict, Mapping, Tuple
 from minros import logfiles, node
 from minros.client import rostime
 from minros.rosenv import ros_log_dir
+from minros.roslogging import (  # noqa: F401 - the console line is rosgraph.roslogging's
+    DEFAULT_FORMAT,
+    RosStreamHandler,
+    format_console_line,
+    set_console_sources,
+)
 
 __all__ = [
     "DEBUG", "INFO", "WARN", "ERROR", "FATAL",
@@ -53,66 +60,16 @@ ROS_TO_LOGGING: Dict[int, int] = {
 }
 #: Python logging level -> rospy level
 LOGGING_TO_ROS: Dict[int, int] = {v: k for k, v in ROS_TO_LOGGING.items()}
-#: Python level name -> the severity word ROS prints, and its terminal colour
-_SEVERITY: Dict[str, Tuple[str, str | None]] = {
-    "DEBUG": ("DEBUG", "\033[32m"),
-    "INFO": ("INFO", None),
-    "WARNING": ("WARN", "\033[33m"),
-    "ERROR": ("ERROR", "\033[31m"),
-    "CRITICAL": ("FATAL", "\033[31m"),
-}
-_COLOR_RESET = "\033[0m"
 #: level names accepted by ~set_logger_level (upper-cased first)
 _NAME_TO_LOGGING = {"DEBUG": logging.DEBUG, "INFO": logging.INFO, "WARN": logging.WARNING,
                     "ERROR": logging.ERROR, "FATAL": logging.CRITICAL}
 _LOGGING_TO_NAME = {logging.DEBUG: "debug", logging.INFO: "info", logging.WARNING: "warn",
                     logging.ERROR: "error", logging.CRITICAL: "fatal", logging.NOTSET: "debug"}
 
-DEFAULT_FORMAT = "[${severity}] [${time}]: ${message}"
 ROSOUT_LOGGER = "rosout"
 
 
 # --------------------------------------------------------------------------- console
-
-def _expand_strftime_tag(text: str, tag: str, suffix: str) -> str:
-    """Replace every ``${tag:FORMAT}`` by ``time.strftime(FORMAT)`` (+ ``suffix``)."""
-    opener = "${" + tag + ":"
-    while opener in text:
-        start = text.index(opener)
-        end = text.find("}", start + len(opener))
-        if end < 0:  # unterminated tag: leave the rest alone rather than loop forever
-            break
-        fmt = text[start + len(opener):end]
-        text = text[:start] + time.strftime(fmt) + suffix + text[end + 1:]
-    return text
-
-
-def format_console_line(fmt: str, *, severity: str, message: str, wall_time: float,
-                        ros_time: float | None = None, node: str = "", logger: str = "",
-                        file: str = "", line: int = 0, function: str = "",
-                        thread: Any = "") -> str:
-    """One console line (without newline) for a log record, as rospy's console prints it.
-
-    ``fmt`` uses ROSCONSOLE_FORMAT tags: ``${severity} ${message} ${time} ${time:STRFTIME}
-    ${walltime} ${walltime:STRFTIME} ${node} ${logger} ${file} ${line} ${function} ${thread}``.
-    ``${time}`` is the wall time as ``%f``, followed by ``, <ros time>`` when the node runs on
-    simulated time (``ros_time`` given).
-    """
-    sim_suffix = "" if ros_time is None else f", {ros_time:f}"
-    out = fmt.replace("${severity}", severity)
-    out = out.replace("${message}", str(message))
-    out = out.replace("${walltime}", f"{wall_time:f}")
-    out = _expand_strftime_tag(out, "walltime", "")
-    out = out.replace("${thread}", str(thread))
-    out = out.replace("${logger}", str(logger))
-    out = out.replace("${file}", str(file))
-    out = out.replace("${line}", str(line))
-    out = out.replace("${function}", str(function))
-    out = out.replace("${node}", node)
-    out = out.replace("${time}", f"{wall_time:f}" + sim_suffix)
-    out = _expand_strftime_tag(out, "time", sim_suffix)
-    return out
-
 
 def _ros_time_or_none() -> float | None:
     """The simulated time for the console's ``${time}``, or None on wall-clock time."""
@@ -121,47 +78,9 @@ def _ros_time_or_none() -> float | None:
     return rostime.get_time()
 
 
-class ConsoleHandler(logging.Handler):
-    """Writes records in ROSCONSOLE_FORMAT: DEBUG/INFO to stdout, WARN and worse to stderr.
-
-    The streams are looked up per record (not captured at creation) so redirecting
-    ``sys.stdout`` later, as test runners do, is honoured.
-    """
-
-    _plain = logging.Formatter()
-
-    def __init__(self, colorize: bool = True, stdout: Any=None, stderr: Any=None) -> None:
-        super().__init__()
-        self._colorize = colorize
-        self._stdout = stdout
-        self._stderr = stderr
-
-    def emit(self, record: logging.LogRecord) -> None:
-        try:
-            severity, color = _SEVERITY.get(record.levelname, (record.levelname, None))
-            line = format_console_line(
-                os.environ.get("ROSCONSOLE_FORMAT", DEFAULT_FORMAT),
-                severity=severity,
-                message=self._plain.format(record),
-                wall_time=time.time(),
-                ros_time=_ros_time_or_none(),
-                node=node.get_caller_id(),
-                logger=record.name,
-                file=record.pathname,
-                line=record.lineno,
-                function=getattr(record, "ros_function", record.funcName),
-                thread=record.thread,
-            ) + "\n"
-            if record.levelno < logging.WARNING:
-                stream = self._stdout or sys.stdout
-            else:
-                stream = self._stderr or sys.stderr
-            if self._colorize and color and hasattr(stream, "isatty") and stream.isatty():
-                line = color + line + _COLOR_RESET
-            stream.write(line)
-            stream.flush()
-        except Exception:
-            self.handleError(record)
+#: the console handler is rosgraph.roslogging's, fed this node's clock and name
+ConsoleHandler = RosStreamHandler
+set_console_sources(_ros_time_or_none, node.get_caller_id)
 
 
 def _install_console_handler() -> logging.Logger:

@@ -111,6 +111,21 @@ class ParamCache:
                 raise KeyError(key)
             return value
 
+    def delete(self, key: str) -> None:
+        """Forget ``key``; KeyError if it is not cached (rospy.impl.paramserver's contract)."""
+        with self.lock:
+            parts = self._parts(key)
+            d = self.tree
+            if d is None or not parts:
+                raise KeyError(key)
+            for part in parts[:-1]:
+                d = d.get(part) if isinstance(d, dict) else None
+                if d is None:
+                    raise KeyError(key)
+            if not isinstance(d, dict) or parts[-1] not in d:
+                raise KeyError(key)
+            del d[parts[-1]]
+
     def clear(self) -> None:
         with self.lock:
             self.tree = None

@@ -11,11 +11,16 @@ a message's large array from a shared-memory connection's slot, so that publishi
 nothing (the other connections get the frame as usual). The publication keeps what ROS
 keeps per topic: the latched message (sent first to every new subscriber), the sequence number,
 the SubscribeListeners, the user's extra header fields.
+
+Code written against rospy's ``_PublisherImpl`` finds its names here too (``add_connection``,
+``publish(msg, connection_override)``, ``acquire``/``release``, ``has_connection``): rospy's
+own transports (:mod:`minros.rospy_internals.transport`) are transports of this seam.
 """
 
 from __future__ import annotations
 
 import ctypes
+import io
 import logging
 import struct
 import threading
@@ -78,13 +83,13 @@ class Publication:
         fields.update(self.headers)
         return fields
 
-    def add_connection(self, transport: Transport) -> None:
+    def add_connection(self, transport: Transport) -> bool:
         """A subscriber's negotiated connection: the latched message goes first, then the
-        listeners hear of it."""
+        listeners hear of it. False (and the transport closed) when the publication is."""
         with self.lock:
             if self.closed:
                 transport.close()
-                return
+                return False
             self.connections = self.connections + [transport]
             takes_objects = getattr(transport, "takes_objects", False)
             if takes_objects:
@@ -100,6 +105,7 @@ class Publication:
                 listener.peer_subscribe(self.resolved_name, self._publish_any, publish_single)
             except Exception:
                 _logger.error("peer_subscribe failed: %s", traceback.format_exc())
+        return True
 
     def remove_connection(self, transport: Transport) -> None:
         """A connection ended (the subscriber left or failed)."""
@@ -137,7 +143,9 @@ class Publication:
         self.message_data_sent += frame_len(frame) - 4
         return frame
 
-    def publish(self, msg: Any) -> None:
+    def publish(self, msg: Any, connection_override: Transport | None = None) -> None:
+        """Send ``msg`` to every connection, or to ``connection_override`` only (rospy's way
+        of sending to one subscriber); a latching publication keeps it for newcomers."""
         with self.lock:
             if self.closed:
                 if self.node.is_shutdown():
@@ -145,7 +153,7 @@ class Publication:
                 raise ROSException("publish() to a closed topic")
             if self.is_latch:
                 self.latch = msg
-            conns = self.connections
+            conns = self.connections if connection_override is None else [connection_override]
             if not conns:
                 self._give_back()
                 return
@@ -154,6 +162,8 @@ class Publication:
             if getattr(msg, "_has_header", False):
                 stamp_header(msg, self.seq)
             takers = self.takers
+            if connection_override is not None:
+                takers = [t for t in takers if t is connection_override]
             if takers:  # intra-process links: the object itself
                 for taker in takers:
                     taker.put(msg)
@@ -161,7 +171,9 @@ class Publication:
                     return
                 conns = [c for c in conns if c not in takers]
             lender = None
-            if self._loan is not None:  # a loaned array: its connection copies nothing
+            loan = self._loan
+            if loan is not None and any(c is loan[0] for c in conns):
+                # a loaned array: its connection copies nothing
                 lender = self._publish_loaned(msg)
                 if lender is not None:
                     conns = [c for c in conns if c is not lender]
@@ -233,7 +245,7 @@ class Publication:
 
     def has_connection(self, endpoint_id: str) -> bool:
         """rospy's query: is the subscriber node ``endpoint_id`` (its caller id) connected?"""
-        return any(c.header.get("callerid") == endpoint_id and not c.done for c in self.connections)
+        return any(c.endpoint_id == endpoint_id and not c.done for c in self.connections)
 
     def has_connections(self) -> bool:
         return any(not c.done for c in self.connections)
@@ -242,8 +254,22 @@ class Publication:
         return sum(1 for c in self.connections if not c.done)
 
     def get_stats_info(self) -> list:
-        return [[c.id, c.header.get("callerid", ""), "o", c.protocol, self.resolved_name, True,
+        return [[c.id, c.endpoint_id, "o", c.transport_type, self.resolved_name, True,
                  c.info()] for c in self.connections]
+
+    # rospy's _PublisherImpl names, for code written against them
+
+    @property
+    def buff(self) -> io.BytesIO:
+        """rospy's serialization buffer, empty between publishes: one here serializes into a
+        frame of its own each time, so this one is always empty."""
+        return io.BytesIO()
+
+    def acquire(self) -> None:
+        self.lock.acquire()
+
+    def release(self) -> None:
+        self.lock.release()
 
     def close(self) -> None:
         with self.lock:

@@ -111,7 +111,8 @@ def acquire_subscription(name: str, data_class: Any) -> Subscription:
     return sub
 
 
-def _release(impl: Endpoint) -> None:
+def release(impl: Endpoint) -> None:
+    """One reference fewer on ``impl``; the last one closes it and unregisters it."""
     with _impl_lock:
         impl.ref_count -= 1
         if impl.ref_count > 0:
@@ -148,7 +149,7 @@ class Topic:
     def unregister(self) -> None:
         impl, self.impl = self.impl, None
         if impl is not None:
-            _release(impl)
+            release(impl)
 
 
 class SubscribeListener:

@@ -5,6 +5,8 @@ of ROS 1's python3-diagnostic-updater (1.11), so aggregators and rqt_robot_monit
 minros node's diagnostics as any other's.
 """
 
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+
 from .functions import (
     FrequencyStatus,
     FrequencyStatusParam,
@@ -27,4 +29,6 @@ __all__ = [
     "CompositeDiagnosticTask", "DiagnosticTaskVector", "Updater", "FrequencyStatusParam",
     "FrequencyStatus", "TimeStampStatusParam", "TimeStampStatus", "Heartbeat",
     "HeaderlessTopicDiagnostic", "TopicDiagnostic", "DiagnosedPublisher",
+    # ROS's modules star-import these messages, so `from diagnostic_updater import *` gives them
+    "DiagnosticArray", "DiagnosticStatus", "KeyValue",
 ]

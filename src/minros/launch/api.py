@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import os
+import re
 import threading
 import uuid
 from typing import Any, Dict, List, Sequence, Tuple
@@ -21,6 +22,30 @@ __all__ = ["Node", "ROSLaunchParent", "ROSLaunch", "get_or_generate_uuid", "RLEx
 RLException = LaunchError
 
 
+def _namespace(ns: str | None) -> str:
+    return re.sub("//+", "/", names.make_global_ns(ns or "/"))
+
+
+def _cwd(cwd: str | None) -> str | None:
+    return "ROS_HOME" if cwd == "ros_home" else cwd  # lenient on case, as roslaunch
+
+
+def validate_node(node: NodeSpec) -> None:
+    """roslaunch's checks of a node's settings, with its texts (ValueError)."""
+    if node.respawn and node.required:
+        raise ValueError("respawn and required cannot both be set to true")
+    if node.name and "/" in node.name:
+        raise ValueError("node name cannot contain a namespace")
+    if not node.package.strip():
+        raise ValueError("package must be non-empty")
+    if not node.type.strip():
+        raise ValueError("type must be non-empty")
+    if node.output not in ("log", "screen", None):
+        raise ValueError("output must be one of 'log', 'screen'")
+    if node.cwd not in ("ROS_HOME", "node", None):
+        raise ValueError("cwd must be one of 'ROS_HOME', 'node'")
+
+
 class Node(NodeSpec):
     """roslaunch.core.Node: a node to launch, with roslaunch's constructor."""
 
@@ -32,15 +57,59 @@ class Node(NodeSpec):
                  cwd: str | None = None, launch_prefix: str | None = None, required: bool = False,
                  filename: str = "<unknown>") -> None:
         super().__init__(package=package, type=node_type, name=name or "",
-                         namespace=names.make_global_ns(namespace or "/"), args=args or "",
+                         namespace=_namespace(namespace), args=args or "",
                          remap_args=list(remap_args or []), env_args=list(env_args or []),
                          output=output, respawn=respawn, respawn_delay=respawn_delay,
-                         required=required, cwd=cwd, launch_prefix=launch_prefix,
-                         machine=machine_name, filename=filename)
+                         required=required, cwd=_cwd(cwd), launch_prefix=launch_prefix or None,
+                         machine=None, filename=filename)
+        #: the <machine> named in the launch file; ``machine`` is that Machine once assigned
+        self.machine_name = machine_name or None
+        validate_node(self)
 
     @property
     def node_type(self) -> str:
         return self.type
+
+    def xmltype(self) -> str:
+        return "node"
+
+    def xmlattrs(self) -> List[Tuple[str, Any]]:
+        return node_xmlattrs(self)
+
+    def to_xml(self) -> str:
+        """The node as launch XML (private parameters are not part of it)."""
+        return node_to_xml(self)
+
+    def to_remote_xml(self) -> str:
+        return node_to_xml(self, remote=True)
+
+
+def _xml_escape(s: Any) -> Any:
+    """``s`` with ``< > & "`` escaped (other values as they are)."""
+    if isinstance(s, str):
+        from xml.sax.saxutils import escape
+
+        return escape(s, entities={'"': "&quot;"})
+    return s
+
+
+def node_xmlattrs(node: Any) -> List[Tuple[str, Any]]:
+    """The attributes of a node's XML element, as roslaunch writes them."""
+    return [("pkg", node.package), ("type", node.type), ("machine", getattr(node, "machine_name", None)),
+            ("ns", node.namespace), ("args", node.args), ("output", node.output),
+            ("cwd", node.cwd or None), ("respawn", node.respawn),
+            ("respawn_delay", node.respawn_delay), ("name", node.name or None),
+            ("launch-prefix", node.launch_prefix), ("required", node.required)]
+
+
+def node_to_xml(node: Any, remote: bool = False) -> str:
+    """A node as launch XML (its remappings and environment included)."""
+    tag = node.xmltype()
+    attrs = [(a, v) for a, v in node.xmlattrs() if v is not None and not (remote and a == "machine")]
+    out = f"<{tag} " + " ".join(f'{a}="{_xml_escape(v)}"' for a, v in attrs) + ">\n"
+    out += "".join(f'  <remap from="{a}" to="{b}" />\n' for a, b in node.remap_args)
+    out += "".join(f'  <env name="{a}" value="{b}" />\n' for a, b in node.env_args)
+    return out + f"</{tag}>"
 
 
 def get_or_generate_uuid(options_runid: str | None = None,

@@ -48,6 +48,7 @@ class NodeSpec:
     line: int | None = None
     test_name: str | None = None
     time_limit: float | None = None
+    retry: int = 0  # a <test>'s reruns after a failure
 
     @property
     def resolved_name(self) -> str:
@@ -59,6 +60,12 @@ class Machine:
     name: str
     address: str
     default: str = "false"
+    # how to reach it (roslaunch's <machine> attributes; minros launches locally only)
+    env_loader: str | None = None
+    user: str | None = None
+    password: str | None = None
+    ssh_port: int = 22
+    timeout: float | None = None
 
 
 @dataclass

@@ -229,6 +229,15 @@ def _float_attr(value: str | None, default: float, label: str) -> float:
         raise ValueError(f"invalid float value for {label}: {value}") from None
 
 
+def _int_attr(value: str | None, default: int, label: str) -> int:
+    if value is None or value == "":
+        return default
+    try:
+        return int(value)
+    except ValueError:
+        raise ValueError(f"'{label}' must be a number: [{value}]") from None
+
+
 def _run_command(command: str, name: str, env: Mapping[str, str]) -> str:
     """Output of ``<param command=...>``; Python scripts run under minros's interpreter."""
     from minros.workspace.executables import child_environment, command_for
@@ -275,8 +284,14 @@ class Loader:
 
     def __init__(self, env: Mapping[str, str] | None = None,
                  find: Callable[[str], Path | None] | None = None,
-                 run_commands: bool = True, args_only: bool = False) -> None:
+                 run_commands: bool = True, args_only: bool = False,
+                 check_machines: bool = True, ignore_unset_args: bool = False) -> None:
         self.config = LaunchConfig()
+        #: roslaunch's check mode: a file (or include) that uses an arg without a value stops
+        #: there, keeping what came before it, instead of failing the load
+        self.ignore_unset_args = ignore_unset_args
+        #: False for roslaunch's loader API, whose config checks machine names later
+        self.check_machines = check_machines
         self.args_only = args_only  # `roslaunch --ros-args`: read the <arg> declarations only
         self.env = os.environ if env is None else env
         self.find = find
@@ -307,7 +322,8 @@ class Loader:
             self._launch_tag(root, scope)
             self._recurse(root.children, scope)
         except ArgError as exc:
-            raise LaunchError(f"requires the '{exc.name}' arg to be set", filename) from None
+            if not self.ignore_unset_args:
+                raise LaunchError(f"requires the '{exc.name}' arg to be set", filename) from None
         except RecursionError:  # hundreds of nested groups/includes: refuse, do not crash
             raise LaunchError("groups and includes nest too deeply", filename) from None
         finally:
@@ -446,12 +462,32 @@ class Loader:
         scope.env_args.append((name, value))
 
     def _machine_tag(self, el: Element, scope: Scope) -> None:
+        if any(a.startswith("ros-") for a in el.attrs):
+            raise ValueError("<machine>: ros-* attributes are not supported since ROS Fuerte.\n"
+                             "Please use env-loader instead.")
+        if any(c.tag == "env" for c in el.children):
+            raise ValueError("<machine>: <env> tag is not supported since ROS Fuerte.\n"
+                             "Please use env-loader instead.")
         self._check_attrs(el, scope, MACHINE_ATTRS)
         name, address = self._req(el, scope, "name"), self._req(el, scope, "address")
         default = (self._opt(el, scope, "default") or "false").lower()
         if default not in ("true", "false", "never"):
             raise ValueError(f"Invalid value for 'attribute': {default}")
-        self.config.machines[name] = Machine(name, address, default)
+        timeout, seconds = self._opt(el, scope, "timeout"), None
+        if timeout is not None:
+            if not timeout.strip():
+                raise ValueError("'timeout' cannot be empty")
+            try:
+                seconds = float(timeout)
+            except ValueError:
+                raise ValueError(f"'timeout' be a number: [{timeout}]") from None
+            if seconds <= 0:
+                raise ValueError(f"'timeout' be a positive number: [{seconds}]")
+        ssh_port = self._opt(el, scope, "ssh-port")
+        self.config.machines[name] = Machine(
+            name, address, default, env_loader=self._opt(el, scope, "env-loader"),
+            user=self._opt(el, scope, "user"), password=self._opt(el, scope, "password"),
+            ssh_port=int(ssh_port) if ssh_port else 22, timeout=seconds)
 
     # -- parameters
     def _param_value(self, el: Element, scope: Scope, name: str) -> Any:
@@ -553,7 +589,7 @@ class Loader:
         pkg, node_type = self._req(el, scope, "pkg"), self._req(el, scope, "type")
         opt = {a: self._opt(el, scope, a) for a in ("machine", "args", "output", "respawn",
                                                       "respawn_delay", "cwd", "launch-prefix",
-                                                      "required", "time-limit")}
+                                                      "required", "time-limit", "retry")}
         required = _bool_attr(opt["required"], False, "required")
         respawn = _bool_attr(opt["respawn"], False, "respawn")
         respawn_delay = _float_attr(opt["respawn_delay"], 0.0, "respawn_delay")
@@ -596,16 +632,24 @@ class Loader:
         for bad, message in problems:
             if bad:
                 raise self._err(scope, el, f"Invalid <{el.tag}> tag: {message}")
+        time_limit, retry = None, 0
+        if is_test:
+            try:
+                time_limit = _float_attr(opt["time-limit"], 60.0, "time-limit")
+                if time_limit <= 0:
+                    raise ValueError("'time-limit' must be a positive number")
+                retry = _int_attr(opt["retry"], 0, "retry")
+            except ValueError as exc:
+                raise self._err(scope, el, f"Invalid <{el.tag}> tag: {exc}") from None
         machine = opt["machine"]
-        if machine and machine not in self.config.machines:
+        if machine and self.check_machines and machine not in self.config.machines:
             raise self._err(scope, el, f"unknown machine [{machine}]")
         spec = NodeSpec(
             package=pkg, type=node_type, name=name, namespace=child.ns, args=opt["args"] or "",
             remap_args=remap_scope.remap_args(), env_args=list(env_scope.env_args), output=output,
             respawn=respawn, respawn_delay=respawn_delay, required=required, cwd=cwd,
             launch_prefix=opt["launch-prefix"] or None, machine=machine, filename=scope.filename,
-            line=el.line, test_name=test_name,
-            time_limit=_float_attr(opt["time-limit"], 60.0, "time-limit") if is_test else None)
+            line=el.line, test_name=test_name, time_limit=time_limit, retry=retry)
         if is_test:
             self.config.tests.append(spec)
         else:
@@ -656,7 +700,8 @@ class Loader:
             self._launch_tag(root, child)
             self._recurse(root.children, child)
         except ArgError as exc:
-            raise self._err(scope, el, f"included file [{inc}] requires the '{exc.name}' arg to be set") from None
+            if not self.ignore_unset_args:
+                raise self._err(scope, el, f"included file [{inc}] requires the '{exc.name}' arg to be set") from None
         finally:
             self._stack.pop()
             self._stack_names.pop()

@@ -34,6 +34,8 @@ class RostestOutcome:
     results: testing.Results = field(default_factory=testing.Results)
     failed_to_run: List[str] = field(default_factory=list)
     summary_file: Path | None = None
+    #: the run's own cases, ``test<name>`` each, failed with the reason when a test did not run
+    cases: List[testing.CaseResult] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -44,6 +46,17 @@ def _free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
+
+
+def summary_file(test_file: str, package: str, pkg_dir: Path | None,
+                 results_filename: str | None, env: Mapping[str, str]) -> Path:
+    """Where the run's own results go: ``<results>/<pkg>/rostest-<name>.xml`` (the name from
+    ``--results-filename`` without its extension, else from the file's path in its package)."""
+    if results_filename:
+        name = results_filename.rpartition(".")[0] if "." in results_filename else results_filename
+    else:
+        name = test_file_name(pkg_dir, Path(test_file))
+    return testing.results_file(package, name, is_rostest=True, env=env)
 
 
 def test_file_name(pkg_dir: Path | None, test_file: Path) -> str:
@@ -118,10 +131,12 @@ class _TestRun:
 def run_rostest(test_file: str, package: str, pkg_dir: Path | None, argv: Sequence[str] = (), *,
                 reuse_master: bool = False, text: bool = False, env: Mapping[str, str],
                 results_filename: str | None = None, out: Print = print,
-                err: Print = print) -> RostestOutcome:
+                err: Print = print, loaded: Callable[[], None] | None = None) -> RostestOutcome:
     """Run ``test_file`` (a launch file with ``<test>`` tags); raises LaunchError when the file
-    cannot be loaded (a broken ``<test>`` entry included)."""
+    cannot be loaded (a broken ``<test>`` entry included). ``loaded()`` is called once it is."""
     config = load_launch(test_file, list(argv), env=env)
+    if loaded is not None:
+        loaded()
     if reuse_master:
         master_uri, port = get_master_uri(env), None
     else:
@@ -159,8 +174,8 @@ def run_rostest(test_file: str, package: str, pkg_dir: Path | None, argv: Sequen
     finally:
         runner.stop()
         monitor.join(timeout=10)
-    summary = testing.results_file(package, results_filename or test_file_name(pkg_dir, Path(test_file)),
-                                   is_rostest=True, env=child_env)
+    summary = summary_file(test_file, package, pkg_dir, results_filename, child_env)
     testing.write_junit(summary, "rostest", cases, time.monotonic() - started)
     outcome.summary_file = summary
+    outcome.cases = cases
     return outcome

@@ -149,7 +149,9 @@ class LaunchProcess:
                 err.truncate(0)
             self._files = [out, err]
             stdout, stderr = out, err
-        self.popen = subprocess.Popen(self.argv, env=self.env, cwd=self.cwd, stdin=subprocess.DEVNULL,
+        # stdin inherited, as ROS's roslaunch does: a keyboard teleop started from a launch file
+        # reads the terminal (in a session of its own, it gets no job-control signals from it)
+        self.popen = subprocess.Popen(self.argv, env=self.env, cwd=self.cwd, stdin=None,
                                       stdout=stdout, stderr=stderr, start_new_session=True,
                                       preexec_fn=_PREEXEC)
         self.exit_code = None

@@ -192,8 +192,20 @@ def _apply(resolved: str, command_text: str, ctx: SubstitutionContext, passes: t
     else:  # find
         if len(args) != 1:
             raise SubstitutionError(f"$(find pkg) command only accepts one argument [{command_text}]")
-        value = _find(args[0], ctx)
+        return _find_with_path(resolved, token, _find(args[0], ctx))
     return resolved.replace(token, value)
+
+
+def _find_with_path(resolved: str, token: str, package_dir: str) -> str:
+    """Replace the first ``$(find pkg)`` and the path that follows it (up to a space) with the
+    file's path, as roslaunch: the path's separators are the platform's, a leading one is
+    dropped, and it is joined to the package's folder (``$(find a)$(find a)`` is 'A/A')."""
+    before, after = resolved.split(token, 1)
+    path, space, rest = after.partition(" ")
+    path = path.replace("/", os.sep).replace("\\", os.sep)
+    if path.startswith(os.sep):
+        path = path[1:]
+    return before + (os.path.join(package_dir, path) if path else package_dir) + space + rest
 
 
 def resolve_args(text: str | None, ctx: SubstitutionContext) -> str | None:
@@ -211,8 +223,14 @@ def resolve_args(text: str | None, ctx: SubstitutionContext) -> str | None:
 
 # ----------------------------------------------------------------------------- $(eval)
 
+#: roslaunch lists list, dict, map, str, float and int, but its eval gets every builtin (the
+#: table is in the wrong argument), and launch files and its own tests use more (round, len,
+#: ...): those that compute, without files, imports or introspection
 _EVAL_BUILTINS = {name: __builtins__[name] if isinstance(__builtins__, dict) else getattr(__builtins__, name)
-                  for name in ("list", "dict", "map", "str", "float", "int")}
+                  for name in ("list", "dict", "map", "str", "float", "int", "bool", "tuple", "set",
+                               "range", "len", "round", "abs", "min", "max", "sum", "pow",
+                               "divmod", "sorted", "reversed", "enumerate", "zip", "filter",
+                               "any", "all", "repr", "format", "chr", "ord", "hex", "oct", "bin")}
 
 
 class _EvalNames(dict):

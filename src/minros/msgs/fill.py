@@ -171,3 +171,7 @@ def get_printable_message_args(msg: Any, buff: Any = None, prefix: str = "") -> 
 
 #: the name minros's tools used for it
 printable_message_args = get_printable_message_args
+
+#: genpy.message's names of the two steps (code written for genpy calls them directly)
+_fill_message_args = _fill
+_fill_val = _fill_value

@@ -75,6 +75,7 @@ def namespace_hooks(package: str, kind: str, module_globals: dict
         if name.startswith("__") or not name[:1].isalpha():
             raise AttributeError(f"module '{package}.{kind}' has no attribute '{name}'")
         from .registry import UnknownTypeError, get_message_class, get_service_class
+        from .spec import MsgSpecError
 
         try:
             if kind == "msg":
@@ -82,7 +83,13 @@ def namespace_hooks(package: str, kind: str, module_globals: dict
             else:
                 value = _service_attr(package, name, get_message_class, get_service_class)
         except UnknownTypeError as exc:
+            if exc.located:
+                # the type exists but names one that does not: say so, not "cannot import
+                # name" (what ``from ... import`` makes of an AttributeError)
+                raise _broken(package, kind, name, exc) from None
             raise AttributeError(f"module '{package}.{kind}' has no attribute '{name}' ({exc})") from None
+        except MsgSpecError as exc:
+            raise _broken(package, kind, name, exc) from None
         module_globals[name] = value
         return value
 
@@ -90,6 +97,12 @@ def namespace_hooks(package: str, kind: str, module_globals: dict
         return sorted(set(module_globals) | set(type_names(package, kind)))
 
     return __getattr__, __dir__
+
+
+def _broken(package: str, kind: str, name: str, exc: Exception) -> ImportError:
+    """The ImportError of a type whose definition is there but broken (file and line in it)."""
+    return ImportError(f"cannot import name '{name}' from '{package}.{kind}': {exc}",
+                       name=f"{package}.{kind}")
 
 
 def _service_attr(package: str, name: str, get_message_class: Callable,
@@ -100,7 +113,9 @@ def _service_attr(package: str, name: str, get_message_class: Callable,
         if name.endswith(suffix) and len(name) > len(suffix):
             try:
                 service = get_service_class(f"{package}/{name[:-len(suffix)]}")
-            except UnknownTypeError:
+            except UnknownTypeError as exc:
+                if exc.located:
+                    raise  # the service exists; a type it uses does not
                 break
             return service._request_class if suffix == "Request" else service._response_class
     return get_service_class(f"{package}/{name}")

@@ -312,6 +312,54 @@ class MsgContext:
 
 
 # ---------------------------------------------------------------------------------------------
+# one line of a definition (genmsg's line parsers, which its tests and generators call)
+
+def _strip_comments(line: str) -> str:
+    return _spec._strip_comment(line)
+
+
+def convert_constant_value(field_type: str, val: str) -> object:
+    """A constant's value text as Python: ``ValueError`` when it is no value of the type,
+    :class:`InvalidMsgSpec` when it is out of the type's range or the type has no constants."""
+    if field_type not in PRIMITIVE_TYPES:
+        raise InvalidMsgSpec(f"invalid constant type: [{field_type}]")
+    try:
+        return _spec._convert_constant(field_type, val)
+    except _spec.ConstantRangeError as exc:
+        raise InvalidMsgSpec(str(exc)) from None
+
+
+def _load_constant_line(orig_line: str) -> Constant:
+    """``'int8 X=1'`` -> ``Constant('int8', 'X', 1, '1')`` (:class:`InvalidMsgSpec` if bad)."""
+    clean = _strip_comments(orig_line)
+    if not clean:
+        raise InvalidMsgSpec(f"Invalid constant declaration: {orig_line}")
+    try:
+        return _spec._parse_constant(orig_line, clean)
+    except ValueError as exc:
+        raise InvalidMsgSpec(str(exc)) from None
+
+
+def _load_field_line(orig_line: str, package_context: str) -> Tuple[str, str]:
+    """``'Header header'`` -> ``('std_msgs/Header', 'header')``; a bare message type is
+    resolved in ``package_context`` when one is given (:class:`InvalidMsgSpec` if bad)."""
+    try:
+        return _spec._parse_field(_strip_comments(orig_line), package_context)
+    except ValueError as exc:
+        raise InvalidMsgSpec(str(exc)) from None
+
+
+def includepath_to_dict(includepath: Sequence[str] | None) -> Dict[str, List[str]]:
+    """``['pkg:/dir', ...]`` (generators' ``-I`` options) -> the search path ``{pkg: [dir]}``."""
+    search_path: Dict[str, List[str]] = {}
+    for entry in includepath or ():
+        package, _, folder = entry.partition(":")
+        if folder:
+            search_path.setdefault(package, []).append(folder)
+    return search_path
+
+
+# ---------------------------------------------------------------------------------------------
 # loading
 
 def _check_search_path(search_path: Any) -> None:
@@ -407,7 +455,8 @@ def load_srv_by_type(msg_context: MsgContext, srv_type: str,
 
 def load_msg_depends(msg_context: MsgContext, spec: MsgSpec,
                      search_path: Mapping[str, Sequence[str]]) -> List[str]:
-    """Load every type ``spec`` embeds, recursively; returns its first-order dependencies."""
+    """Load every type ``spec`` embeds, recursively; returns (a copy of) its first-order
+    dependencies, one per field as genmsg lists them."""
     package_context = spec.package
     depends: List[str] = []
     for field in spec.parsed_fields():
@@ -419,11 +468,11 @@ def load_msg_depends(msg_context: MsgContext, spec: MsgSpec,
         else:
             dep_spec = load_msg_by_type(msg_context, dep, search_path)
             msg_context.register(dep, dep_spec)
-        if dep not in depends:
-            depends.append(dep)
-        load_msg_depends(msg_context, dep_spec, search_path)
+        depends.append(dep)
+        if msg_context.get_depends(dep) is None:
+            load_msg_depends(msg_context, dep_spec, search_path)
     msg_context.set_depends(spec.full_name, depends)
-    return depends
+    return list(depends)
 
 
 def load_depends(msg_context: MsgContext, spec: Any,

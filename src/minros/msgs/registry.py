@@ -19,6 +19,7 @@ from .codegen import generate_source, in_place_class_name, numpy_class_name
 from .message import Message
 from .spec import (
     ACTION_SUFFIXES,
+    BUILTIN_TYPES,
     HEADER,
     HEADER_FULL_NAME,
     MsgSpec,
@@ -39,6 +40,7 @@ class UnknownTypeError(LookupError):
 
     def __init__(self, type_name: str, reason: str) -> None:
         self.type_name = type_name
+        self.located = False  # True once the text names the file and line that use the type
         super().__init__(reason)
 
 
@@ -250,14 +252,53 @@ class MsgContext:
                 try:
                     source = self.source(type_name)
                 except UnknownTypeError as exc:
-                    if exc.type_name == type_name or "needed by" in str(exc):
+                    if exc.type_name == type_name or exc.located:
                         raise
-                    spec = self._specs.get(type_name)
-                    where = f" in {spec.filename}" if spec is not None and spec.filename else ""
-                    raise UnknownTypeError(exc.type_name, f"{exc} (needed by {type_name}{where})") from None
+                    raise self._unknown_field_type(type_name, exc) from None
                 cls = self._compile(type_name, source, None)
                 self._classes[type_name] = cls
             return cls
+
+    def _unknown_field_type(self, type_name: str, exc: UnknownTypeError) -> UnknownTypeError:
+        """``exc`` (type ``exc.type_name`` not found while building ``type_name``) restated
+        from the field that names the missing type: its file and line, and a likely fix."""
+        missing = exc.type_name
+        found = self._referrer(type_name, missing)
+        if found is None:
+            spec = self._specs.get(type_name)
+            where = f" in {spec.filename}" if spec is not None and spec.filename else ""
+            error = UnknownTypeError(missing, f"{exc} (needed by {type_name}{where})")
+        else:
+            spec, field = found
+            line = spec.field_lines.get(field.name)
+            where = (spec.filename or spec.full_name) + (f":{line}" if line else "")
+            reason = str(exc)
+            if reason.startswith("Cannot locate") and "]: " in reason:
+                reason = reason.split("]: ", 1)[1]
+            text = (f"{where}: field [{field.name}] of {spec.full_name} has unknown type "
+                    f"[{missing}]: {reason}{_did_you_mean(missing)}")
+            if spec.full_name != type_name:
+                text += f" (needed by {type_name})"
+            error = UnknownTypeError(missing, text)
+        error.located = True
+        return error
+
+    def _referrer(self, root: str, missing: str) -> Tuple[MsgSpec, Any] | None:
+        """The loaded spec (reached from ``root``) and its field whose type is ``missing``."""
+        queue, seen = [root], {root}
+        while queue:
+            spec = self._specs.get(queue.pop(0))
+            if spec is None:
+                continue
+            for field in spec.fields:
+                if field.is_builtin:
+                    continue
+                if field.base_type == missing:
+                    return spec, field
+                if field.base_type not in seen:
+                    seen.add(field.base_type)
+                    queue.append(field.base_type)
+        return None
 
     def get_numpy_class(self, cls: Any) -> type:
         """The ``numpy_msg`` variant of message class ``cls``."""
@@ -326,6 +367,21 @@ class MsgContext:
             })
             self._srv_classes[type_name] = cls
             return cls
+
+
+def _did_you_mean(type_name: str) -> str:
+    """``; did you mean [string]?`` for a misspelled type: the closest primitive, or type of
+    the same package."""
+    import difflib
+
+    package, _, short = type_name.rpartition("/")
+    candidates = sorted(BUILTIN_TYPES) + ["Header"]
+    try:
+        candidates += [name.rpartition("/")[2] for name in list_types(package)]
+    except UnknownTypeError:
+        pass
+    close = difflib.get_close_matches(short, candidates, n=1, cutoff=0.75)
+    return f"; did you mean [{close[0]}]?" if close else ""
 
 
 def _read_text(path: Path) -> str:

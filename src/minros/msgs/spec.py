@@ -58,6 +58,11 @@ class MsgSpecError(ValueError):
         super().__init__(f"{where}: {message}")
 
 
+class ConstantRangeError(ValueError):
+    """A constant's value does not fit its integer type (genmsg reports it apart from a value
+    that is not a number at all)."""
+
+
 def is_legal_base_name(name: str) -> bool:
     return bool(_BASE_NAME_RE.match(name))
 
@@ -139,13 +144,16 @@ class MsgSpec:
     """A parsed message: fields, constants and the raw text it came from."""
 
     def __init__(self, full_name: str, fields: List[Field], constants: List[Constant],
-                 text: str, filename: str | None = None) -> None:
+                 text: str, filename: str | None = None,
+                 field_lines: Dict[str, int] | None = None) -> None:
         self.full_name = full_name
         self.package, _, self.short_name = full_name.rpartition("/")
         self.fields = fields
         self.constants = constants
         self.text = text
         self.filename = filename
+        #: field name -> line of ``filename`` declaring it (errors about a field cite it)
+        self.field_lines = field_lines or {}
 
     @property
     def names(self) -> List[str]:
@@ -203,7 +211,7 @@ def _convert_constant(type_: str, text: str) -> object:
         value = int(text)
         lower, upper = _INT_BOUNDS[type_]
         if not lower <= value <= upper:
-            raise ValueError(f"cannot coerce [{value}] to {type_} (out of bounds)")
+            raise ConstantRangeError(f"cannot coerce [{value}] to {type_} (out of bounds)")
         return value
     raise ValueError(f"invalid constant type: [{type_}]")
 
@@ -286,7 +294,7 @@ def parse_msg(text: str, full_name: str, filename: str | None = None,
                                filename or full_name, lineno)
         seen[name] = lineno
         fields.append(Field(name, type_))
-    return MsgSpec(full_name, fields, constants, text, filename)
+    return MsgSpec(full_name, fields, constants, text, filename, seen)
 
 
 def split_srv_text(text: str) -> Tuple[str, str, int]:

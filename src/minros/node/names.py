@@ -54,6 +54,16 @@ class NodeNames:
         self.named = True
 
     @property
+    def resolved_mappings(self) -> Dict[str, str]:
+        """The remappings resolved against the node's name (rospy.names' ``_resolved_mappings``,
+        which rospy code reads and sets)."""
+        return self._resolved_mappings
+
+    @resolved_mappings.setter
+    def resolved_mappings(self, value: Dict[str, str]) -> None:
+        self._resolved_mappings = value
+
+    @property
     def master_uri(self) -> str:
         """``__master:=``, else ROS_MASTER_URI, else the default (fixed once init_node ran)."""
         if self._master_uri is not None:

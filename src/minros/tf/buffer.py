@@ -20,7 +20,6 @@ from typing import Any, Callable, Dict, Tuple
 import minros
 
 from .core import BufferCore, to_nsec
-from .exceptions import TransformException
 
 #: tf2_ros's polling interval as a fraction of the timeout; here the longest wait between
 #: two checks (new data wakes a waiter at once)
@@ -303,17 +302,6 @@ class Buffer(BufferCore, BufferInterface):
         return result if return_debug_tuple else result[0]
 
 
-class BufferClient(BufferInterface):
-    """tf2_ros.BufferClient asks a tf2 buffer server (tf2_ros's buffer_server node, through
-    its tf2_msgs/LookupTransform action), which minros does not implement yet: use
-    tf2_ros.Buffer with a TransformListener instead."""
-
-    def __init__(self, ns: str, check_frequency: Any = None, timeout_padding: Any = None) -> None:
-        raise TransformException(
-            "tf2_ros.BufferClient needs a tf2 buffer server, which this minros does not provide; "
-            "use tf2_ros.Buffer() with tf2_ros.TransformListener(buffer) instead")
-
-
-__all__ = ["Buffer", "BufferInterface", "BufferClient", "TransformRegistration",
+__all__ = ["Buffer", "BufferInterface", "TransformRegistration",
            "ConvertRegistration", "convert", "Stamped", "TypeException",
            "NotImplementedException", "DEFAULT_CAN_TRANSFORM_POLLING_SCALE"]

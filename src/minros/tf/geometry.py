@@ -112,9 +112,11 @@ def do_transform_wrench(wrench: Any, transform: Any) -> Any:
 
 
 def transform_to_kdl(t: Any) -> Any:
-    """PyKDL is not part of minros; say so instead of failing at import time."""
-    raise ImportError("transform_to_kdl needs PyKDL, which minros does not provide; "
-                      "use do_transform_point/pose/vector3 instead")
+    """The PyKDL Frame of a geometry_msgs/TransformStamped (tf2_kdl's is this one)."""
+    from minros.kdl import Frame, Rotation, Vector  # PyKDL only for the code that asks for it
+
+    r, v = t.transform.rotation, t.transform.translation
+    return Frame(Rotation.Quaternion(r.x, r.y, r.z, r.w), Vector(v.x, v.y, v.z))
 
 
 def _register() -> None:

@@ -75,10 +75,21 @@ def flush_stdout() -> None:
         pass
 
 
+def explained(exc: BaseException) -> str | None:
+    """The one line the XML-RPC client wrote for the failure behind ``exc`` (a request over
+    the master's size limit, a host outside its ROS_ALLOWED_HOSTS, a reply that is not
+    XML-RPC), or None when it is a plain network failure (master not running)."""
+    from minros.wire.xmlrpc import CallError
+
+    cause = exc if isinstance(exc, CallError) else exc.__cause__
+    return str(cause) if isinstance(cause, CallError) else None
+
+
 def run_tool(fn: Callable[[], int], io_message: str = "Unable to communicate with master!",
              io_status: int = 1) -> int:
     """Run ``fn``; translate expected failures to one line on stderr and an exit status."""
     from minros.tools.master import MasterError, MasterFailure, MasterIOError
+    from minros.wire.xmlrpc import CallError
 
     try:
         return int(fn() or 0)
@@ -86,9 +97,13 @@ def run_tool(fn: Callable[[], int], io_message: str = "Unable to communicate wit
         flush_stdout()
         print(f"{exc.prefix}{exc.text}", file=sys.stderr)
         return exc.status
-    except MasterIOError:
+    except MasterIOError as exc:
         flush_stdout()
-        print(f"ERROR: {io_message}", file=sys.stderr)
+        print(f"ERROR: {explained(exc) or io_message}", file=sys.stderr)
+        return io_status
+    except CallError as exc:  # a call to a node (or through the client library) that failed
+        flush_stdout()
+        print(f"ERROR: {exc}", file=sys.stderr)
         return io_status
     except (MasterError, MasterFailure) as exc:
         flush_stdout()
@@ -110,12 +125,15 @@ def library_call(fn: Callable[[], Any], error: type, io_error: type,
     exceptions its Python API documents (``error``; ``io_error`` when the master cannot be
     reached) instead of an exit status."""
     from minros.tools.master import MasterError, MasterFailure, MasterIOError
+    from minros.wire.xmlrpc import CallError
 
     try:
         return fn()
     except ToolError as exc:
         raise error(exc.text) from None
-    except MasterIOError:
-        raise io_error(io_message) from None
+    except MasterIOError as exc:
+        raise io_error(explained(exc) or io_message) from None
+    except CallError as exc:
+        raise io_error(str(exc)) from None
     except (MasterError, MasterFailure) as exc:
         raise error(str(exc)) from None

@@ -8,7 +8,6 @@ rostest reads each file back (:func:`read_results`) and prints the summary
 
 from __future__ import annotations
 
-import os
 import sys
 import time
 import unittest
@@ -46,6 +45,8 @@ class CaseResult:
     time: float = 0.0
     failure: str | None = None
     error: str | None = None
+    #: rosunit's name of the file the case was read from (``<folder>.<file stem>``)
+    suite: str = ""
 
     @property
     def passed(self) -> bool:
@@ -53,9 +54,17 @@ class CaseResult:
 
     @property
     def description(self) -> str:
-        """rosunit's line for the case: ``[classname/name][passed]``."""
-        state = "passed" if self.passed else ("FAILURE" if self.failure is not None else "ERROR")
-        return f"[{self.classname}/{self.name}][{state}]\n"
+        """rosunit's text for the case: ``[suite/name][passed]``, or for a failure or error
+        the line padded with dashes to 80 columns, its text, and a line of dashes."""
+        label = f"{self.suite}/{self.name}" if self.suite else f"{self.classname}/{self.name}"
+        if self.passed:
+            return f"[{label}][passed]\n"
+        text = ""
+        for state, detail in (("FAILURE", self.failure), ("ERROR", self.error)):
+            if detail is not None:
+                head = f"[{label}][{state}]"
+                text += head + "-" * (80 - len(head)) + f"\n{detail}\n" + "-" * 80 + "\n\n"
+        return text
 
 
 @dataclass
@@ -188,15 +197,20 @@ def read_results(path: str | Path, test_name: str) -> Results:
         raise ResultsError(f"cannot read test results [{path}]: {exc}") from None
     suites = [root] if root.tag == "testsuite" else root.findall("testsuite")
     results = Results(test_name)
+    # rosunit names the cases after the file: <folder>.<name without TEST- and .xml>/<case>
+    stem = Path(path).name
+    stem = stem[5:] if stem.startswith("TEST-") else stem
+    stem = stem[:-4] if stem.endswith(".xml") else stem
+    suite_name = f"{Path(path).absolute().parent.name}.{stem}"
     for suite in suites:
         for element in suite.iter("testcase"):
-            case = CaseResult(element.get("name", ""), element.get("classname", ""),
-                              float(element.get("time", "0") or 0))
+            case = CaseResult(element.get("name", "") or "unknown", element.get("classname", ""),
+                              float(element.get("time", "0") or 0), suite=suite_name)
             failure, error = element.find("failure"), element.find("error")
             if failure is not None:
-                case.failure = failure.text or failure.get("message", "")
+                case.failure = (failure.text or "").strip() or failure.get("message", "")
             if error is not None:
-                case.error = error.text or error.get("message", "")
+                case.error = (error.text or "").strip() or error.get("message", "")
             results.cases.append(case)
         results.num_tests += int(suite.get("tests", "0") or 0)
         results.num_errors += int(suite.get("errors", "0") or 0)
@@ -206,26 +220,25 @@ def read_results(path: str | Path, test_name: str) -> Results:
 
 def summary_text(results: Results, failed_to_run: Sequence[str] = (), runner_name: str = "ROSTEST",
                  color: bool = True) -> str:
-    """rosunit's summary block: each case's line, then RESULT, TESTS, ERRORS, FAILURES."""
+    """rosunit's summary block (print_runner_summary): each case's description, a
+    ``[test<name>][failed]`` line per test that did not run properly, then RESULT, TESTS,
+    ERRORS and FAILURES, coloured as ROS colours them (always, terminal or not)."""
     def paint(code: str, text: str) -> str:
         return f"\033[{code}m{text}\033[0m" if color else text
 
-    lines = [f"[{runner_name}]" + "-" * 71, ""]
-    lines += [c.description.rstrip("\n") for c in results.cases]
-    lines += [f"[{name}][failed]" for name in failed_to_run]
-    lines += ["", "SUMMARY"]
+    text = f"[{runner_name}]" + "-" * 71 + "\n\n"
+    text += "".join(c.description for c in results.cases)
+    text += "".join(f"[test{name}][failed]\n" for name in failed_to_run)
     ok = results.ok and not failed_to_run
-    lines.append(paint("32", " * RESULT: SUCCESS") if ok else paint("1;31", " * RESULT: FAIL"))
-    lines.append(f" * TESTS: {results.num_tests}")
+    lines = ["", "SUMMARY",
+             paint("32", " * RESULT: SUCCESS") if ok else paint("1;31", " * RESULT: FAIL"),
+             f" * TESTS: {results.num_tests}"]
     errors = results.num_errors
     lines.append(paint("1;31", f" * ERRORS: {errors}") if errors else " * ERRORS: 0")
     failures = results.num_failures + len(failed_to_run)
     lines.append(paint("1;31", f" * FAILURES: {failures}") if failures else " * FAILURES: 0")
     if failed_to_run:
         lines += ["", "ERROR: The following tests failed to run:"]
-        lines += [f" * {name}" for name in failed_to_run]
-    return "\n".join(lines) + "\n"
+        lines += [f" * test{name}" for name in failed_to_run]
+    return text + "\n".join(lines) + "\n"
 
-
-def is_tty() -> bool:
-    return os.isatty(sys.stdout.fileno()) if hasattr(sys.stdout, "fileno") else False

@@ -107,6 +107,18 @@ class Transport(abc.ABC):
     def info(self) -> str:
         """One line for getBusInfo, as rospy writes it."""
 
+    # rospy's names (rospy.impl.transport.Transport, whose classes are transports here too)
+
+    @property
+    def endpoint_id(self) -> str:
+        """Who is at the other end: the peer's caller id, from its header."""
+        return self.header.get("callerid", "")
+
+    @property
+    def transport_type(self) -> str:
+        """The protocol's name, as getBusInfo lists it."""
+        return self.protocol
+
 
 class PublicationSide(Protocol):
     """What a protocol handler needs of a publication to connect a subscriber to it."""
@@ -122,7 +134,7 @@ class PublicationSide(Protocol):
     closed: bool
 
     def header_fields(self) -> Dict[str, str]: ...
-    def add_connection(self, transport: Transport) -> None: ...
+    def add_connection(self, transport: Transport) -> bool: ...
     def remove_connection(self, transport: Transport) -> None: ...
 
 

@@ -4,7 +4,10 @@ Channels are the graph's topics (encoding ``ros1``, schema = the type's full def
 subscription forwards the TCPROS bytes of each message unchanged. Clients may publish (their
 channels become publishers of the web node, their bytes are checked against the type before
 they are forwarded), call services (raw request bytes in, raw response bytes out), read, set and
-follow parameters and follow the connection graph; with ``use_sim_time`` the server sends
+follow parameters (Lichtblick's 3D panel draws the URDF of ``/robot_description``) and follow
+the connection graph, and fetch assets (``fetchAsset``: the meshes and textures that URDF
+names, by ``package://`` or ``file://`` URL, under foxglove_bridge's allow-list rules and only
+from inside a ROS package, :mod:`minros.web.assets`); with ``use_sim_time`` the server sends
 ``/clock`` as Time messages. Errors are ``status`` messages (level 2) to that client only.
 """
 
@@ -14,17 +17,24 @@ import threading
 from typing import Any, Callable, Dict, List, Optional, Set, Tuple
 
 import minros
+from minros.msgs import reader_for
+from minros.web import assets
 from minros.web import foxglove_protocol as fp
 from minros.web.outbox import Outbox
 from minros.web.rosapi import Graph
 from minros.web.state import Incoming, WebState, raw_class
 
 CAPABILITIES = ["clientPublish", "parameters", "parametersSubscribe", "services",
-                "connectionGraph"]
+                "connectionGraph", "assets"]
 #: messages per subscription waiting for a slow client (foxglove_bridge's queue length)
 QUEUE_LENGTH = 10
 QUEUE_BYTES = 32 << 20
 MAX_CALLS_IN_FLIGHT = 16
+#: asset fetches one client may have in flight (each reads a file in a thread)
+MAX_FETCHES_IN_FLIGHT = 8
+#: subscriptions and advertised channels one client may hold (each costs memory; a channel
+#: a publisher and a master registration)
+MAX_PER_CLIENT = 10_000
 
 
 def _graph_maps(graph: Graph) -> Tuple[Dict[str, Set[str]], ...]:
@@ -36,7 +46,8 @@ def _graph_maps(graph: Graph) -> Tuple[Dict[str, Set[str]], ...]:
 class FoxgloveSession:
     def __init__(self, client_id: str, state: WebState, outbox: Outbox,
                  close_client: Callable[[str], None], server_name: str = "minros web",
-                 run_async: Optional[Callable[[Callable[[], None]], None]] = None) -> None:
+                 run_async: Optional[Callable[[Callable[[], None]], None]] = None,
+                 asset_patterns: Any = assets.DEFAULT_PATTERNS) -> None:
         self.client_id = client_id
         self.state = state
         self.outbox = outbox
@@ -52,6 +63,8 @@ class FoxgloveSession:
         self.graph_subscribed = False
         self._graph_sent: Tuple[Dict[str, Set[str]], ...] = ({}, {}, {})
         self._calls = threading.BoundedSemaphore(MAX_CALLS_IN_FLIGHT)
+        self._fetches = threading.BoundedSemaphore(MAX_FETCHES_IN_FLIGHT)
+        self.asset_patterns = asset_patterns
         self._closed = False
 
     @staticmethod
@@ -200,6 +213,7 @@ class FoxgloveSession:
             "unsubscribeParameterUpdates": self.unsubscribe_parameters,
             "subscribeConnectionGraph": self.subscribe_graph,
             "unsubscribeConnectionGraph": self.unsubscribe_graph,
+            "fetchAsset": self.fetch_asset,
         }.get(op)
         if handler is None:
             raise fp.ProtocolError(f'Unrecognized client opcode "{op}"')
@@ -222,6 +236,10 @@ class FoxgloveSession:
             with self.lock:
                 if sub_id in self.subscriptions:
                     self.error(f"Client subscription id {sub_id} was already used; ignoring subscription")
+                    continue
+                if len(self.subscriptions) >= MAX_PER_CLIENT:
+                    self.error(f"this client has {MAX_PER_CLIENT} subscriptions already, the "
+                               f"most one client may have; ignoring subscription {sub_id}")
                     continue
                 channel = self.channels.get(channel_id)
                 if channel is None:
@@ -274,6 +292,10 @@ class FoxgloveSession:
             if channel_id in self.client_channels:
                 self.error(f"Client channel {channel_id} was already advertised")
                 continue
+            if len(self.client_channels) >= MAX_PER_CLIENT:
+                self.error(f"this client advertised {MAX_PER_CLIENT} channels already, the most "
+                           f"one client may; ignoring channel {channel_id}")
+                continue
             if not self.state.topic_allowed(topic):
                 self.error(f"topic {topic} is not in the server's topics_glob")
                 continue
@@ -318,8 +340,10 @@ class FoxgloveSession:
         topic, cls = entry
         payload = bytes(frame.payload)
         try:  # a malformed payload stops here instead of breaking every subscriber
-            msg = cls()
-            msg.deserialize(payload)
+            # read from the bytes (every length checked against them before anything is built),
+            # never cls() first: a schema the client chose ("float64[100000000] a") would make
+            # the default instance take 800 MB before a 13-byte message was found short
+            msg = reader_for(cls)(payload)
         except Exception as exc:
             self.error(f"Dropping a message on {topic}: the payload is not a valid "
                        f"{cls._type}: {exc}")
@@ -370,6 +394,35 @@ class FoxgloveSession:
                 self.send_binary(reply)
             else:
                 self.send(reply)
+        self.run_async(run)
+
+    # -- assets ----------------------------------------------------------------------------
+
+    def fetch_asset(self, msg: Dict[str, Any]) -> None:
+        """foxglove_bridge's fetchAsset: the file's bytes, or an error naming the URI (and,
+        unlike foxglove_bridge, why), read in a worker thread."""
+        uri, request_id = msg.get("uri"), msg.get("requestId")
+        if not isinstance(uri, str) or type(request_id) is not int or not 0 <= request_id < 1 << 32:
+            self.error("fetchAsset needs a string 'uri' and an integer 'requestId' (0 to 2^32-1)")
+            return
+        if not self._fetches.acquire(blocking=False):
+            self.send_binary(fp.fetch_asset_response(
+                request_id, error=f"Failed to retrieve asset {uri}: more than "
+                                  f"{MAX_FETCHES_IN_FLIGHT} fetches in flight"))
+            return
+
+        def run() -> None:
+            try:
+                reply = fp.fetch_asset_response(request_id, assets.read(uri, self.asset_patterns))
+            except assets.AssetError as exc:
+                minros.logwarn(f"[web] Foxglove client {self.client_id}: Failed to retrieve "
+                               f"asset '{uri[:300]}': {exc}")
+                reply = fp.fetch_asset_response(request_id,
+                                                error=f"Failed to retrieve asset {uri}: {exc}")
+            finally:
+                self._fetches.release()
+            if not self._closed:
+                self.send_binary(reply)
         self.run_async(run)
 
     # -- parameters ------------------------------------------------------------------------

@@ -21,6 +21,7 @@ SCHEMA_ENCODING = "ros1msg"
 MESSAGE_DATA = 0x01
 TIME = 0x02
 SERVICE_CALL_RESPONSE = 0x03
+FETCH_ASSET_RESPONSE = 0x04
 # client -> server binary opcodes
 CLIENT_MESSAGE_DATA = 0x01
 SERVICE_CALL_REQUEST = 0x02
@@ -31,6 +32,8 @@ INFO, WARNING, ERROR = 0, 1, 2
 _MESSAGE_HEAD = struct.Struct("<BIQ")
 _TIME = struct.Struct("<BQ")
 _SERVICE_HEAD = struct.Struct("<BIII")
+_ASSET_HEAD = struct.Struct("<BIBI")
+FETCH_ASSET_SUCCESS, FETCH_ASSET_ERROR = 0, 1
 
 
 class ProtocolError(ValueError):
@@ -55,6 +58,16 @@ def time_frame(ns: int) -> bytes:
 def service_call_response(service_id: int, call_id: int, encoding: str, payload: bytes) -> bytes:
     enc = encoding.encode("utf-8")
     return _SERVICE_HEAD.pack(SERVICE_CALL_RESPONSE, service_id, call_id, len(enc)) + enc + bytes(payload)
+
+
+def fetch_asset_response(request_id: int, data: Optional[bytes] = None,
+                         error: str = "") -> bytes:
+    """A fetchAsset answer: opcode, request id, status (0 success, 1 error), the error text's
+    length and text, then the asset's bytes (success) or nothing."""
+    if data is not None:
+        return _ASSET_HEAD.pack(FETCH_ASSET_RESPONSE, request_id, FETCH_ASSET_SUCCESS, 0) + data
+    text = error.encode("utf-8")
+    return _ASSET_HEAD.pack(FETCH_ASSET_RESPONSE, request_id, FETCH_ASSET_ERROR, len(text)) + text
 
 
 def dumps(obj: Mapping[str, Any]) -> str:
@@ -149,14 +162,23 @@ def parameter_from_client(entry: Mapping[str, Any]) -> Tuple[str, Any, bool]:
         return name, None, True
     value = entry["value"]
     kind = entry.get("type")
-    if kind == "byte_array":
-        if not isinstance(value, str):
-            raise ProtocolError(f"setParameters: {name}: byte_array value must be base64 text")
-        return name, base64.b64decode(value), False
-    if kind == "float64":
-        return name, float(value), False
-    if kind == "float64_array":
-        return name, [float(v) for v in value], False
+    try:
+        if kind == "byte_array":
+            if not isinstance(value, str):
+                raise ValueError
+            return name, base64.b64decode(value, validate=True), False
+        if kind == "float64":
+            if isinstance(value, (str, bool)):
+                raise ValueError
+            return name, float(value), False
+        if kind == "float64_array":
+            if not isinstance(value, list) or any(isinstance(v, (str, bool)) for v in value):
+                raise ValueError
+            return name, [float(v) for v in value], False
+    except (TypeError, ValueError, OverflowError):
+        what = {"byte_array": "base64 text", "float64": "a number",
+                "float64_array": "a list of numbers"}[kind]
+        raise ProtocolError(f"setParameters: {name}: a {kind} value must be {what}") from None
     return name, value, False
 
 
@@ -230,6 +252,8 @@ def parse_text(text: str) -> Dict[str, Any]:
         obj = json.loads(text)
     except ValueError as exc:
         raise ProtocolError(f"Invalid JSON message: {exc}") from None
+    except RecursionError:  # json's C parser counts its depth against the recursion limit
+        raise ProtocolError("Invalid JSON message: nested too deeply to read") from None
     if not isinstance(obj, dict) or not isinstance(obj.get("op"), str):
         raise ProtocolError("JSON message must be an object with a string 'op'")
     return obj

@@ -5,7 +5,12 @@ Used by ``minros web`` (minros.cli.web) and by the executables that roslaunch an
 ``rosapi/rosapi_node`` (the launch files minros ships start those). Launched as a node, the
 server reads its settings from private parameters, with rosbridge's and foxglove_bridge's
 names: ``~port``, ``~address``, ``~topics_glob``, ``~services_glob``, ``~params_glob``,
-``~max_message_size``, ``~unregister_timeout``, ``~use_compression``, plus ``~token``.
+``~max_message_size``, ``~unregister_timeout``, ``~use_compression``, plus ``~token`` and
+``~allow_origin`` (``--allow-origin``: one origin, or a list) and foxglove_bridge's
+``~asset_uri_allowlist`` (regular expressions of the ``package://`` and ``file://`` URLs the
+page's 3D view and Foxglove's ``fetchAsset`` may read; see :mod:`minros.web.assets`; also read
+by ``minros web``, as ``_asset_uri_allowlist:=...``). Once listening, the node sets
+``~actual_port`` to the port it got, as rosbridge_websocket does (``~port`` 0 picks a free one).
 """
 
 from __future__ import annotations
@@ -38,6 +43,12 @@ class Settings:
     rosapi: bool = True
     server: bool = True
     trace: List[str] = field(default_factory=list)  # wire traces for the page's Wire view
+    #: origins of pages from other sites allowed to use the server (--allow-origin)
+    allow_origins: List[str] = field(default_factory=list)
+    #: set ~actual_port once listening (the launch-file nodes, as rosbridge_websocket does)
+    set_actual_port: bool = False
+    #: the asset allow-list (None: minros.web.assets' default, or ~asset_uri_allowlist)
+    asset_uri_allowlist: Optional[List[str]] = None
 
 
 def parse_globs(value: Any) -> List[str]:
@@ -97,17 +108,26 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
                              params_glob=settings.params_glob, graph_interval=settings.graph_interval,
                              unregister_timeout=settings.unregister_timeout))
     rosapi = Rosapi(state, settings.topics_glob, settings.services_glob, settings.params_glob)
+    allowlist = settings.asset_uri_allowlist
+    if allowlist is None:
+        allowlist = asset_allowlist(minros.get_param("~asset_uri_allowlist", None))
     if settings.rosapi:
         register_rosapi(rosapi)
     server = None
     if settings.server:
         from minros.web.server import WebServer
 
-        server = WebServer(state, settings.host, settings.port, token=settings.token,
-                           name=settings.server_name, rosapi=rosapi,
-                           send_timeout=settings.send_timeout,
-                           max_message_size=settings.max_message_size,
-                           compression=settings.compression, trace=settings.trace)
+        try:  # a malformed ROS_ALLOWED_HOSTS or ~allow_origin
+            server = WebServer(state, settings.host, settings.port, token=settings.token,
+                               name=settings.server_name, rosapi=rosapi,
+                               send_timeout=settings.send_timeout,
+                               max_message_size=settings.max_message_size,
+                               compression=settings.compression, trace=settings.trace,
+                               allow_origins=settings.allow_origins, asset_allowlist=allowlist)
+        except ValueError as exc:
+            print(f"minros web: error: {exc}", file=sys.stderr)
+            minros.signal_shutdown("bad settings")
+            return 2
         try:
             server.start()
         except OSError as exc:
@@ -116,6 +136,8 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
                   "with --port.", file=sys.stderr)
             minros.signal_shutdown("port unavailable")
             return 1
+        if settings.set_actual_port:
+            minros.set_param("~actual_port", server.port)
     state.start()
     if server is not None:
         announce(_banner(server, settings))
@@ -153,6 +175,29 @@ def _banner(server: Any, settings: Settings) -> str:
          if settings.trace else []))
 
 
+def asset_allowlist(value: Any) -> List[str]:
+    """foxglove_bridge's ``~asset_uri_allowlist``: a list of regular expressions (one text is
+    one expression); unset, :data:`minros.web.assets.DEFAULT_ALLOWLIST`."""
+    from minros.web.assets import DEFAULT_ALLOWLIST
+
+    if value is None:
+        return list(DEFAULT_ALLOWLIST)
+    if isinstance(value, str):
+        return [value]
+    return [str(v) for v in value]
+
+
+def _origins(value: Any) -> List[str]:
+    """``~allow_origin`` (one origin, a comma-separated text or a list) plus
+    MINROS_WEB_ALLOW_ORIGIN."""
+    import os
+
+    from minros.web.origin import ENV_VAR, split_values
+
+    given = [str(v) for v in value] if isinstance(value, list) else split_values(str(value or ""))
+    return split_values(os.environ.get(ENV_VAR, "")) + given
+
+
 def run_node(default_name: str, default_port: int, server_name: str, serve: bool = True) -> int:
     """Entry of the launch-file executables: settings from private parameters."""
     from minros.web.state import DEFAULT_UNREGISTER_TIMEOUT
@@ -163,6 +208,7 @@ def run_node(default_name: str, default_port: int, server_name: str, serve: bool
         return minros.get_param("~" + key, default)
 
     max_size = param("max_message_size", None)
+    allow = param("allow_origin", [])
     settings = Settings(
         host=str(param("address", "127.0.0.1") or "0.0.0.0"), port=int(param("port", default_port)),
         token=param("token", None) or None, name=default_name,
@@ -172,5 +218,5 @@ def run_node(default_name: str, default_port: int, server_name: str, serve: bool
         max_message_size=int(max_size) if str(max_size).isdigit() else 64 << 20,
         unregister_timeout=float(param("unregister_timeout", DEFAULT_UNREGISTER_TIMEOUT)),
         compression=bool(param("use_compression", False)), server_name=server_name,
-        server=serve)
+        server=serve, allow_origins=_origins(allow), set_actual_port=serve)
     return run(settings, announce=minros.loginfo)

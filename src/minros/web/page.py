@@ -29,10 +29,17 @@ are pushed:
 ``wire_watch``     the steps of the wire traces the server follows (``--trace``), then what
                    changes, as ``wire`` frames: ``steps`` (added or changed, by ``id``),
                    ``removed`` ids, ``status`` (files, problems); the first has ``reset``
+``scene_watch``,   the 3D view's: tf into a fixed frame, displays of topics and of the robot
+``display_add``,   model, interactive marker feedback (:mod:`minros.web.scene`; clouds, scans
+...                and maps come as binary frames)
+``learn_list``,    the Learn view's: ``minros learn``'s exercises listed, one started (its
+``learn_start``,   fixed programs only, one at a time, stopped when its page asks or goes),
+...                its folder's trace followed, an answer checked (:mod:`minros.web.learning`)
 =================  ==========================================================================
 
 The first frame the server sends is ``hello`` (node name, how the graph is read, the debug
-names the graph hides, whether it follows wire traces and which). What the session derives (plot
+names the graph hides, whether it follows wire traces and which, whether this page may start
+exercises). What the session derives (plot
 points, stats, log lines) is computed in ROS threads and only queued; the client's writer
 thread encodes and sends, as for every other client (:mod:`minros.web.outbox`).
 """
@@ -43,17 +50,19 @@ import json
 import threading
 import time
 from collections import deque
-from typing import Any, Callable, Deque, Dict, Hashable, List, Optional, Set, Tuple
+from typing import Any, Callable, Deque, Dict, Hashable, List, Optional, Tuple
 
 import minros
 from minros.tools.master import QUIET_NAMES
 from minros.web import pagemodel, plotpath
 from minros.web.convert import populate_message
+from minros.web.learning import LearnHub, LearnSession
 from minros.web.outbox import Outbox
 from minros.web.rosapi import Graph
 from minros.web.rosbridge import OpError, RosbridgeSession, _check
+from minros.web.scene import SceneHub, SceneSession
 from minros.web.state import Incoming, WebState, flatten_params
-from minros.web.wiretrace import WireFeed
+from minros.web.wiretrace import WIRE_BATCH, WireFeed, WireWatch
 
 SUBPROTOCOL = "minros.page.v1"
 #: topics one page may ask statistics for at a time
@@ -68,8 +77,6 @@ MAX_PUBLISHING = 32
 MAX_DYNREC_CLIENTS = 32
 #: log lines sent in one ``log`` frame
 LOG_BATCH = 5_000
-#: wire steps sent in one ``wire`` frame
-WIRE_BATCH = 500
 PLOT_INTERVAL = 0.05
 ECHO_INTERVAL = 0.1
 LOG_INTERVAL = 0.1
@@ -84,11 +91,15 @@ LOG_TYPE = "rosgraph_msgs/Log"
 class PageHub:
     """What all page sessions of one server share: the console's log ring (one tap on
     ``/rosout_agg``), dynamic_reconfigure clients, the one-second ticker that sends
-    statistics, and the wire traces followed (``wire``, None without ``--trace``)."""
+    statistics, the wire traces followed (``wire``, None without ``--trace``) and the
+    exercise started from a page (``learn``, None: this server runs none)."""
 
-    def __init__(self, state: WebState, wire: Optional[WireFeed] = None) -> None:
+    def __init__(self, state: WebState, wire: Optional[WireFeed] = None,
+                 learn: Optional[LearnHub] = None) -> None:
         self.state = state
         self.wire = wire
+        self.learn = learn
+        self.scene = SceneHub(state)
         self.log = pagemodel.LogRing()
         self.sessions: Dict[int, PageSession] = {}
         self.lock = threading.Lock()
@@ -146,6 +157,9 @@ class PageHub:
             if client is not None:
                 self._dynrec[server] = client  # now the most recently used
         if client is None:
+            # its Subscribers and our taps cannot both hold a topic of the node
+            self.state.share_topics([minros.resolve_name(f"{server}/{suffix}") for suffix in
+                                     ("parameter_descriptions", "parameter_updates")])
             client = Client(server, timeout=DYNREC_TIMEOUT)
             evicted = []
             with self.lock:
@@ -176,6 +190,8 @@ class PageHub:
             client.close()
         if tapped:
             self.state.untap(CONSOLE_TOPIC, ("page-console",))
+        if self.learn is not None:
+            self.learn.close()
 
 
 class _Plot:
@@ -247,11 +263,14 @@ class _Publishing:
 
 
 class PageSession(RosbridgeSession):
-    """A page's connection: every rosbridge op plus the page's (see the module doc)."""
+    """A page's connection: every rosbridge op plus the page's (see the module doc).
+    ``local``: the page is of this machine (:meth:`~minros.web.origin.OriginPolicy.local_page`),
+    so it may start exercises."""
 
     def __init__(self, client_id: str, state: WebState, outbox: Outbox,
                  close_client: Callable[[str], None], hub: PageHub, rosapi: Any = None,
-                 run_async: Optional[Callable[[Callable[[], None]], None]] = None) -> None:
+                 run_async: Optional[Callable[[Callable[[], None]], None]] = None,
+                 local: bool = False) -> None:
         super().__init__(client_id, state, outbox, close_client, rosapi=rosapi, run_async=run_async)
         self.hub = hub
         self.key = ("page", client_id)
@@ -260,8 +279,8 @@ class PageSession(RosbridgeSession):
         self.echoes: Dict[Any, str] = {}
         self.publishing: Dict[Any, _Publishing] = {}
         self.console_seq: Optional[int] = None
-        self.wire_seq: Optional[int] = None  # None: the page does not watch the wire
-        self.wire_sent: Set[int] = set()
+        #: what this page has been sent of the traces the server follows (``wire_watch``)
+        self.wire = WireWatch("wire", WIRE_BATCH)
         self.params_watched = False
         self.page_lock = threading.Lock()
         self.ops.update({
@@ -273,6 +292,10 @@ class PageSession(RosbridgeSession):
             "dynrec_set": self.dynrec_set, "pub_start": self.pub_start,
             "pub_stop": self.pub_stop, "wire_watch": self.wire_watch,
         })
+        self.scene = SceneSession(self, hub.scene)
+        self.ops.update(self.scene.ops)
+        self.learn = LearnSession(self, hub.learn, local)
+        self.ops.update(self.learn.ops)
         hub.add(self)
 
     def start(self) -> None:
@@ -280,6 +303,7 @@ class PageSession(RosbridgeSession):
                    "graph_mode": self.state.graph_mode, "quiet": list(QUIET_NAMES),
                    "wire": self.hub.wire is not None,
                    "wire_paths": self.hub.wire.specs if self.hub.wire is not None else [],
+                   "learn": self.hub.learn is not None and self.learn.local,
                    "version": _version(), "started": self.state.started})
 
     # -- replies ---------------------------------------------------------------------------
@@ -366,6 +390,7 @@ class PageSession(RosbridgeSession):
         self.outbox.open_slot(("page", "stats"), json.dumps, maxlen=1)
 
     def tick(self, now: float) -> None:
+        self.scene.tick()
         with self.page_lock:
             meters = list(self.stats_topics.items())
         if not meters:
@@ -517,39 +542,11 @@ class PageSession(RosbridgeSession):
                            "--trace FILE' (FILE written by 'minros trace -o FILE -- ...')")
             return
         slot = ("page", "wire")
-        self.outbox.open_slot(slot, lambda _token: self._render_wire(), maxlen=1,
+        self.outbox.open_slot(slot, lambda _token: self.wire.frames(), maxlen=1,
                               min_interval=WIRE_INTERVAL)
-        with self.page_lock:
-            self.wire_seq, self.wire_sent = 0, set()
+        self.wire.follow(feed)
         feed.listen(self.key, lambda: self.outbox.put(slot, None))
         self.outbox.put(slot, None)
-
-    def _render_wire(self) -> List[str]:
-        """What changed since this page's last ``wire`` frame, in frames of WIRE_BATCH steps
-        (the page drops what is ``removed``: the store keeps the newest steps)."""
-        feed = self.hub.wire
-        with self.page_lock:
-            since, sent = self.wire_seq, self.wire_sent
-        if feed is None or since is None:
-            return []
-        steps, removed, status, seq = feed.changes(since, sent)
-        sent.difference_update(removed)
-        sent.update(step["id"] for step in steps)
-        with self.page_lock:
-            if self.wire_sent is not sent:  # the page asked again meanwhile: a new start
-                return []
-            self.wire_seq = seq
-        frames = []
-        for start in range(0, max(1, len(steps)), WIRE_BATCH):
-            frame: Dict[str, Any] = {"op": "wire", "steps": steps[start:start + WIRE_BATCH]}
-            if start == 0:
-                frame["removed"] = removed
-                if since == 0:
-                    frame["reset"] = True
-            if start + WIRE_BATCH >= len(steps):
-                frame["status"] = status
-            frames.append(json.dumps(frame))
-        return frames
 
     # -- parameters ------------------------------------------------------------------------
 
@@ -703,6 +700,8 @@ class PageSession(RosbridgeSession):
             self.unplot({"id": plot_id})
         for echo_id in echoes:
             self.unecho({"id": echo_id})
+        self.scene.close()
+        self.learn.close()
         super().close()
 
 

@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import itertools
 import json
+import sys
 import threading
 import time
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Tuple
 
 import minros
 from minros.web import cbor
@@ -30,14 +31,45 @@ LEVELS = {"info": 0, "warning": 1, "error": 2, "none": 3}
 DEFAULT_QUEUE_LENGTH = 100
 MAX_QUEUE_BYTES = 32 << 20
 MAX_CALLS_IN_FLIGHT = 16
+#: the largest publisher queue a client may ask for
+MAX_PUBLISH_QUEUE = 1000
+#: topics one client may subscribe to, topics and services it may advertise (2,000 is a
+#: busy robot; each costs memory and a master registration)
+MAX_PER_CLIENT = 10_000
+#: ids of one client's subscriptions or advertisements of one topic
+MAX_IDS_PER_TOPIC = 1_000
 #: how long a ROS caller waits for a client that advertised a service
 SERVICE_RESPONSE_TIMEOUT = 60.0
 MAX_FRAGMENTED_MESSAGES = 64
+#: bytes a received fragment is charged beyond its text (its string and table entry)
+FRAGMENT_OVERHEAD = 100
 FRAGMENT_TIMEOUT = 600.0
+
+
+#: roughly how deep json.loads can nest (it counts against the interpreter's recursion limit)
+MAX_JSON_DEPTH = sys.getrecursionlimit()
 
 
 class OpError(Exception):
     """A client op that cannot be carried out; the text is what rosbridge would log."""
+
+
+def _bounded(what: str, held: Any, key: Any, limit: int = 0) -> None:
+    """OpError when a client adding ``key`` to ``held`` would hold more than ``limit`` (each
+    costs the server memory, and a registration with the master)."""
+    limit = limit or MAX_PER_CLIENT
+    if key not in held and len(held) >= limit:
+        raise OpError(f"this client has {len(held)} {what} already, the most one client may "
+                      "have: remove some first")
+
+
+def _queue_size(msg: Dict[str, Any]) -> int:
+    """A client's publisher queue_size, kept to 1..MAX_PUBLISH_QUEUE: the queue holds the
+    client's messages while a subscriber is slow, and 0 would make it unbounded in rospy."""
+    value = msg.get("queue_size", 100)
+    if type(value) is not int:
+        raise OpError(f"Expected field queue_size to be an int. Invalid value: {str(value)[:80]}")
+    return min(max(value, 1), MAX_PUBLISH_QUEUE)
 
 
 def _check(msg: Dict[str, Any], fields: List[Tuple[bool, str, tuple]]) -> None:
@@ -47,7 +79,8 @@ def _check(msg: Dict[str, Any], fields: List[Tuple[bool, str, tuple]]) -> None:
             raise OpError(f"Expected a {name} field but none was found.")
         if name in msg and not isinstance(msg[name], types):
             names = tuple(t.__name__ for t in types)
-            raise OpError(f"Expected field {name} to be one of {names}. Invalid value: {msg[name]}")
+            raise OpError(f"Expected field {name} to be one of {names}. Invalid value: "
+                          f"{str(msg[name])[:200]}")
 
 
 class _Subscription:
@@ -142,6 +175,10 @@ class RosbridgeSession:
             self.log("error", f"Received a message that is not valid JSON ({exc}): {excerpt}; "
                               "send one JSON object per message")
             return
+        except RecursionError:  # json's C parser counts its depth against the recursion limit
+            self.log("error", "Received JSON nested too deeply to read (more than "
+                              f"{MAX_JSON_DEPTH} levels); rosbridge ops are a few levels deep")
+            return
         if not isinstance(msg, dict):
             self.log("error", f"Received JSON that is not an object: {str(data)[:80]}")
             return
@@ -197,8 +234,11 @@ class RosbridgeSession:
         topic = minros.resolve_name(msg["topic"])
         self._allowed(topic)
         cls = self._established_class(topic, msg["type"])
+        ids = self.advertised.get(topic, set())
+        _bounded("advertised topics", self.advertised, topic)
+        _bounded(f"advertisements of {topic}", ids, msg.get("id"), MAX_IDS_PER_TOPIC)
         self.state.acquire_publisher(self, topic, cls, latch=bool(msg.get("latch", False)),
-                                     queue_size=int(msg.get("queue_size", 100)))
+                                     queue_size=_queue_size(msg))
         self.advertised.setdefault(topic, set()).add(msg.get("id"))
 
     def unadvertise(self, msg: Dict[str, Any]) -> None:
@@ -224,7 +264,7 @@ class RosbridgeSession:
         if pub is None or self not in pub.clients:
             cls = self._established_class(topic, None) if pub is None else pub.data_class
             pub = self.state.acquire_publisher(self, topic, cls, latch=bool(msg.get("latch", False)),
-                                               queue_size=int(msg.get("queue_size", 100)))
+                                               queue_size=_queue_size(msg))
             self.published.add(topic)
         cls = pub.data_class
         if issubclass(cls, minros.AnyMsg):  # set up by a Foxglove client: bytes publisher
@@ -250,6 +290,9 @@ class RosbridgeSession:
             self.log("warning", "png compression is not supported; sending plain JSON", msg.get("id"))
         sub = self.subscriptions.get(topic)
         first = sub is None
+        _bounded("subscribed topics", self.subscriptions, topic)
+        if not first:
+            _bounded(f"subscriptions to {topic}", sub.ids, msg.get("id"), MAX_IDS_PER_TOPIC)
         if first:
             sub = self.subscriptions[topic] = _Subscription()
         sub.ids[msg.get("id")] = {
@@ -277,7 +320,7 @@ class RosbridgeSession:
             put(key, incoming, incoming.size)
         return listener
 
-    def _renderer(self, topic: str, params: Dict[str, Any]) -> Callable[[Incoming], List[Any]]:
+    def _renderer(self, topic: str, params: Dict[str, Any]) -> Callable[[Incoming], Iterable[Any]]:
         compression = params["compression"]
         fragment_size = params["fragment_size"]
         if compression == "cbor":
@@ -294,7 +337,7 @@ class RosbridgeSession:
                      "msg": {"secs": secs, "nsecs": nsecs, "bytes": bytes(incoming.data)}}))]
             return render_raw
 
-        def render_json(incoming: Incoming) -> List[Any]:
+        def render_json(incoming: Incoming) -> Iterable[Any]:
             text = incoming.cached(("rosbridge-json", topic), lambda: json.dumps(
                 {"op": "publish", "topic": topic, "msg": message_to_json(incoming.decoded())}))
             if fragment_size is not None and len(text) > fragment_size > 0:
@@ -387,6 +430,7 @@ class RosbridgeSession:
             srv = get_service_class(msg["type"])
         except Exception as exc:
             raise OpError(f"Unable to load the service type {msg['type']}: {exc}") from None
+        _bounded("advertised services", self.services, name)
         if name in self.services:
             self.log("warning", f"Duplicate service advertised. Overwriting {name}.")
             self.services.pop(name)[0].shutdown("Duplicate advertiser.")
@@ -413,10 +457,18 @@ class RosbridgeSession:
                     self.pending.pop(request_id, None)
             if not box:
                 raise minros.ServiceException(f"the rosbridge client serving {name} went away")
+            if isinstance(box[0], Exception):
+                raise minros.ServiceException(f"the rosbridge client serving {name} answered "
+                                              f"with a response that does not fit: {box[0]}")
             return box[0]
         return handle
 
     def service_response(self, msg: Dict[str, Any]) -> None:
+        """The answer of a client serving a ROS service. As rosbridge_suite's ROS 1 server, the
+        ``values`` are the ROS caller's response whatever ``result`` says (its capability never
+        reads ``result``; roslibjs and roslibpy send ``false`` when the handler returned false,
+        with the values it filled). Values that do not fit fail the ROS call at once, naming
+        why, where rosbridge leaves the caller waiting for good."""
         _check(msg, [(True, "service", (str,)), (True, "result", (bool,))])
         name = msg["service"]
         entry = self.services.get(name)
@@ -427,14 +479,15 @@ class RosbridgeSession:
         if waiting is None:
             raise OpError(f"no call of {name} is waiting for a response with id {msg.get('id')!r}")
         done, box = waiting
-        if msg["result"]:
-            response = entry[1]._response_class()
-            try:
-                populate_message(msg.get("values") or {}, response, self.state.now)
-            except ConversionError:
-                done.set()
-                raise
-            box.append(response)
+        response = entry[1]._response_class()
+        try:
+            _check(msg, [(False, "values", (dict, type(None)))])
+            populate_message(msg.get("values") or {}, response, self.state.now)
+        except (OpError, ConversionError) as exc:
+            box.append(exc)
+            done.set()
+            raise
+        box.append(response)
         done.set()
 
     def unadvertise_service(self, msg: Dict[str, Any]) -> None:
@@ -471,11 +524,15 @@ class RosbridgeSession:
         if msg["total"] != total or not 0 <= msg["num"] < total or msg["num"] in entry["parts"]:
             raise OpError(f"error while trying to append fragment {msg['num']}")
         entry["parts"][msg["num"]] = msg["data"]
-        entry["size"] += len(msg["data"])
+        # a part costs its text and its place in the table: 32 MB of 1-character parts would
+        # otherwise hold 3 GB; and the messages in progress share the bound
+        entry["size"] += len(msg["data"]) + FRAGMENT_OVERHEAD
         entry["time"] = now
-        if entry["size"] > MAX_QUEUE_BYTES:
+        if sum(e["size"] for e in self.fragments.values()) > MAX_QUEUE_BYTES:
             del self.fragments[msg["id"]]
-            raise OpError(f"fragmented message {msg['id']} is larger than {MAX_QUEUE_BYTES} bytes")
+            raise OpError(f"fragmented message {msg['id']} does not fit: the fragments in progress "
+                          f"would hold more than {MAX_QUEUE_BYTES} bytes (send larger fragments, "
+                          "or fewer messages at once)")
         if len(entry["parts"]) == total:
             del self.fragments[msg["id"]]
             self.receive("".join(entry["parts"][i] for i in range(total)))
@@ -504,8 +561,11 @@ class RosbridgeSession:
 _fragment_ids = itertools.count()
 
 
-def fragment(text: str, size: int, message_id: Any) -> List[str]:
-    """rosbridge's fragmentation of an outgoing JSON text into ``fragment`` ops."""
-    parts = [text[i:i + size] for i in range(0, len(text), size)]
-    return [json.dumps({"op": "fragment", "id": message_id, "data": part, "num": n,
-                        "total": len(parts)}) for n, part in enumerate(parts)]
+def fragment(text: str, size: int, message_id: Any) -> Iterator[str]:
+    """rosbridge's fragmentation of an outgoing JSON text into ``fragment`` ops, made one at a
+    time as the writer sends them: the client picks ``fragment_size`` (1 byte would make a
+    1080p image's 8 MB of JSON into 8 million texts at once)."""
+    total = -(-len(text) // size)
+    for n in range(total):
+        yield json.dumps({"op": "fragment", "id": message_id, "data": text[n * size:(n + 1) * size],
+                          "num": n, "total": total})

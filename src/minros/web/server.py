@@ -7,18 +7,26 @@ minros). A connection is told apart by:
   ``minros.page.v1`` (the page at ``/``) -> :class:`~minros.web.page.PageSession`; no (or any
   other) subprotocol -> :class:`RosbridgeSession` (roslibjs and roslibpy ask for none);
 * for plain HTTP (no ``Upgrade``), the path: ``/stream``, ``/snapshot``, ``/stream_viewer``,
-  ``/streams`` (web_video_server's endpoints), else the static files of ``minros/web/static``.
+  ``/streams`` (web_video_server's endpoints), ``/pkg/<package>/<path>`` (a mesh or texture of
+  a ROS package, for the 3D view: ``package://<package>/<path>`` under
+  :mod:`minros.web.assets`' rules, which Foxglove's ``fetchAsset`` follows too), else the static
+  files of ``minros/web/static``.
 
 Each WebSocket client has an :class:`~minros.web.outbox.Outbox` and a writer thread: ROS
 callbacks only queue, the writer encodes and sends. A watchdog closes a client whose send has
 been blocked for ``send_timeout`` seconds (a client that stopped reading); MJPEG viewers write
-with the same bound. With a token, every request (WebSocket or HTTP) must carry it, as
+with the same bound. Every request first passes the Host and Origin checks of
+:mod:`minros.web.origin` (no page of another site may drive the server; ``--allow-origin``
+opens it to named ones). With a token, every request (WebSocket or HTTP) must carry it, as
 ``?token=`` in the URL or an ``Authorization: Bearer`` header, except the page's scripts and
 styles (:data:`PUBLIC_ASSETS`), which hold nothing of the ROS system.
 
 Connections are admitted as in every minros server (:mod:`minros.wire.admission`), by a small
-guard around the websockets handler: ROS_ALLOWED_HOSTS, a cap that closes the oldest
-connection still sending its request when full, a per-peer share. websockets' own options do
+guard around the websockets handler: ROS_ALLOWED_HOSTS, a cap that closes the idlest
+connection when full, a per-peer share. A request counts as busy while it is answered; a
+WebSocket session or an MJPEG stream counts as idle between messages, each message in either
+direction renewing it, so at the cap (or over a peer's share) the session that has done
+nothing for longest is closed and a new client always gets in. websockets' own options do
 the rest: ``open_timeout`` is a deadline for the whole opening handshake, ``max_size`` refuses
 a frame from its announced length, and frames are buffered as their bytes arrive.
 """
@@ -37,13 +45,15 @@ import time
 import traceback
 import urllib.parse
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import minros
 from minros import rosenv
+from minros.web import assets, video
 from minros.web import foxglove_protocol as fp
-from minros.web import video
 from minros.web.foxglove import FoxgloveSession
+from minros.web.learning import LearnHub
+from minros.web.origin import OriginPolicy
 from minros.web.outbox import Outbox
 from minros.web.page import SUBPROTOCOL as PAGE_SUBPROTOCOL
 from minros.web.page import PageHub, PageSession
@@ -60,6 +70,11 @@ DEFAULT_MAX_MESSAGE_SIZE = 64 << 20
 DEFAULT_SEND_TIMEOUT = 10.0
 #: browsers and Foxglove open a few connections each; the handshake of each must end in 10 s
 WEB_LIMITS = admission.Limits(max_connections=512, head_timeout=10.0)
+#: seconds between two renewals of a session's activity (admission's idleness)
+ACTIVITY_INTERVAL = 0.5
+#: content types of the mesh files /pkg/ serves that mimetypes does not know
+_MESH_TYPES = {"stl": "model/stl", "dae": "model/vnd.collada+xml", "obj": "model/obj",
+               "mtl": "model/mtl", "urdf": "application/xml", "xacro": "application/xml"}
 
 
 class _OneLine(logging.Filter):
@@ -110,8 +125,18 @@ class _Client:
         self.send_started: Optional[float] = None
         self.closing: Optional[str] = None
         self.session: Any = None
+        #: the connection's admission key and when it last told admission it was active
+        self.key: Optional[int] = None
+        self.touched = 0.0
         self.writer = threading.Thread(target=self._write_loop, name=f"minros-web-writer:{client_id}",
                                        daemon=True)
+
+    def touch(self) -> None:
+        """Something went in or out: renew the session's activity (at most twice a second)."""
+        now = time.monotonic()
+        if now - self.touched >= ACTIVITY_INTERVAL:
+            self.touched = now
+            self.server.guard_active(self.key)
 
     def close(self, reason: str) -> None:
         """Drop the client (from any thread): one log line, the socket shut down."""
@@ -136,8 +161,9 @@ class _Client:
                 return
             slot, item = got
             try:
+                # a frame, or an iterable of them: rosbridge's fragments are made one at a time
                 frames = item if slot is None else slot.render(item)
-                if not isinstance(frames, list):
+                if isinstance(frames, (str, bytes, bytearray, memoryview)):
                     frames = [frames]
             except Exception as exc:
                 minros.logerr(f"[web] client {self.id}: cannot encode a message for "
@@ -151,12 +177,14 @@ class _Client:
             except (ConnectionClosed, OSError):
                 self.send_started = None
                 return
+            self.touch()
 
 
 class _Guard:
     """Admission in front of websockets' per-connection handler: the allow-list, the cap and
-    the per-peer share of :class:`minros.wire.admission.Admission`. A connection counts as
-    evictable until its request has been read (``served``), then as a session."""
+    the per-peer share of :class:`minros.wire.admission.Admission`. A connection is evictable
+    while its request arrives, busy while it is answered (``served``), then, as a session or
+    a stream, idle since its last message (``active``): the idlest goes first."""
 
     def __init__(self, inner: Any, server: Any, allowed: Any) -> None:
         self.inner = inner
@@ -202,12 +230,46 @@ class _Guard:
                 self._keys.pop(sock, None)
             adm.leave(key)
 
-    def served(self, sock: socket.socket) -> None:
-        """The connection's request is in: a session or a stream now, never evicted."""
+    def key_of(self, sock: socket.socket) -> Optional[int]:
         with self._lock:
-            key = self._keys.get(sock)
+            return self._keys.get(sock)
+
+    def served(self, sock: socket.socket) -> None:
+        """The connection's request is in and being answered: not evicted meanwhile."""
+        key = self.key_of(sock)
         if key is not None:
             self.admission.set_state(key, admission.BUSY)
+
+    def active(self, key: Optional[int]) -> None:
+        """An established session or stream did something now: idle from now on, so it is
+        evicted after every connection that has been quiet for longer."""
+        if key is not None:
+            self.admission.set_state(key, admission.IDLE)
+
+    def evicted(self, key: Optional[int]) -> bool:
+        return key is not None and self.admission.evicted(key)
+
+
+def _header(request: Any, name: str) -> Optional[str]:
+    """The one value of header ``name`` (None when absent); ValueError when repeated."""
+    values = request.headers.get_all(name)
+    if len(values) > 1:
+        raise ValueError(f"the request has {len(values)} {name} headers: send one")
+    return values[0] if values else None
+
+
+def _local_names(bound: str) -> List[str]:
+    """The names this machine answers to in a Host header, besides its addresses and
+    localhost: its host name (and the mDNS ``.local`` one), ROS_HOSTNAME / ROS_IP, and the
+    address ``--host`` names."""
+    names = [bound, rosenv.get_address_override() or ""]
+    try:
+        hostname = socket.gethostname()
+    except OSError:
+        hostname = ""
+    if hostname:
+        names += [hostname, hostname.split(".")[0] + ".local"]
+    return [n for n in names if n]
 
 
 def _refuse(sock: socket.socket, status: int, reason: str) -> None:
@@ -229,7 +291,9 @@ class WebServer:
                  token: Optional[str] = None, name: str = "minros web", rosapi: Any = None,
                  send_timeout: float = DEFAULT_SEND_TIMEOUT,
                  max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE, compression: bool = False,
-                 static_dir: Path = STATIC_DIR, trace: Sequence[str] = ()) -> None:
+                 static_dir: Path = STATIC_DIR, trace: Sequence[str] = (),
+                 allow_origins: Sequence[str] = (),
+                 asset_allowlist: Sequence[str] = assets.DEFAULT_ALLOWLIST) -> None:
         self.state = state
         self.host = host
         self.port = port
@@ -243,7 +307,9 @@ class WebServer:
         self.clients: Dict[str, _Client] = {}
         #: the wire traces followed for the page's Wire view (``--trace``)
         self.wire = WireFeed(trace) if trace else None
-        self.page_hub = PageHub(state, self.wire)
+        #: the exercise a page started (the Learn view), in minros learn's folder
+        self.learn = LearnHub()
+        self.page_hub = PageHub(state, self.wire, self.learn)
         self.viewers = 0
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
@@ -251,7 +317,15 @@ class WebServer:
         self._server: Any = None
         self._guard: Any = None
         self._threads: List[threading.Thread] = []
+        self._evicted = 0
+        self._evicted_logged = -10.0
         self.allowed = rosenv.allowed_hosts()  # ValueError naming a malformed entry
+        #: the Host and Origin checks (OriginError naming a malformed --allow-origin)
+        self.origins = OriginPolicy(allow_origins, _local_names(host))
+        self._refusals_logged: Dict[str, float] = {}
+        #: which package files /pkg/ and Foxglove's fetchAsset serve (ValueError naming a
+        #: pattern that does not parse)
+        self.asset_patterns = assets.compile_allowlist(asset_allowlist)
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -294,6 +368,24 @@ class WebServer:
             host = socket.gethostname()
         return f"http://{host}:{self.port}"
 
+    def guard_active(self, key: Optional[int]) -> None:
+        if self._guard is not None:
+            self._guard.active(key)
+
+    def _note_eviction(self, what: str) -> None:
+        """One log line for the first session closed to make room, then at most one every 10 s
+        with the count (a flood of connections must not flood the log)."""
+        with self._lock:
+            self._evicted += 1
+            now = time.monotonic()
+            if now - self._evicted_logged < 10.0:
+                return
+            count, self._evicted, self._evicted_logged = self._evicted, 0, now
+        more = f" ({count} since the last report)" if count > 1 else ""
+        minros.logwarn(f"[web] closed {what}, the idlest, to make room for a new connection "
+                       f"(at most {WEB_LIMITS.max_connections}, "
+                       f"{WEB_LIMITS.peer_connections} from one address){more}")
+
     def _watchdog(self) -> None:
         while not self._stop.wait(0.5):
             now = time.monotonic()
@@ -315,7 +407,7 @@ class WebServer:
         if self.token is None:
             return True
         given = urllib.parse.parse_qs(query).get("token", [""])[0]
-        auth = request.headers.get("Authorization", "")
+        auth = _header(request, "Authorization") or ""
         if not given and auth.lower().startswith("bearer "):
             given = auth[7:].strip()
         return hmac.compare_digest(given.encode(), self.token.encode())
@@ -339,26 +431,59 @@ class WebServer:
     def _text(self, status: int, text: str) -> Any:
         return self._response(status, (text + "\n").encode("utf-8"))
 
+    def _refused_page(self, connection: Any, status: int, text: str) -> Any:
+        """A 403 (or 400) of the Host and Origin checks, logged at most once a minute per
+        reason (a page may retry every second)."""
+        now = time.monotonic()
+        if now - self._refusals_logged.get(text, -60.0) >= 60.0:
+            if len(self._refusals_logged) > 256:
+                self._refusals_logged.clear()
+            self._refusals_logged[text] = now
+            peer = connection.remote_address
+            reason = text.removeprefix("minros web: ")
+            minros.logwarn(f"[web] {peer[0] if peer else '?'}: {reason}")
+        return self._text(status, text)
+
     def _process_request(self, connection: Any, request: Any) -> Any:
         self._guard.served(connection.socket)
+        try:
+            host = _header(request, "Host")
+            origin = _header(request, "Origin")
+            upgrade = (_header(request, "Upgrade") or "").lower() == "websocket"
+        except ValueError as exc:
+            return self._refused_page(connection, 400, f"minros web: {exc}")
+        refusal = self.origins.host_error(host) or self.origins.origin_error(origin, host)
+        if refusal is not None:
+            return self._refused_page(connection, 403, refusal)
         path, _, query = request.path.partition("?")
-        upgrade = request.headers.get("Upgrade", "").lower() == "websocket"
+        if any(ord(c) < 0x20 or ord(c) == 0x7F for c in urllib.parse.unquote(path)):
+            return self._text(400, "minros web: the path holds a control character (such as "
+                                   "%00): no page or endpoint has one")
         if not upgrade and posixpath.normpath(urllib.parse.unquote(path)).startswith(PUBLIC_ASSETS):
             # the page's code is the same in every install: a browser fetches it without the
             # token (a module's imports carry no query); the page itself and every piece of
             # data (WebSocket, video) still need the token
             return self._static(path)
-        if not self._token_ok(request, query):
+        try:
+            token_ok = self._token_ok(request, query)
+        except ValueError as exc:
+            return self._refused_page(connection, 400, f"minros web: {exc}")
+        if not token_ok:
             peer = connection.remote_address
             minros.logwarn(f"[web] refused {peer[0] if peer else '?'}: wrong or missing token")
             return self._text(401, "minros web: wrong or missing token. Add ?token=TOKEN to the "
                                    "URL (the token `minros web --token` was started with).")
         if upgrade:
             return None
+        cors = self.origins.cors_origin(origin, host)
         try:
-            return self._http(connection, path, query)
+            response = self._http(connection, path, query, cors)
         except video.VideoError as exc:
-            return self._text(exc.status, f"minros web: {exc}")
+            response = self._text(exc.status, f"minros web: {exc}")
+        if cors is not None:  # a page that may use the server may read its answers
+            response.headers["Access-Control-Allow-Origin"] = cors
+            response.headers["Vary"] = "Origin"
+        return response
 
     # -- plain HTTP ------------------------------------------------------------------------
 
@@ -366,9 +491,12 @@ class WebServer:
         token = urllib.parse.parse_qs(query).get("token", [""])[0]
         return "&token=" + urllib.parse.quote(token) if token else ""
 
-    def _http(self, connection: Any, path: str, query: str) -> Any:
+    def _http(self, connection: Any, path: str, query: str, cors: Optional[str]) -> Any:
+        """``cors``: the origin of a page allowed to read the answer, for the stream (whose
+        head is written here); a page of another site may show the images, not read them."""
         if path == "/stream":
-            return self._stream(connection, self._video_params(query))
+            cors_headers = [("Access-Control-Allow-Origin", cors), ("Vary", "Origin")] if cors else []
+            return self._stream(connection, self._video_params(query), cors_headers)
         if path == "/snapshot":
             params = self._video_params(query)
             feed = self._feed(params.topic)
@@ -385,6 +513,8 @@ class WebServer:
             params = self._video_params(query)
             return self._response(200, video.viewer_page(params, query).encode(),
                                   "text/html; charset=utf-8")
+        if path.startswith("/pkg/"):
+            return self._package_file(path)
         if path == "/streams":
             graph = self.state.refresh_graph()
             topics = [t for t, ty in graph.topic_types.items() if video.is_image_type(ty)]
@@ -395,13 +525,30 @@ class WebServer:
     def _static(self, path: str) -> Any:
         relative = urllib.parse.unquote(path).lstrip("/") or "index.html"
         root = self.static_dir.resolve()
-        target = (root / relative).resolve()
-        if root not in target.parents or not target.is_file():
-            return self._text(404, f"minros web: no such page {path}")
+        try:
+            target = (root / relative).resolve()
+            found = root in target.parents and target.is_file()
+        except (OSError, ValueError):  # a name too long for the file system, say
+            found = False
+        if not found:
+            return self._text(404, f"minros web: no such page {path[:200]}")
         content_type = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
         if content_type.startswith("text/") or content_type.endswith("javascript"):
             content_type += "; charset=utf-8"
         return self._response(200, target.read_bytes(), content_type)
+
+    def _package_file(self, path: str) -> Any:
+        """``/pkg/<package>/<path>``: the file ``package://<package>/<path>`` names, if the
+        asset rules allow it (the path stays percent-encoded: the rules decode it)."""
+        uri = assets.PACKAGE_PREFIX + path[len("/pkg/"):]
+        try:
+            data = assets.read(uri, self.asset_patterns)
+        except assets.AssetError as exc:
+            return self._text(exc.status, f"minros web: {exc}")
+        suffix = uri.rsplit(".", 1)[-1].lower()
+        content_type = _MESH_TYPES.get(suffix) or mimetypes.guess_type("x." + suffix)[0]
+        return self._response(200, data, content_type or "application/octet-stream",
+                              [("Cache-Control", "no-cache")])
 
     # -- video -----------------------------------------------------------------------------
 
@@ -439,25 +586,32 @@ class WebServer:
                 del self.state.feeds[topic]
                 self.state.untap(topic, ("video", topic))
 
-    def _stream(self, connection: Any, params: video.StreamParams) -> Any:
+    def _stream(self, connection: Any, params: video.StreamParams,
+                extra_headers: Sequence[Tuple[str, str]] = ()) -> Any:
         """Write an MJPEG stream on the connection's socket until the viewer goes away (this
         runs in the connection's own thread; the websockets handshake is never completed)."""
         feed = self._feed(params.topic)
         sock = connection.socket
         reader = getattr(connection, "recv_events_thread", None)
+        key = self._guard.key_of(sock)
         with self._lock:
             self.viewers += 1
         try:
-            send_with_timeout(sock, [video.stream_head()], self.send_timeout)
+            send_with_timeout(sock, [video.stream_head(extra_headers)], self.send_timeout)
+            self._guard.active(key)
             seq = 0
+            touched = time.monotonic()
             while not self._stop.is_set():
                 newest = feed.wait(seq, 1.0)
                 if reader is not None and not reader.is_alive():
-                    break  # the viewer closed its end
+                    break  # the viewer closed its end (or was closed to make room)
                 if newest == seq:
                     continue
                 seq, jpeg, stamp = feed.jpeg(params)
                 send_with_timeout(sock, video.stream_part(jpeg, stamp), self.send_timeout)
+                if time.monotonic() - touched >= ACTIVITY_INTERVAL:
+                    touched = time.monotonic()
+                    self._guard.active(key)
         except TimeoutError as exc:
             minros.logwarn(f"[web] closing the stream of {params.topic}: {exc}")
         except video.VideoError as exc:
@@ -465,6 +619,8 @@ class WebServer:
         except OSError:
             pass  # the viewer went away
         finally:
+            if self._guard.evicted(key):
+                self._note_eviction(f"the stream of {params.topic} to {connection.remote_address}")
             with self._lock:
                 self.viewers -= 1
             self._release_feed(params.topic)
@@ -475,6 +631,16 @@ class WebServer:
         return self._text(200, "")  # not delivered: the socket is shut down
 
     # -- WebSocket clients -----------------------------------------------------------------
+
+    def _local_page(self, connection: Any) -> bool:
+        """The page is of this machine (may start exercises): see OriginPolicy.local_page."""
+        request = getattr(connection, "request", None)
+        if request is None:
+            return False
+        try:
+            return self.origins.local_page(_header(request, "Origin"), _header(request, "Host"))
+        except ValueError:
+            return False
 
     def _handle(self, connection: Any) -> None:
         from websockets.exceptions import ConnectionClosed
@@ -487,13 +653,17 @@ class WebServer:
         kind = "Foxglove" if foxglove else "page" if page else "rosbridge"
         if foxglove:
             client.session = FoxgloveSession(client_id, self.state, client.outbox, client.close,
-                                             server_name=self.name)
+                                             server_name=self.name,
+                                             asset_patterns=self.asset_patterns)
         elif page:
             client.session = PageSession(client_id, self.state, client.outbox, client.close,
-                                         self.page_hub, rosapi=self.rosapi)
+                                         self.page_hub, rosapi=self.rosapi,
+                                         local=self._local_page(connection))
         else:
             client.session = RosbridgeSession(client_id, self.state, client.outbox, client.close,
                                               rosapi=self.rosapi)
+        client.key = self._guard.key_of(connection.socket)
+        client.touch()
         with self._lock:
             self.clients[client_id] = client
         minros.loginfo(f"[web] {kind} client {client_id} connected")
@@ -503,6 +673,7 @@ class WebServer:
                 client.session.start()
             while True:
                 data = connection.recv()
+                client.touch()
                 try:
                     client.session.receive(data)
                 except Exception:
@@ -514,6 +685,8 @@ class WebServer:
             if sent is not None and sent.code == 1009:  # websockets refused a frame over max_size
                 minros.logwarn(f"[web] closed client {client_id}: it sent a message larger than "
                                f"{self.max_message_size} bytes (raise --max-message-size)")
+            if self._guard.evicted(client.key):
+                self._note_eviction(f"{kind} client {client_id}")
             with self._lock:
                 self.clients.pop(client_id, None)
             client.outbox.close()

@@ -28,12 +28,14 @@ the ``minros`` facade and ``minros.tools``.
 from __future__ import annotations
 
 import fnmatch
+import io
 import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Hashable, List, Optional, Set, Tuple
 
 import minros
+from minros.msgs import reader_for
 from minros.tools.services import probe_service
 from minros.web.rosapi import Graph
 
@@ -115,15 +117,26 @@ class Incoming:
         return self.cached("decoded", self._decode)
 
     def _decode(self) -> Any:
-        cls = self.tap.state.decoder.class_for_header(self.header)
-        msg = cls()
-        msg.deserialize(self.data)
-        return msg
+        # from the bytes, without a default instance first (the publisher chose the type's
+        # definition: its fixed-size arrays may be huge where the message is short)
+        return _reader(self.tap.state.decoder.class_for_header(self.header))(self.data)
+
+
+_READERS: Dict[type, Callable[[Any], Any]] = {}
+
+
+def _reader(cls: type) -> Callable[[Any], Any]:
+    read = _READERS.get(cls)
+    if read is None:
+        read = _READERS[cls] = reader_for(cls)
+    return read
 
 
 class TopicTap:
-    """The one subscriber of the web node on a topic; listeners are called in its receive thread
-    and must only queue (no I/O)."""
+    """The one subscription of the web node on a topic: a subscription of the state's
+    :class:`~minros.web.receiver.Receiver` (no thread of its own), or a Subscriber where the
+    node has one already (/clock on simulated time, a dynamic_reconfigure client's topics).
+    Listeners are called in the receiving thread and must only queue (no I/O)."""
 
     def __init__(self, state: WebState, topic: str, data_class: type) -> None:
         self.state = state
@@ -135,20 +148,57 @@ class TopicTap:
         self.bytes = 0
         self.last_ns = 0
         self.header: Dict[str, str] = {}
+        # the last message of each latching publisher, for listeners that come later: the one
+        # subscription is shared, so a second client would otherwise never see a latched
+        # message (rosbridge's shared subscriber keeps it too)
+        self.latched: Dict[str, Incoming] = {}
         self._times: List[float] = []
-        self.subscriber = minros.Subscriber(topic, data_class, self._callback, tcp_nodelay=True)
+        self.subscriber: Any = None
+        self.raw: Any = None
+        try:
+            self.raw = state.receiver().subscribe(topic, data_class, self._deliver)
+        except ValueError:  # the node subscribes there itself: share its Subscriber
+            self.use_subscriber()
+
+    def use_subscriber(self) -> None:
+        """Receive through a Subscriber from now on, which other code of the node shares: with
+        the type's own class when there is one, since the first Subscriber of a topic picks
+        the class every callback gets (``_callback`` takes either)."""
+        raw, self.raw = self.raw, None
+        if raw is not None:
+            self.state.receiver().unsubscribe(raw)
+        if self.subscriber is None:
+            cls = self.data_class
+            if cls._type not in ("", "*"):
+                try:
+                    cls = self.state.message_class(cls._type)
+                except Exception:  # a type only the publisher knows: bytes it is
+                    cls = self.data_class
+            self.subscriber = minros.Subscriber(self.topic, cls, self._callback, tcp_nodelay=True)
 
     @property
     def type(self) -> str:
         return self.header.get("type") or (self.data_class._type if self.data_class._type != "*" else "")
 
-    def _callback(self, raw: Any) -> None:
-        header = getattr(raw, "_connection_header", None) or {}
+    def _callback(self, msg: Any) -> None:
+        """A Subscriber's message: the bytes as received (a raw class), or, when code of the
+        node subscribed first with the type's class (/clock, dynamic_reconfigure), the
+        message serialized again."""
+        data = getattr(msg, "_buff", None)
+        if data is None:
+            buff = io.BytesIO()
+            msg.serialize(buff)
+            data = buff.getvalue()
+        self._deliver(data, getattr(msg, "_connection_header", None) or {})
+
+    def _deliver(self, data: Any, header: Dict[str, str]) -> None:
         self.header = header
         now_ns = self.state.now_ns()
-        incoming = Incoming(self, raw._buff, header, now_ns)
+        incoming = Incoming(self, data, header, now_ns)
+        if header.get("latching") == "1":
+            self.latched[header.get("callerid", "")] = incoming
         self.count += 1
-        self.bytes += len(raw._buff)
+        self.bytes += len(data)
         self.last_ns = now_ns
         times = self._times
         times.append(time.monotonic())
@@ -170,6 +220,9 @@ class TopicTap:
     def add(self, key: Hashable, listener: Callable[[Incoming], None]) -> None:
         with self.lock:
             self.listeners = {**self.listeners, key: listener}
+            latched = list(self.latched.values())
+        for incoming in latched:
+            listener(incoming)
 
     def remove(self, key: Hashable) -> bool:
         """Drop a listener; True when none is left."""
@@ -180,7 +233,10 @@ class TopicTap:
             return not listeners
 
     def close(self) -> None:
-        self.subscriber.unregister()
+        if self.raw is not None:
+            self.state.receiver().unsubscribe(self.raw)
+        if self.subscriber is not None:
+            self.subscriber.unregister()
 
 
 # -- publishers shared by clients ----------------------------------------------------------
@@ -286,6 +342,7 @@ class WebState:
         self._graph_listeners: Dict[Hashable, Callable[[Graph], None]] = {}
         self._service_types: Dict[Tuple[str, Tuple[str, ...]], str] = {}
         self.taps: Dict[str, TopicTap] = {}
+        self._receiver: Any = None
         self.publishers: Dict[str, SharedPublisher] = {}
         self.channel_ids: Dict[Tuple[str, str], int] = {}
         self.service_ids: Dict[Tuple[str, str], int] = {}
@@ -333,6 +390,8 @@ class WebState:
             pubs, self.publishers = list(self.publishers.values()), {}
         for tap in taps:
             tap.close()
+        if self._receiver is not None:
+            self._receiver.close()
         for pub in pubs:
             if pub.timer:
                 pub.timer.cancel()
@@ -473,6 +532,23 @@ class WebState:
             return self.service_ids[key]
 
     # -- taps ------------------------------------------------------------------------------
+
+    def receiver(self) -> Any:
+        """The node's :class:`~minros.web.receiver.Receiver` (started on first use)."""
+        with self.lock:
+            if self._receiver is None:
+                from minros.web.receiver import Receiver
+
+                self._receiver = Receiver()
+            return self._receiver
+
+    def share_topics(self, topics: List[str]) -> None:
+        """Other code of this node is about to subscribe to ``topics`` with Subscribers (a
+        dynamic_reconfigure client): the taps there move to Subscribers it can share."""
+        with self.lock:
+            taps = [self.taps[t] for t in topics if t in self.taps]
+        for tap in taps:
+            tap.use_subscriber()
 
     def message_class(self, type_name: str) -> type:
         from minros.msgs import get_message_class

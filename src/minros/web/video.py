@@ -1,6 +1,7 @@
 """The video endpoints, as web_video_server serves them: MJPEG streams, snapshots, a viewer page.
 
 ``/stream?topic=T`` answers ``multipart/x-mixed-replace`` JPEG parts (``&width=&height=`` resize,
+at most to the source's size or 3840 x 2160 pixels, whichever is larger,
 ``&quality=`` 1-100, default 95, ``&invert`` rotates 180 degrees, ``&type=mjpeg`` or
 ``ros_compressed``), ``/snapshot?topic=T`` one JPEG, ``/stream_viewer?topic=T`` a page showing the
 stream, and ``/`` lists image topics when asked for ``?list``. ``sensor_msgs/Image`` in every
@@ -18,7 +19,7 @@ import html
 import threading
 import urllib.parse
 from dataclasses import dataclass
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -27,6 +28,10 @@ COMPRESSED = "sensor_msgs/CompressedImage"
 BOUNDARY = "boundarydonotcross"
 DEFAULT_QUALITY = 95
 MAX_SIDE = 16384
+#: frames are sent at most this large (4K UHD) unless the source is larger (see output_size)
+MAX_OUTPUT_PIXELS = 3840 * 2160
+#: JPEGs of the latest frame kept per feed, one per parameter set (the oldest set goes first)
+MAX_PARAM_SETS = 16
 
 
 class VideoError(ValueError):
@@ -143,12 +148,25 @@ def compressed_to_bgr8(msg: Any) -> np.ndarray:
     return _bgr(image)
 
 
+def output_size(width: int, height: int, params: StreamParams) -> Tuple[int, int]:
+    """The size a frame of ``width`` x ``height`` is sent at: ``&width=``/``&height=`` as
+    asked, shrunk (keeping their ratio) to at most the source's pixels or
+    :data:`MAX_OUTPUT_PIXELS`, whichever is more: a viewer picks the size, and 16384 x 16384
+    would take the server 800 MB per frame."""
+    out_w = params.width if params.width > 0 else width
+    out_h = params.height if params.height > 0 else height
+    limit = max(width * height, MAX_OUTPUT_PIXELS)
+    if out_w * out_h > limit:
+        scale = (limit / (out_w * out_h)) ** 0.5
+        out_w, out_h = max(1, int(out_w * scale)), max(1, int(out_h * scale))
+    return out_w, out_h
+
+
 def encode_jpeg(image: np.ndarray, params: StreamParams) -> bytes:
     import cv2
 
     height, width = image.shape[:2]
-    out_w = params.width if params.width > 0 else width
-    out_h = params.height if params.height > 0 else height
+    out_w, out_h = output_size(width, height, params)
     if params.invert:
         image = cv2.flip(image, -1)
     if (out_w, out_h) != (width, height):
@@ -213,7 +231,13 @@ class ImageFeed:
         """``(seq, jpeg, stamp)`` of the latest frame, encoded once for these parameters."""
         key = params.key
         with self.cond:
-            lock = self._locks.setdefault(key, threading.Lock())
+            lock = self._locks.get(key)
+            if lock is None:
+                if len(self._locks) >= MAX_PARAM_SETS:  # viewers pick the sizes: keep a few
+                    oldest = next(iter(self._locks))
+                    del self._locks[oldest]
+                    self._jpegs.pop(oldest, None)
+                lock = self._locks[key] = threading.Lock()
         with lock:
             with self.cond:
                 seq, incoming = self.seq, self.latest
@@ -224,9 +248,13 @@ class ImageFeed:
                 raise VideoError(f"no frame received on {self.topic} yet", 503)
             msg = incoming.decoded()
             type_name = incoming.header.get("type", "")
-            data = incoming.cached(("jpeg",) + key, lambda: frame_jpeg(msg, type_name, params))
+            # kept in the feed (bounded), not on the message: a frame that stays the latest
+            # (a latched image) would collect one JPEG per size every viewer asks for
+            data = frame_jpeg(msg, type_name, params)
             result = (seq, data, stamp_of(msg))
-            self._jpegs[key] = result
+            with self.cond:
+                if key in self._locks:
+                    self._jpegs[key] = result
             self.encoded += 1
             return result
 
@@ -238,12 +266,13 @@ STREAM_HEADERS = [
     ("Cache-Control", "no-cache, no-store, must-revalidate, pre-check=0, post-check=0, max-age=0"),
     ("Pragma", "no-cache"),
     ("Content-type", f"multipart/x-mixed-replace;boundary={BOUNDARY}"),
-    ("Access-Control-Allow-Origin", "*"),
 ]
 
 
-def stream_head() -> bytes:
-    lines = ["HTTP/1.1 200 OK"] + [f"{k}: {v}" for k, v in STREAM_HEADERS]
+def stream_head(extra: Sequence[Tuple[str, str]] = ()) -> bytes:
+    """The response head of an MJPEG stream (web_video_server's headers, without its
+    ``Access-Control-Allow-Origin: *``: the server adds the origin of a page it trusts)."""
+    lines = ["HTTP/1.1 200 OK"] + [f"{k}: {v}" for k, v in [*STREAM_HEADERS, *extra]]
     return ("\r\n".join(lines) + "\r\n\r\n" + f"--{BOUNDARY}\r\n").encode("ascii")
 
 
@@ -256,8 +285,7 @@ def stream_part(jpeg: bytes, stamp: float) -> List[bytes]:
 def snapshot_headers(stamp: float) -> List[Tuple[str, str]]:
     return [("Cache-Control", "no-cache, no-store, must-revalidate, "
             "pre-check=0, post-check=0, max-age=0"), ("X-Timestamp", f"{stamp:.6f}"),
-            ("Pragma", "no-cache"), ("Content-Type", "image/jpeg"),
-            ("Access-Control-Allow-Origin", "*")]
+            ("Pragma", "no-cache"), ("Content-Type", "image/jpeg")]
 
 
 def viewer_page(params: StreamParams, query_string: str) -> str:

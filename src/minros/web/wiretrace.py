@@ -18,6 +18,7 @@ from __future__ import annotations
 import functools
 import glob
 import inspect
+import json
 import os
 import threading
 import time
@@ -422,3 +423,66 @@ class WireFeed:
             steps = self.model.since(since)
             removed = [i for i in sent if i not in self.model.steps]
             return steps, removed, self._status, self.model.seq
+
+
+#: wire steps sent in one frame
+WIRE_BATCH = 500
+
+
+class WireWatch:
+    """One page's place in a feed: the steps it has been sent, as of which ``seq``; its frames
+    (op ``op``) say what changed since. :meth:`follow` points it at another feed (or none),
+    and the next frames start afresh (``reset``)."""
+
+    def __init__(self, op: str = "wire", batch: int = WIRE_BATCH,
+                 empty_status: Optional[Dict[str, Any]] = None) -> None:
+        self.op = op
+        self.batch = max(1, batch)
+        self.empty_status = empty_status
+        self.feed: Optional[WireFeed] = None
+        self.seq: Optional[int] = None  # None: the page watches nothing
+        self.sent: set = set()
+        self.lock = threading.Lock()
+
+    def follow(self, feed: Optional[WireFeed]) -> Optional[WireFeed]:
+        """Watch ``feed`` from its start (None: no feed, but a watch: one frame of nothing
+        when ``empty_status`` is given); returns the feed watched before."""
+        with self.lock:
+            old, self.feed = self.feed, feed
+            self.seq, self.sent = 0, set()
+            return old
+
+    def frames(self) -> List[str]:
+        """What changed since the last frames, in frames of ``batch`` steps (the page drops
+        what is ``removed``: the store keeps the newest steps)."""
+        with self.lock:
+            feed, since, sent = self.feed, self.seq, self.sent
+        if since is None:
+            return []
+        if feed is None:
+            if since != 0 or self.empty_status is None:
+                return []
+            with self.lock:
+                if self.sent is not sent:
+                    return []
+                self.seq = -1  # told once
+            return [json.dumps({"op": self.op, "steps": [], "removed": [], "reset": True,
+                                "status": self.empty_status})]
+        steps, removed, status, seq = feed.changes(since, sent)
+        sent.difference_update(removed)
+        sent.update(step["id"] for step in steps)
+        with self.lock:
+            if self.sent is not sent:  # followed anew meanwhile: a new start
+                return []
+            self.seq = seq
+        frames = []
+        for start in range(0, max(1, len(steps)), self.batch):
+            frame: Dict[str, Any] = {"op": self.op, "steps": steps[start:start + self.batch]}
+            if start == 0:
+                frame["removed"] = removed
+                if since == 0:
+                    frame["reset"] = True
+            if start + self.batch >= len(steps):
+                frame["status"] = status
+            frames.append(json.dumps(frame))
+        return frames

@@ -112,8 +112,11 @@ class MasterClient:
             self._local.proxy = None
             raise MasterFailure(0, f"{method}: malformed answer: {exc}") from None
         except xmlrpc.client.ProtocolError as exc:
+            # str() of wire.xmlrpc's CallRefused/BadReply is the one line naming the cause (a
+            # request over the 64 MiB limit, a host outside ROS_ALLOWED_HOSTS): kept, and the
+            # cause chained, since that line is what the tools print
             self._local.proxy = None
-            raise MasterIOError(str(exc), exc.errcode, exc.errmsg) from None
+            raise MasterIOError(str(exc), exc.errcode, exc.errmsg) from exc
         except (xmlrpc.client.ResponseError, OSError) as exc:
             self._local.proxy = None
             raise MasterIOError(str(exc)) from None
@@ -132,7 +135,7 @@ class MasterClient:
             raise MasterFailure(0, f"system.multicall: {exc.faultString}") from None
         except (xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError, OSError) as exc:
             self._local.proxy = None
-            raise MasterIOError(str(exc)) from None
+            raise MasterIOError(str(exc)) from exc
 
     def close(self) -> None:
         """Close this thread's connection (the next call opens another)."""

@@ -21,8 +21,9 @@ from minros.names import ANYTYPE, SEP, resolve_name
 __all__ = [
     "ERROR", "FAILURE", "ROSRPC", "SUCCESS",
     "CalleeFailure", "CallerError", "ParameterInvalid", "RemoteError", "Validator",
-    "api", "empty_or_valid_name", "is_api", "is_topic", "non_empty_str", "not_none",
-    "parse_rosrpc_uri", "triplet", "unwrap", "valid_name", "valid_type_name",
+    "api", "empty_or_valid_name", "global_name", "is_api", "is_service", "is_topic", "non_empty",
+    "non_empty_str", "not_none", "parse_rosrpc_uri", "triplet", "unwrap", "valid_name",
+    "valid_name_validator_resolved", "valid_name_validator_unresolved", "valid_type_name",
 ]
 
 #: the call did what was asked
@@ -95,6 +96,15 @@ def parse_rosrpc_uri(uri: str) -> Tuple[str, int]:
 Validator = Callable[[Any, str], Any]
 
 
+def non_empty(name: str) -> Validator:
+    """Any value that is not empty (or zero)."""
+    def check(value: Any, caller_id: str) -> Any:
+        if not value:
+            raise ParameterInvalid(f"ERROR: parameter [{name}] must be specified and non-empty")
+        return value
+    return check
+
+
 def non_empty_str(name: str) -> Validator:
     def check(value: Any, caller_id: str) -> Any:
         if not value:
@@ -123,19 +133,41 @@ def is_api(name: str) -> Validator:
     return check
 
 
-def _resolved_name(name: str, value: Any, caller_id: str) -> str:
+def valid_name_validator_unresolved(name: str, value: Any, caller_id: str) -> str:
+    """``value`` as a graph name, unresolved (ParameterInvalid when it cannot be one)."""
     if not value or not isinstance(value, str):
         raise ParameterInvalid(f"ERROR: parameter [{name}] must be a non-empty string")
     # ':' and ' ' catch the common mistake of passing a URI where a name belongs
     if ":" in value or " " in value:
         raise ParameterInvalid(f"ERROR: parameter [{name}] contains illegal chars")
-    return resolve_name(value, caller_id)
+    return value
 
 
-def valid_name(name: str) -> Validator:
-    """A graph name, resolved relative to the caller."""
+def valid_name_validator_resolved(name: str, value: Any, caller_id: str) -> str:
+    """``value`` as a graph name resolved relative to ``caller_id``."""
+    return resolve_name(valid_name_validator_unresolved(name, value, caller_id), caller_id)
+
+
+_resolved_name = valid_name_validator_resolved
+
+
+def valid_name(name: str, resolve: bool = True) -> Validator:
+    """A graph name, resolved relative to the caller (unless ``resolve`` is False)."""
     def check(value: Any, caller_id: str) -> Any:
-        return _resolved_name(name, value, caller_id)
+        if resolve:
+            return valid_name_validator_resolved(name, value, caller_id)
+        return valid_name_validator_unresolved(name, value, caller_id)
+    return check
+
+
+def global_name(name: str) -> Validator:
+    """A global graph name, as given."""
+    def check(value: Any, caller_id: str) -> Any:
+        if not value or not isinstance(value, str):
+            raise ParameterInvalid(f"ERROR: parameter [{name}] must be a non-empty string")
+        if not value.startswith(SEP):
+            raise ParameterInvalid(f"ERROR: parameter [{name}] must be a globally referenced name")
+        return value
     return check
 
 
@@ -147,6 +179,10 @@ def is_topic(name: str) -> Validator:
             raise ParameterInvalid(f"ERROR: parameter [{name}] cannot be the global namespace")
         return resolved
     return check
+
+
+#: a service name is checked as a topic name is
+is_service = is_topic
 
 
 def empty_or_valid_name(name: str) -> Validator:

@@ -17,6 +17,7 @@ lookups are ever made).
 from __future__ import annotations
 
 import logging
+import re
 import socket
 import threading
 import time
@@ -36,6 +37,10 @@ DEFAULT_MAX_CONNECTIONS = 1024
 DEFAULT_CLIENT_TIMEOUT = 5.0
 MAX_HEADER_LINE = 8192
 MAX_HEADER_LINES = 100
+#: arrays and structs nested deeper than this in a reply are refused: no ROS value is that
+#: deep (Python's own XML-RPC writer stops near 450 levels, PyYAML's near 330), and consumers
+#: walk values recursively, so a deeper reply would only end in a RecursionError
+MAX_REPLY_DEPTH = 200
 
 
 def _check_markup(body: bytes | bytearray) -> None:
@@ -354,6 +359,7 @@ class XmlRpcServer:
         # the hard bound on connection threads; evicted ones release it as they exit
         self._slots = threading.BoundedSemaphore(limits.max_connections)
         self._conns: Dict[int, socket.socket] = {}
+        self._conn_threads: Dict[int, threading.Thread] = {}
         self._conns_lock = threading.Lock()
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
@@ -390,10 +396,21 @@ class XmlRpcServer:
             sock.close()
         with self._conns_lock:
             conns = list(self._conns.values())
+            threads = list(self._conn_threads.values())
         for conn in conns:
             _shut(conn)
-        if self._thread is not None and self._thread is not threading.current_thread():
-            self._thread.join(2.0)
+        # joined, so that what a connection does after its last reply (an after-reply hook,
+        # its trace event) is done when shutdown returns; bounded, and never this thread
+        # (shutdown may run in a connection's after-reply hook)
+        deadline = time.monotonic() + 2.0
+        for thread in [self._thread, *threads]:
+            if thread is not None and thread is not threading.current_thread():
+                thread.join(max(0.0, deadline - time.monotonic()))
+
+    def serve_forever(self) -> None:
+        """Block until :meth:`shutdown` (the accept thread serves; this is for callers written
+        for socketserver, whose server loop runs in the calling thread)."""
+        self._stopping.wait()
 
     def connection_count(self) -> int:
         with self._conns_lock:
@@ -446,13 +463,16 @@ class XmlRpcServer:
             return
         try:
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            thread = threading.Thread(target=self._serve_connection, args=(conn, key),
+                                      daemon=True, name=f"xmlrpc-conn:{self.port}")
             with self._conns_lock:
                 self._conns[key] = conn
-            threading.Thread(target=self._serve_connection, args=(conn, key), daemon=True,
-                             name=f"xmlrpc-conn:{self.port}").start()
+                self._conn_threads[key] = thread
+            thread.start()
         except BaseException:  # noqa: BLE001 - e.g. cannot start a thread: drop this client
             with self._conns_lock:
                 self._conns.pop(key, None)
+                self._conn_threads.pop(key, None)
             self.admission.leave(key)
             conn.close()
             self._slots.release()
@@ -524,6 +544,7 @@ class XmlRpcServer:
                 pass
             with self._conns_lock:
                 self._conns.pop(key, None)
+                self._conn_threads.pop(key, None)
             self.admission.leave(key)
             self._slots.release()
 
@@ -611,6 +632,92 @@ def _refuse(conn: socket.socket, status: int, reason: str) -> None:
 # ------------------------------------------------------------------ client
 
 
+class CallError(xmlrpc.client.Error):
+    """A call failed for a reason the client recognised: ``str()`` is one line that names it
+    (and the fix), which the tools print instead of a traceback."""
+
+    def __init__(self, url: str, errcode: int, errmsg: str, headers: Dict[str, str],
+                 text: str) -> None:
+        xmlrpc.client.Error.__init__(self)  # not ProtocolError's: the fields are set here
+        self.url = url
+        self.errcode = errcode
+        self.errmsg = errmsg
+        self.headers = headers
+        self.text = text
+
+    def __str__(self) -> str:
+        return self.text
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__}: {self.text}>"
+
+
+class CallRefused(CallError, ProtocolError):
+    """The server answered with an HTTP error status (``errcode``) and ``errmsg`` saying why:
+    minros's servers answer 413 to a request over their size limit and 403 to a peer outside
+    their ROS_ALLOWED_HOSTS. An :class:`xmlrpc.client.ProtocolError`, as before."""
+
+
+class BadReply(CallError, ProtocolError, xmlrpc.client.ResponseError):
+    """The reply is not an XML-RPC response this client accepts: not HTTP, not XML-RPC, a DTD,
+    nested deeper than :data:`MAX_REPLY_DEPTH`, or larger than the client's limit. Both a
+    ProtocolError and a ResponseError, so code catching either of Python's keeps working."""
+
+
+_LIMIT_OF = re.compile(r"limit of (\d+)")
+
+
+def _refusal(uri: str, status: int, reason: str, headers: Dict[str, str],
+             request_size: int) -> CallRefused:
+    """The one-line explanation of an HTTP error status (``reason``: the server's own line)."""
+    detail = reason.split(": ", 1)[1] if reason[:3] == str(status) and ": " in reason else reason
+    if status == 413:
+        found = _LIMIT_OF.search(reason)
+        limit = f"its limit of {_size(int(found.group(1)))}" if found else "its size limit"
+        text = (f"{uri} refused a request of {_size(request_size)}: larger than {limit} "
+                "per XML-RPC call (keep large data out of parameters and service arguments: "
+                "send it on a topic or as a file)")
+    elif status == 403 and "ROS_ALLOWED_HOSTS" in reason:
+        text = (f"{uri} refused this host: {detail} (add this host's address to "
+                "ROS_ALLOWED_HOSTS where that server runs)")
+    else:
+        text = f"{uri} answered HTTP {status}: {detail or 'no reason given'}"
+    return CallRefused(uri, status, reason, headers, text)
+
+
+def _size(n: int) -> str:
+    mib = n / (1024 * 1024)
+    return f"{n} bytes ({mib:.0f} MiB)" if n >= 1024 * 1024 else f"{n} bytes"
+
+
+_NESTING = re.compile(rb"<(/?)(?:[A-Za-z_][\w.-]*:)?(?:array|struct)\s*>")
+
+
+def check_nesting(data: bytes, limit: int = MAX_REPLY_DEPTH) -> None:
+    """ValueError when arrays and structs in ``data`` nest deeper than ``limit``. Counting the
+    opening tags first (in C) makes the usual reply cost one pass of ``bytes.count``."""
+    if data.count(b"<array") + data.count(b"<struct") + data.count(b":array") \
+            + data.count(b":struct") <= limit:
+        return
+    depth = 0
+    for match in _NESTING.finditer(data):
+        if match.group(1):
+            depth -= 1
+        else:
+            depth += 1
+            if depth > limit:
+                raise ValueError(f"arrays and structs nested more than {limit} deep")
+
+
+def parse_reply(data: bytes) -> Any:
+    """The value of a methodResponse; Fault for a fault response, ValueError (or the XML
+    parser's error) for anything else."""
+    _check_markup(data)
+    check_nesting(data)
+    result, _ = xmlrpc.client.loads(data, use_builtin_types=False)
+    return result[0] if len(result) == 1 else result
+
+
 class _Method:
     __slots__ = ("_send", "_name")
 
@@ -629,8 +736,12 @@ class ServerProxy:
     """XML-RPC client with connect/read timeouts and a kept-alive connection.
 
     Thread-safe (calls on one proxy are serialized). ``proxy.method(*args)`` returns the raw
-    result; faults raise :class:`xmlrpc.client.Fault`, HTTP errors :class:`ProtocolError`,
-    network failures and timeouts :class:`OSError`.
+    result; faults raise :class:`xmlrpc.client.Fault`, network failures and timeouts
+    :class:`OSError`; what the client recognises raises a :class:`CallError` whose one line
+    says what happened: :class:`CallRefused` for an HTTP error status (the server's reason
+    kept: a request over its size limit, a host outside its ROS_ALLOWED_HOSTS),
+    :class:`BadReply` for a reply that is not XML-RPC (garbage, a DTD, nested too deep, too
+    large). Both are :class:`ProtocolError` too.
     """
 
     def __init__(self, uri: str, timeout: float | None = DEFAULT_CLIENT_TIMEOUT, *,
@@ -680,7 +791,7 @@ class ServerProxy:
                 reused = self._sock is not None
                 t0 = time.time() if _trace.ON else 0.0
                 try:
-                    result = self._single_request(request)
+                    result = self._single_request(request, len(body))
                 except (ConnectionResetError, ConnectionAbortedError, BrokenPipeError,
                         _PeerClosed) as exc:
                     if t0:
@@ -720,7 +831,7 @@ class ServerProxy:
                 pass
             self._sock = None
 
-    def _single_request(self, request: bytes) -> Any:
+    def _single_request(self, request: bytes, body_size: int) -> Any:
         if self._sock is None:
             self._addresses = None
             sock = socket.create_connection(self._address, timeout=self.timeout)
@@ -731,7 +842,33 @@ class ServerProxy:
             if _trace.ON:
                 self._addresses = _addresses(sock)
         self._sent += 1
-        self._sock.sendall(request)
+        try:
+            self._sock.sendall(request)
+        except (BrokenPipeError, ConnectionResetError) as exc:
+            # A server that will not take a request (413 over its size limit, 403 outside its
+            # allow-list) answers at once and closes without reading the rest, so the send
+            # fails; its answer is in this socket's receive buffer already.
+            refusal = self._refusal_after_send_failed(body_size)
+            if refusal is not None:
+                raise refusal from exc
+            raise
+        return self._read_reply(body_size)
+
+    def _refusal_after_send_failed(self, body_size: int) -> CallRefused | None:
+        try:
+            assert self._sock is not None
+            self._sock.settimeout(min(self.timeout or 1.0, 1.0))
+            self._read_reply(body_size)
+        except CallRefused as refusal:
+            return refusal
+        except (OSError, xmlrpc.client.Error, ValueError):
+            pass
+        return None
+
+    def _bad(self, what: str, status: int = 0, headers: Dict[str, str] | None = None) -> BadReply:
+        return BadReply(self.uri, status, what, headers or {}, f"{self.uri} sent a bad reply: {what}")
+
+    def _read_reply(self, body_size: int) -> Any:
         reader = self._reader
         status_line = reader.readline(MAX_HEADER_LINE + 1)
         raw_head = [status_line]
@@ -739,7 +876,7 @@ class ServerProxy:
             raise _PeerClosed("connection closed by the server")
         parts = status_line.decode("latin-1").split(None, 2)
         if len(parts) < 2 or not parts[0].startswith("HTTP/") or not parts[1].isdigit():
-            raise ProtocolError(self.uri, 0, f"bad status line {status_line[:80]!r}", {})
+            raise self._bad(f"not HTTP: {status_line[:80]!r}")
         status = int(parts[1])
         reason = parts[2].strip() if len(parts) > 2 else ""
         headers: Dict[str, str] = {}
@@ -751,10 +888,11 @@ class ServerProxy:
             key, _sep, value = line.decode("latin-1").partition(":")
             headers[key.strip().lower()] = value.strip()
         else:
-            raise ProtocolError(self.uri, status, "too many header lines", headers)
+            raise self._bad(f"more than {MAX_HEADER_LINES} header lines", status, headers)
         length_text = headers.get("content-length")
         close = ("close" in headers.get("connection", "").lower()
                  or parts[0] == "HTTP/1.0" and "keep-alive" not in headers.get("connection", "").lower())
+        too_large = f"larger than this client's limit of {_size(self.max_body)}"
         if length_text is None:
             data = reader.read(self.max_body + 1)  # body delimited by the end of the connection
             close = True
@@ -762,9 +900,10 @@ class ServerProxy:
             try:
                 length = int(length_text)
             except ValueError:
-                raise ProtocolError(self.uri, status, "bad Content-Length", headers) from None
+                raise self._bad(f"bad Content-Length {length_text[:40]!r}", status,
+                                headers) from None
             if length < 0 or length > self.max_body:
-                raise ProtocolError(self.uri, 413, "response too large", headers)
+                raise self._bad(f"a body of {length} bytes, {too_large}", status, headers)
             data = reader.read(length)
             if len(data) != length:
                 raise _PeerClosed("connection closed mid-response")
@@ -773,16 +912,28 @@ class ServerProxy:
         if close:
             self._drop()
         if len(data) > self.max_body:
-            raise ProtocolError(self.uri, 413, "response too large", headers)
+            raise self._bad(f"a body {too_large}", status, headers)
         if status != 200:
             self._drop()
             if headers.get("content-type", "").startswith("text/plain") and len(data) < 1024:
                 # a refusal's one line says why (minros's servers name the setting to change)
                 reason = data.decode("utf-8", "replace").strip() or reason
-            raise ProtocolError(self.uri, status, reason, headers)
-        _check_markup(data)
-        result, _ = xmlrpc.client.loads(data, use_builtin_types=False)
-        return result[0] if len(result) == 1 else result
+            raise _refusal(self.uri, status, reason, headers, body_size)
+        try:
+            return parse_reply(data)
+        except Fault:
+            raise
+        except Exception as exc:  # noqa: BLE001 - expat, ValueError, TypeError, ...: not XML-RPC
+            what = _one_line(exc)
+            raise BadReply(self.uri, status, what, headers,
+                           f"{self.uri} sent a reply that is not XML-RPC ({what})") from None
+
+
+def _one_line(exc: BaseException) -> str:
+    if isinstance(exc, xmlrpc.client.ResponseError) and not exc.args:
+        return "no methodResponse value in it"  # what the unmarshaller's bare error means
+    text = " ".join(str(exc).split())
+    return text[:200] if text else type(exc).__name__
 
 
 class _PeerClosed(ConnectionError):

@@ -391,11 +391,9 @@ def _check_definition(path: Path, build: Callable[[str], object], type_name: str
         raise WorkspaceError(f"{path}: {text}") from None
 
 
-def _write_cfg_modules(manifest: Manifest, dist_packages: Path, out: Print) -> None:
-    """generate_dynamic_reconfigure_options: run each ``cfg/*.cfg`` (a broken one fails the
-    build with one line naming file and line) and write ``<pkg>.cfg.<Name>Config`` modules,
-    which rerun the script on import, so later edits need no rebuild."""
-    from minros.dynamic_reconfigure.cfg_import import write_stubs
+def _check_cfg_scripts(manifest: Manifest, out: Print) -> Dict[str, Path]:
+    """Run each ``cfg/*.cfg`` of the package (a broken one fails the build with one line
+    naming file and line); ``{<Name>Config: script}``."""
     from minros.dynamic_reconfigure.generator import CfgError, run_cfg
 
     modules = {}
@@ -405,6 +403,16 @@ def _write_cfg_modules(manifest: Manifest, dist_packages: Path, out: Print) -> N
         except CfgError as exc:
             raise WorkspaceError(str(exc)) from None
         modules[f"{gen.name}Config"] = path
+    return modules
+
+
+def _write_cfg_modules(manifest: Manifest, dist_packages: Path, out: Print) -> None:
+    """generate_dynamic_reconfigure_options: run each ``cfg/*.cfg`` (a broken one fails the
+    build with one line naming file and line) and write ``<pkg>.cfg.<Name>Config`` modules,
+    which rerun the script on import, so later edits need no rebuild."""
+    from minros.dynamic_reconfigure.cfg_import import write_stubs
+
+    modules = _check_cfg_scripts(manifest, out)
     init = dist_packages / manifest.name / "__init__.py"
     if not init.exists():
         init.parent.mkdir(parents=True, exist_ok=True)
@@ -413,7 +421,7 @@ def _write_cfg_modules(manifest: Manifest, dist_packages: Path, out: Print) -> N
 
 
 def _write_message_stubs(manifest: Manifest, dist_packages: Path, src: Path,
-                         out: Print = _print) -> None:
+                         out: Print = _print, stubs: bool = True) -> None:
     """Check the package's .msg/.srv files and write its ``<pkg>.msg``/``<pkg>.srv`` stubs.
 
     The stubs (helper A's writer) generate classes on first use from the package's files, found
@@ -434,12 +442,55 @@ def _write_message_stubs(manifest: Manifest, dist_packages: Path, src: Path,
             out(f"Generating .msg files for action {name}/{path.stem} {path}")
             for suffix in _ACTION_TYPES:
                 _check_definition(path, msgs.get_message_class, f"{name}/{path.stem}{suffix}")
-        msgs.write_stub_package(name, dist_packages)
+        if stubs:
+            msgs.write_stub_package(name, dist_packages)
     finally:
         if previous is None:
             os.environ.pop("ROS_PACKAGE_PATH", None)
         else:
             os.environ["ROS_PACKAGE_PATH"] = previous
+
+
+def shipped_python_packages() -> frozenset:
+    """The top-level Python packages minros installs: its stand-ins under ROS names (rospy,
+    actionlib, tf, std_msgs, ...). A devel space must not put a package of one of these names
+    on PYTHONPATH: it would come first and hide minros's library (an ``actionlib`` holding only
+    message stubs has no SimpleActionClient)."""
+    import importlib.metadata
+
+    try:
+        text = importlib.metadata.distribution("minros").read_text("top_level.txt") or ""
+    except importlib.metadata.PackageNotFoundError:
+        text = ""
+    names = set(text.split())
+    if not names:  # running from a source tree that was never installed
+        stubs = Path(__file__).resolve().parents[3] / "stubs"
+        if stubs.is_dir():
+            names = {p.name for p in stubs.iterdir() if (p / "__init__.py").is_file()}
+    names.discard("minros")
+    return frozenset(names)
+
+
+#: texts that mark a devel-space package as written by minros's catkin_make (safe to remove)
+_WRITTEN_BY_MINROS = ("provided by minros", "written by minros catkin_make", _RELAY_MARK)
+
+
+def _remove_shadowing_package(folder: Path) -> bool:
+    """Remove a devel-space package an earlier catkin_make wrote under a name minros ships;
+    one the user wrote (without minros's marks) is left alone. Returns whether it is gone."""
+    import shutil
+
+    init = folder / "__init__.py"
+    if not folder.is_dir():
+        return True
+    try:
+        text = init.read_text(encoding="utf-8") if init.exists() else ""
+    except (OSError, UnicodeDecodeError):
+        return False
+    if not any(mark in text for mark in _WRITTEN_BY_MINROS):
+        return False
+    shutil.rmtree(folder, ignore_errors=True)
+    return not folder.exists()
 
 
 def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _print) -> List[Manifest]:
@@ -478,18 +529,32 @@ def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _pr
         out(f"-- ~~  - {m.name}")
     out("-- ~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~~")
     total = max(len(manifests), 1)
+    shipped = shipped_python_packages()
     for index, m in enumerate(manifests, 1):
         out(f"-- +++ processing catkin package: '{m.name}'")
         out(f"-- ==> add_subdirectory({m.path.relative_to(src)})")
         counts = _interface_counts(m.path)
+        # a package under the name of a library minros ships gets no Python package in the
+        # devel space (it would hide the library); its .msg/.srv/.cfg still import through
+        # minros's package of that name and the import hook, from the workspace's files
+        hides = m.name in shipped
+        if hides:
+            if not _remove_shadowing_package(dist / m.name):
+                raise WorkspaceError(
+                    f"{dist / m.name} hides minros's Python package '{m.name}': remove it")
+            out(f"-- {m.name}: minros ships the Python package '{m.name}'; the devel space "
+                "leaves it in place (the package's messages import from the workspace)")
         if counts["msg"] or counts["srv"] or counts["action"]:
             messages = counts["msg"] + len(_ACTION_TYPES) * counts["action"]
             out(f"-- {m.name}: {messages} messages, {counts['srv']} services")
-            _write_message_stubs(m, dist, src, out)
+            _write_message_stubs(m, dist, src, out, stubs=not hides)
         if counts["cfg"]:
-            _write_cfg_modules(m, dist, out)
+            if hides:
+                _check_cfg_scripts(m, out)
+            else:
+                _write_cfg_modules(m, dist, out)
         module_src = m.path / "src" / m.name
-        if (module_src / "__init__.py").is_file():
+        if (module_src / "__init__.py").is_file() and not hides:
             init = dist / m.name / "__init__.py"
             init.parent.mkdir(parents=True, exist_ok=True)
             text = init.read_text() if init.exists() else ""

@@ -22,6 +22,8 @@ from minros import packages
 #: package -> executable name -> module run with ``python -m``. Turtlesim's modules are written
 #: separately (minros.nodes.turtlesim); a missing module is reported as "not available".
 BUILTIN_NODES: Dict[str, Dict[str, str]] = {
+    # roscore's node (``minros core`` runs it too); roslaunch's API starts it as a core node
+    "rosout": {"rosout": "minros.nodes.rosout"},
     "rospy_tutorials": {
         "talker.py": "minros.nodes.rospy_tutorials.talker",
         "talker": "minros.nodes.rospy_tutorials.talker",
@@ -49,6 +51,7 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     # tf's tools (minros.tf): names as Debian's tf-tools and tf2-tools install them
     "tf2_ros": {
         "static_transform_publisher": "minros.tf.static_transform_publisher",
+        "buffer_server": "minros.nodes.tf2_ros.buffer_server",
     },
     "tf": {
         "static_transform_publisher": "minros.tf.tf_static_transform_publisher",
@@ -59,6 +62,13 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "tf2_tools": {
         "view_frames.py": "minros.tf.view_frames",
     },
+    # minros sim and the navigation nodes it starts (minros.sim holds their logic)
+    "minros_sim": {"sim_node": "minros.nodes.minros_sim.sim_node"},
+    "map_server": {
+        "map_server": "minros.nodes.map_server.map_server",
+        "map_saver": "minros.nodes.map_server.map_saver",
+    },
+    "move_base": {"move_base": "minros.nodes.move_base.move_base"},
     "turtle_tf": {
         "turtle_tf_broadcaster.py": "minros.nodes.turtle_tf.turtle_tf_broadcaster",
         "turtle_tf_listener.py": "minros.nodes.turtle_tf.turtle_tf_listener",
@@ -78,6 +88,25 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosmsg": {"rosmsg": "minros.cli.msg", "rossrv": "minros.cli.srv"},
     "rosconsole": {"rosconsole": "minros.cli.console"},
     "rostest": {"rostest": "minros.cli.rostest"},
+    "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
+    "image_transport": {"republish": "minros.nodes.image_transport.republish"},
+    "robot_state_publisher": {
+        "robot_state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher",
+        "state_publisher": "minros.nodes.robot_state_publisher.robot_state_publisher"},
+    "joint_state_publisher": {
+        "joint_state_publisher": "minros.nodes.joint_state_publisher.joint_state_publisher"},
+    # PyPI's xacro with minros's package lookup (the package folder holds the same program
+    # for <param command="$(find xacro)/xacro ...">)
+    "xacro": {"xacro": "minros.nodes.xacro.xacro", "xacro.py": "minros.nodes.xacro.xacro"},
+    "tf2_web_republisher": {
+        "tf2_web_republisher": "minros.nodes.tf2_web_republisher.tf2_web_republisher"},
+    # headless: ROS's axclient is a wxPython window
+    "actionlib_tools": {"axclient.py": "minros.nodes.actionlib_tools.axclient",
+                        "axclient": "minros.nodes.actionlib_tools.axclient"},
+    # topic_tools' programs (minros.topic_tools; ROS ships C++ relay/throttle/drop/mux)
+    "topic_tools": {name: f"minros.nodes.topic_tools.{name}" for name in (
+        "relay", "throttle", "drop", "mux", "transform", "mux_select", "mux_add",
+        "mux_delete", "mux_list")},
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...
@@ -183,6 +212,10 @@ def resolve_executable(pkg: str, executable: str) -> List[str]:
                                   f"couldn't find executable named {absname}")
         return command_for(absname)
     unique = _executables_in(pkg, pkg_dir, executable)
+    if not unique and module and _module_exists(module):
+        # the package's sources on ROS_PACKAGE_PATH (rosout's C++, say) have no program: as
+        # ROS finds the installed one first, minros's built-in one runs
+        return [sys.executable, "-m", module]
     if not unique:
         lines = [f"[rosrun] Couldn't find executable named {executable} below {pkg_dir}"]
         others = _search(pkg_dir, executable, skip_build=False)

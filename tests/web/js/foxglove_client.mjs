@@ -9,6 +9,9 @@
 //   node foxglove_client.mjs params URL NAME JSON_VALUE
 //   node foxglove_client.mjs graph URL NODE
 //   node foxglove_client.mjs bench URL TOPIC SECONDS
+//   node foxglove_client.mjs urdf URL [URI...]   what Lichtblick's 3D panel does for a robot: the
+//        /robot_description parameter, then fetchAsset of each mesh it names (and of URI...)
+// FOXGLOVE_CLIENT_ORIGIN=https://app.foxglove.dev sends that Origin, as the hosted app would.
 import { createRequire } from "node:module";
 
 const require = createRequire(import.meta.url);
@@ -37,7 +40,10 @@ function fail(text) {
 
 setTimeout(() => fail(`timed out after ${TIMEOUT_MS} ms in mode ${mode}`), TIMEOUT_MS).unref();
 
-const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+// FOXGLOVE_CLIENT_ORIGIN: send the Origin header a page of that site would (the Foxglove or
+// Lichtblick web app hosted there), as a browser does
+const origin = process.env.FOXGLOVE_CLIENT_ORIGIN;
+const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL], origin ? { origin } : {});
 ws.binaryType = "arraybuffer";
 const client = new FoxgloveClient({ ws });
 const channels = new Map();
@@ -78,7 +84,8 @@ if (mode === "echo" || mode === "bench") {
   if (mode === "echo") {
     let n = 0;
     client.on("message", (event) => {
-      if (event.subscriptionId !== subId) return;
+      // finish() closes asynchronously: messages already in the socket still arrive, not counted
+      if (event.subscriptionId !== subId || n >= Number(countOrSeconds)) return;
       const msg = reader.readMessage(new Uint8Array(event.data.buffer, event.data.byteOffset, event.data.byteLength));
       out({ message: msg, receiveTime: event.timestamp.toString(), size: event.data.byteLength });
       if (++n >= Number(countOrSeconds)) finish();
@@ -161,6 +168,36 @@ if (mode === "echo" || mode === "bench") {
     if (all.includes(node)) finish();
   });
   client.subscribeConnectionGraph();
+} else if (mode === "urdf") {
+  const { createHash } = await import("node:crypto");
+  const info = await serverInfo;
+  if (!info.capabilities.includes("assets")) fail("the server does not offer the assets capability");
+  const urdf = await new Promise((resolve) => {
+    client.on("parameterValues", (event) => {
+      if (event.id !== "get-all-params") return;
+      const found = event.parameters.find((p) => p.name === "/robot_description");
+      resolve(found ? found.value : null);
+    });
+    client.getParameters([], "get-all-params");  // Lichtblick asks for every parameter
+  });
+  if (typeof urdf !== "string") fail("no /robot_description string parameter");
+  const meshes = [...urdf.matchAll(/<mesh\s+filename="([^"]+)"/g)].map((m) => m[1]);
+  out({ robot: { bytes: urdf.length, meshes } });
+  const uris = [...meshes, ...args];
+  const pending = new Map();
+  client.on("fetchAssetResponse", (response) => {
+    const uri = pending.get(response.requestId);
+    pending.delete(response.requestId);
+    const data = response.status === 0 ? new Uint8Array(response.data.buffer, response.data.byteOffset, response.data.byteLength) : null;
+    out({ asset: { uri, requestId: response.requestId, status: response.status, error: response.error,
+                   bytes: data ? data.byteLength : 0, sha256: data ? createHash("sha256").update(data).digest("hex") : null } });
+    if (!pending.size) finish();
+  });
+  uris.forEach((uri, i) => {
+    pending.set(100 + i, uri);
+    client.fetchAsset(uri, 100 + i);
+  });
+  if (!uris.length) finish();
 } else {
   fail(`unknown mode ${mode}`);
 }

@@ -11,12 +11,14 @@ import {createGraphView} from "./views/graph.js";
 import {createTopicsView} from "./views/topics.js";
 import {createPlotView} from "./views/plot.js";
 import {createImagesView} from "./views/images.js";
+import {createView3dView} from "./views/view3d.js";
 import {createTurtlesimView} from "./views/turtlesim.js";
 import {createParamsView} from "./views/params.js";
 import {createServicesView} from "./views/services.js";
 import {createPublishView} from "./views/publish.js";
 import {createConsoleView} from "./views/console.js";
 import {createWireView} from "./views/wire.js";
+import {createLearnView} from "./views/learn.js";
 import {createAboutView} from "./views/about.js";
 
 const VIEWS = [
@@ -24,12 +26,14 @@ const VIEWS = [
   ["topics", "Topics", createTopicsView],
   ["plot", "Plot", createPlotView],
   ["images", "Images", createImagesView],
+  ["3d", "3D", createView3dView],
   ["turtlesim", "Turtlesim", createTurtlesimView],
   ["params", "Parameters", createParamsView],
   ["services", "Services", createServicesView],
   ["publish", "Publish", createPublishView],
   ["console", "Console", createConsoleView],
   ["wire", "Wire", createWireView],
+  ["learn", "Learn", createLearnView],
   ["about", "About", createAboutView],
 ];
 

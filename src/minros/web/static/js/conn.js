@@ -10,8 +10,17 @@
 //
 // It reconnects by itself (backoff up to 5 s) and replays what it was asked to keep (watches,
 // subscriptions) through the "open" handlers each view registers.
+//
+// Binary frames (the 3D view's clouds, scans and maps) are a JSON header and arrays: a uint32
+// (little-endian) header length, the header, zeros to a multiple of 8, then the arrays the
+// header's `buffers` list (name, numpy type, offset from the data's start, length). They are
+// emitted by their header's op like text frames, with `arrays` (typed arrays over the frame,
+// no copy).
 
 export const SUBPROTOCOL = "minros.page.v1";
+
+const TYPED_ARRAYS = {f4: Float32Array, f8: Float64Array, u1: Uint8Array, i1: Int8Array,
+                      u2: Uint16Array, i2: Int16Array, u4: Uint32Array, i4: Int32Array};
 
 export function pageToken() {
   return new URLSearchParams(location.search).get("token") || "";
@@ -44,13 +53,17 @@ export class Connection {
 
   connect() {
     const ws = new WebSocket(this.url, [SUBPROTOCOL]);
+    ws.binaryType = "arraybuffer";
     this.ws = ws;
     ws.onopen = () => {
       this.retry = 250;
       this.advertised.clear();
       for (const [topic, sub] of this.topics) this._subscribeOp(topic, sub);
     };
-    ws.onmessage = (event) => this._receive(event.data);
+    ws.onmessage = (event) => {
+      if (typeof event.data === "string") this._receive(event.data);
+      else this._receiveBinary(event.data);
+    };
     ws.onclose = () => {
       if (this.ws !== ws) return;
       this._setState("disconnected");
@@ -99,6 +112,25 @@ export class Connection {
       const waiting = this.pending.get(msg.id);
       this.pending.delete(msg.id);
       waiting.reject(new Error(msg.msg));
+      return;
+    }
+    this._emit(msg.op, msg);
+  }
+
+  _receiveBinary(buffer) {
+    let msg;
+    try {
+      const length = new DataView(buffer).getUint32(0, true);
+      msg = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, length)));
+      const base = 4 + length + ((8 - ((4 + length) % 8)) % 8);
+      msg.arrays = {};
+      for (const entry of msg.buffers || []) {
+        const Type = TYPED_ARRAYS[entry.type];
+        if (!Type) throw new Error(`unknown array type ${entry.type}`);
+        msg.arrays[entry.name] = new Type(buffer, base + entry.offset, entry.length);
+      }
+    } catch (err) {
+      console.error("minros web sent a binary frame the page cannot read", err);
       return;
     }
     this._emit(msg.op, msg);

@@ -8,6 +8,10 @@
 // details: XML-RPC arguments by name and the [code, status, value] answer, connection headers
 // as key=value tables, a frame's bytes and decoded message. Filter by topic, service or node;
 // pause to read while the trace goes on (what arrives meanwhile is kept and counted).
+//
+// The Learn view shows the trace of an exercise's folder with the same view:
+// createWireView(app, {op: "learn_wire", watch: null, following, help}) takes the frames of
+// another op, leaves the watch to its caller, and is shown while following(status) is true.
 
 import {clear, errorLine, fill, h, treeView} from "../ui.js";
 
@@ -107,7 +111,10 @@ function fileList(paths) {
   return paths.map((path) => path.slice(dir.length)).join(", ") + (dir ? ` in ${dir}` : "");
 }
 
-export function createWireView(app) {
+/** The Wire view; `options` make another instance of it (see the top of the file). */
+export function createWireView(app, options = {}) {
+  const op = options.op || "wire";
+  const following = options.following || (() => Boolean(app.conn.hello && app.conn.hello.wire));
   const sectionSelect = h("select", {class: "wire-section-select", title: "topic or service", onchange: () => refilter()},
     h("option", {value: ""}, "every topic and service"));
   const nodeSelect = h("select", {class: "wire-node-select", title: "node", onchange: () => refilter()},
@@ -342,12 +349,13 @@ export function createWireView(app) {
 
   function renderStatus() {
     const hello = app.conn.hello;
-    const following = hello && hello.wire;
-    help.hidden = Boolean(following);
-    for (const part of [toolbar, source, problems, notes, body]) part.hidden = !following;
-    if (!following) return;
+    const on = following(status);
+    help.hidden = Boolean(on);
+    for (const part of [toolbar, source, problems, notes, body]) part.hidden = !on;
+    if (!on) return;
+    const paths = status && status.files.length ? status.files : status && status.specs.length ? status.specs : hello.wire_paths;
     source.textContent = status
-      ? `following ${fileList(status.files.length ? status.files : hello.wire_paths)} · ${status.events} events` +
+      ? `following ${fileList(paths)} · ${status.events} events` +
         (status.t0 ? ` · times in seconds from ${new Date(status.t0 * 1000).toLocaleTimeString([], {hour12: false})}` : "")
       : "reading the trace…";
     const lines = status ? status.problems : [];
@@ -380,7 +388,8 @@ export function createWireView(app) {
     renderCounts();
   }
 
-  fill(help,
+  if (options.help) fill(help, options.help);
+  else fill(help,
     h("h3", {}, "Wire trace"),
     h("p", {}, "This view shows, live, every XML-RPC call and TCPROS connection header of a running system as the " +
       "numbered sequence ROS courses draw (registerPublisher, registerSubscriber, publisherUpdate, requestTopic, the " +
@@ -391,14 +400,14 @@ export function createWireView(app) {
       "environment) writes its side of the wire to the file; --trace also takes several files, a directory of " +
       "*.jsonl traces or a quoted glob. In a terminal, minros trace show run.jsonl prints the same sequence."));
 
-  app.conn.on("wire", receive);
+  app.conn.on(op, receive);
   app.conn.onOpen(() => {
-    if (app.conn.hello.wire) app.conn.send({op: "wire_watch"});
+    if (options.watch === undefined && app.conn.hello.wire) app.conn.send({op: "wire_watch"});
     schedule(true);
   });
 
   return {
-    id: "wire", el,
+    id: options.id || "wire", el,
     show() {
       visible = true;
       dirtyAll = true;

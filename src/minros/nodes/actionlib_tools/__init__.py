@@ -1,0 +1,1 @@
+"""actionlib_tools' programs (a headless axclient)."""

@@ -1,0 +1,1 @@
+"""nodelet's program (``rosrun nodelet nodelet manager|load|unload|standalone``)."""

@@ -1,0 +1,1 @@
+"""robot_state_publisher's program."""

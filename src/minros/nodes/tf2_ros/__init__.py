@@ -1,0 +1,1 @@
+"""tf2_ros' buffer_server node."""

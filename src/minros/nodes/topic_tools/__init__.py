@@ -1,0 +1,1 @@
+"""topic_tools' programs (``rosrun topic_tools relay|throttle|drop|mux|transform|...``)."""

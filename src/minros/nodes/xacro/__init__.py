@@ -1,0 +1,1 @@
+"""xacro's program."""

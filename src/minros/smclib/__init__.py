@@ -1,0 +1,2 @@
+"""smclib: the Python runtime of the State Machine Compiler (SMC), which ROS's bond and
+other SMC-generated state machines import as ``smclib.statemap``."""

@@ -1,0 +1,1 @@
+"""ackermann_msgs: message package stand-in provided by minros."""

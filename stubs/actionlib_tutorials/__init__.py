@@ -1,0 +1,1 @@
+"""actionlib_tutorials: message package stand-in provided by minros."""

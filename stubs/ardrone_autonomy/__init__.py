@@ -1,0 +1,1 @@
+"""ardrone_autonomy: minros provides the driver's message and service definitions only."""

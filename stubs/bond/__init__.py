@@ -1,0 +1,1 @@
+"""bond: message package stand-in provided by minros."""

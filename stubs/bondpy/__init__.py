@@ -1,0 +1,1 @@
+"""bondpy stand-in: ``from bondpy import bondpy`` (see minros.bondpy)."""

@@ -1,0 +1,1 @@
+"""control_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""darknet_ros_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""franka_msgs: message package stand-in provided by minros."""

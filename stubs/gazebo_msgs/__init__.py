@@ -1,0 +1,1 @@
+"""gazebo_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,3 @@
+"""genpy.genpy_main: the command line of genmsg_py.py and gensrv_py.py (minros.msgs.pygen)."""
+
+from minros.msgs.pygen import genmain, usage, write_modules  # noqa: F401

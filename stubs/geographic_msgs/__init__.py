@@ -1,0 +1,1 @@
+"""geographic_msgs: message package stand-in provided by minros."""

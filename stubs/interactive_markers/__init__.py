@@ -1,0 +1,1 @@
+"""interactive_markers stand-in (see minros.interactive_markers)."""

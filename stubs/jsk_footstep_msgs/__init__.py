@@ -1,0 +1,1 @@
+"""jsk_footstep_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""jsk_recognition_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""kobuki_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""laser_assembler: minros provides the package's service definitions only."""

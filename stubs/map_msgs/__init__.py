@@ -1,0 +1,1 @@
+"""map_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""mavros_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""move_base_msgs: message package stand-in provided by minros."""

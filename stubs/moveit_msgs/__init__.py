@@ -1,0 +1,1 @@
+"""moveit_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""object_recognition_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""octomap_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""pcl_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""polled_camera: minros provides the package's service definition only."""

@@ -1,0 +1,1 @@
+"""pr2_controllers_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""rosapi: message package stand-in provided by minros."""

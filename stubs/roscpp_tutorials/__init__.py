@@ -1,0 +1,1 @@
+"""roscpp_tutorials: message package stand-in provided by minros."""

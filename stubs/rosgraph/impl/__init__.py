@@ -1,0 +1,1 @@
+"""rosgraph.impl: internals of rosgraph (the graph rqt_graph polls)."""

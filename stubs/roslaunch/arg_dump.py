@@ -1,0 +1,3 @@
+"""roslaunch.arg_dump: a launch file's arguments (minros.launch.rostools)."""
+
+from minros.launch.rostools import dump_args, get_args  # noqa: F401

@@ -1,0 +1,3 @@
+"""rosmaster.exceptions."""
+
+from minros.master import InternalException  # noqa: F401

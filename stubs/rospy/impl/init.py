@@ -1,0 +1,9 @@
+"""rospy.impl.init: the node's start and console handler (minros.rospy_internals.init)."""
+
+from minros.rospy_internals.init import (  # noqa: F401
+    DEFAULT_MASTER_PORT,
+    DEFAULT_MASTER_URI,
+    DEFAULT_NODE_PORT,
+    RosStreamHandler,
+    start_node,
+)

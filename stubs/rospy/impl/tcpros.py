@@ -1,0 +1,8 @@
+"""rospy.impl.tcpros: the node's TCPROS handler (minros.rospy_internals.tcpros)."""
+
+from minros.rospy_internals.tcpros import (  # noqa: F401
+    DEFAULT_BUFF_SIZE,
+    TCPROSHandler,
+    get_tcpros_handler,
+    init_tcpros,
+)

@@ -1,0 +1,3 @@
+"""rosunit.xmlrunner: a unittest runner writing JUnit XML (minros.tools.junitxml)."""
+
+from minros.tools.junitxml import XMLTestRunner, cdata  # noqa: F401

@@ -1,0 +1,3 @@
+"""roswtf.context: what roswtf checks and found (minros.cli.wtf)."""
+
+from minros.cli.wtf import WtfContext, WtfException  # noqa: F401

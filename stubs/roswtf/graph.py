@@ -1,0 +1,13 @@
+"""roswtf.graph: checks of the running graph (minros.cli.wtf)."""
+
+from minros.cli.wtf import (  # noqa: F401
+    graph_errors,
+    graph_warnings,
+    missing_edges,
+    ping_check,
+    probe_all_services,
+    simtime_check,
+    unconnected_subscriptions,
+    unexpected_edges,
+    wtf_check_graph,
+)

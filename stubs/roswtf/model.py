@@ -1,0 +1,3 @@
+"""roswtf.model: findings (minros.cli.wtf)."""
+
+from minros.cli.wtf import WtfError, WtfWarning  # noqa: F401

@@ -1,0 +1,7 @@
+"""roswtf.roslaunchwtf: checks of launch files (minros.cli.wtf)."""
+
+from minros.cli.wtf import (  # noqa: F401
+    roslaunch_duplicate_node_check,
+    roslaunch_missing_pkgs_check,
+)
+from minros.cli.wtf import wtf_check_roslaunch_static as wtf_check_static  # noqa: F401

@@ -1,0 +1,3 @@
+"""roswtf.rules: rules' answers as findings (minros.cli.wtf)."""
+
+from minros.cli.wtf import error_rule, warning_rule  # noqa: F401

@@ -1,0 +1,3 @@
+"""smach.iterator stand-in (see minros.smach.iterator)."""
+
+from minros.smach.iterator import *  # noqa: F401,F403

@@ -1,0 +1,1 @@
+"""smach_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""smclib stand-in (see minros.smclib)."""

@@ -1,0 +1,1 @@
+"""tf2_web_republisher: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""theora_image_transport: minros provides the package's message definition only."""

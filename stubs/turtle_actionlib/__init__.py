@@ -1,0 +1,1 @@
+"""turtle_actionlib: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""uuid_msgs: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""vision_msgs: message package stand-in provided by minros."""
