@@ -693,3 +693,27 @@ def test_a_loan_of_a_publication_without_subscribers_left_goes_back(pair):
     pub.remove_connection(sender)
     pub.publish(image(view))
     assert sender.slots.counts()["writing"] == 0 and pub._loan is None
+
+
+def test_a_message_for_one_connection_leaves_the_lender_alone(pair):
+    """rospy's publish(msg, connection_override): only that connection gets the message,
+    even when it holds a loan of another one's slot."""
+    sender, _, _ = pair
+
+    class Other:
+        takes_objects = False
+        done = False
+
+        def __init__(self) -> None:
+            self.frames: List[Any] = []
+
+        def send(self, frame: Any) -> None:
+            self.frames.append(frame)
+
+    other = Other()
+    pub = publication(sender)
+    view = pub.loan(100_000)
+    view[:] = payload(8, 100_000)
+    pub.publish(image(view), connection_override=other)
+    assert len(other.frames) == 1 and frame_len(other.frames[0]) > 100_000
+    assert sender.slots.counts()["writing"] == 1 and sender.stat_msgs == 0
