@@ -321,7 +321,6 @@ def test_rostopic_plot_helpers_and_malformed_field_patterns(capsys) -> None:
     stamp; msgevalgen answers None (and says why) for a malformed pattern."""
     import rostopic
     from geometry_msgs.msg import PointStamped
-
     from minros.msgs import Time
 
     msg = PointStamped()
