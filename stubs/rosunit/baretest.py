@@ -1,5 +1,14 @@
-"""rosunit.baretest's summaries (minros.tools.junitxml)."""
+"""rosunit.baretest: test programs run as unittest cases, and the summaries
+(minros.launch.baretest, minros.tools.junitxml)."""
 
+from minros.launch.baretest import (  # noqa: F401
+    BARE_TIME_LIMIT,
+    TIMEOUT_SIGINT,
+    TIMEOUT_SIGTERM,
+    BareTestCase,
+    LocalProcess,
+    TestTimeoutException,
+)
 from minros.tools.junitxml import print_runner_summary, print_unittest_summary  # noqa: F401
 from rosunit.core import (  # noqa: E402, F401
     create_xml_runner,
@@ -9,7 +18,3 @@ from rosunit.core import (  # noqa: E402, F401
     rostest_name_from_path,
     xml_results_file,
 )
-
-BARE_TIME_LIMIT = 60.0
-TIMEOUT_SIGINT = 15.0
-TIMEOUT_SIGTERM = 2.0
