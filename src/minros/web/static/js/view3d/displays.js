@@ -572,6 +572,19 @@ function palette(scheme) {
 }
 const PALETTES = {map: palette("map"), costmap: palette("costmap")};
 
+const MAP_VERTEX = `varying vec2 vUv;
+void main() {
+  vUv = uv;
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+}`;
+const MAP_FRAGMENT = `uniform sampler2D map;
+uniform float opacity;
+varying vec2 vUv;
+void main() {
+  vec4 texel = texture2D(map, vUv);
+  gl_FragColor = vec4(texel.rgb, texel.a * opacity);
+}`;
+
 export class MapDisplay extends Display {
   static defaults = {alpha: 0.7, scheme: "map"};
   static fields = [["alpha", "alpha", "number", {min: 0, max: 1, step: 0.1}],
@@ -596,14 +609,19 @@ export class MapDisplay extends Display {
     if (!this.mesh || this.size !== `${width}x${height}x${resolution}`) {
       this.clear();
       this.size = `${width}x${height}x${resolution}`;
+      // one cell, one texel, no filtering (as Rviz draws a map); the palette's sRGB bytes are
+      // what the screen shows, so the shader hands them on (no sRGB decode per texel and
+      // encode per pixel): a map covers much of the view, and every pixel of it costs a
+      // software renderer (a third of a frame with the standard material, a tenth with this)
       const texture = new THREE.DataTexture(rgba, width, height, THREE.RGBAFormat);
       texture.magFilter = THREE.NearestFilter;
-      texture.minFilter = THREE.LinearFilter;
-      texture.colorSpace = THREE.SRGBColorSpace;
+      texture.minFilter = THREE.NearestFilter;
       texture.needsUpdate = true;
-      const mat = new THREE.MeshBasicMaterial({map: texture, side: THREE.DoubleSide, transparent: true,
-                                               depthWrite: false, polygonOffset: true,
-                                               polygonOffsetFactor: 1, polygonOffsetUnits: 1});
+      const mat = new THREE.ShaderMaterial({
+        uniforms: {map: {value: texture}, opacity: {value: 1}},
+        vertexShader: MAP_VERTEX, fragmentShader: MAP_FRAGMENT, side: THREE.DoubleSide,
+        transparent: true, depthWrite: false, polygonOffset: true, polygonOffsetFactor: 1,
+        polygonOffsetUnits: 1});
       this.mesh = new THREE.Mesh(new THREE.PlaneGeometry(width * resolution, height * resolution), mat);
       this.mesh.position.set(width * resolution / 2, height * resolution / 2, 0);
       this.origin = new THREE.Group();
@@ -611,8 +629,9 @@ export class MapDisplay extends Display {
       this.anchor = this.scene.anchor({frame: msg.frame, locked: true}, this.group);
       this.anchor.add(this.origin);
     } else {
-      this.mesh.material.map.image.data = rgba;
-      this.mesh.material.map.needsUpdate = true;
+      const texture = this.mesh.material.uniforms.map.value;
+      texture.image.data = rgba;
+      texture.needsUpdate = true;
       this.anchor.userData.place = {frame: msg.frame, locked: true};
       this.scene.placeAnchor(this.anchor);
     }
@@ -622,7 +641,7 @@ export class MapDisplay extends Display {
   }
 
   applyOptions() {
-    if (this.mesh) this.mesh.material.opacity = Number(this.options.alpha);
+    if (this.mesh) this.mesh.material.uniforms.opacity.value = Number(this.options.alpha);
     if (this.last && this.last.scheme !== this.options.scheme) this.data(this.last);
   }
 
