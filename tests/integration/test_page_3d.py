@@ -11,7 +11,8 @@ read back from WebGL, the statuses in the display list) and saves a screenshot
 
 The performance test publishes a PointCloud2 of 100,000 points at 10 Hz and measures, in the
 page, the frames drawn and the clouds taken per second, with the camera still and then turning,
-for ``MINROS_3D_SECONDS`` (20 by default, half each); it prints them and writes
+for ``MINROS_3D_SECONDS`` (20 by default, half each), with the cloud display's "max points" at
+``MINROS_3D_MAX_POINTS`` if set (0: all; else the page's default); it prints them and writes
 view3d_perf.json beside the screenshots.
 """
 
@@ -42,6 +43,7 @@ from support import (
 
 WEB = Path(__file__).resolve().parent.parent / "web"
 PERF_SECONDS = float(os.environ.get("MINROS_3D_SECONDS", "20"))
+PERF_MAX_POINTS = os.environ.get("MINROS_3D_MAX_POINTS")
 V = "minrosPage.view('3d')"
 
 try:
@@ -473,6 +475,10 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
     try:
         cloud.read_until("READY", timeout=30)
         page.wait(f"{V}.summary().some((d) => d.source === '/cloud' && d.total === 100000)", 30_000)
+        if PERF_MAX_POINTS is not None:
+            cloud_display = f"{V}.displays.find((d) => d.source === '/cloud')"
+            page.js(f"{cloud_display}.setOption('max_points', {int(PERF_MAX_POINTS)})")
+            page.wait(f"{cloud_display}.count === {int(PERF_MAX_POINTS) or 100_000}", 30_000)
         page.js(f"{V}.scene3d.resetCamera()")
         # the camera still: the view draws when something changes (each cloud, tf)
         still = measure(page, PERF_SECONDS / 2)
