@@ -1,9 +1,11 @@
 """Master benchmark: minros's master beside Debian's rosmaster (and roscore beside ``minros core``).
 
-Run: ``.venv/bin/python benchmarks/master.py [--quick] [--only-load]``. Every measurement uses the
-same client (Python's stdlib xmlrpc.client over one kept-alive connection per thread) against
-each master, started fresh on a free loopback port, and prints one table. "ratio" = Debian time
-/ minros time (> 1 means minros is faster).
+Run: ``.venv/bin/python benchmarks/master.py [--quick] [--only-load] [--baseline PY]``. Every
+measurement uses the same client (Python's stdlib xmlrpc.client over one kept-alive connection
+per thread) against each master, started fresh on a free loopback port, and prints one table.
+"ratio" = Debian time / minros time (> 1 means minros is faster). ``--baseline PY`` adds the
+master of another checkout (its venv's interpreter), measured in turn with the others, and
+"base/minros" = its time / minros's (> 1 means this checkout is faster).
 
 A second table is the load under attack of issue 18: 500 honest clients (threads in 4 client
 processes, each call on a kept-alive connection) while 100 hostile ones trickle their headers
@@ -377,16 +379,25 @@ def main(argv: List[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer repetitions")
     parser.add_argument("--only-load", action="store_true",
                         help="only the load under attack (issue 18)")
+    parser.add_argument("--baseline", default="", metavar="PY",
+                        help="add the master run by this interpreter (another checkout's venv)")
     args = parser.parse_args(argv)
     if not os.path.exists("/usr/bin/rosmaster"):
         print("Debian's rosmaster is not installed: nothing to compare with", file=sys.stderr)
         return 1
     byte_compile_minros()
+    base = bool(args.baseline)
+    if base:
+        MASTERS["baseline master"] = ([args.baseline, "-m", "minros.master", "-p", "{port}"], False)
+        MASTERS["baseline core"] = ([args.baseline, "-m", "minros", "core", "-p", "{port}"], False)
+        # its checkout, when the interpreter is that checkout's .venv
+        byte_compile_minros(os.path.dirname(os.path.dirname(os.path.dirname(
+            os.path.abspath(args.baseline)))))
     if args.only_load:
         load_section(args.quick)
         return 0
     reps = 1 if args.quick else 3
-    rows: List[Tuple[str, str, float, float]] = []  # (metric, unit, minros, debian)
+    rows: List[Tuple[str, str, float, float, float]] = []  # (metric, unit, minros, debian, base)
     with tempfile.TemporaryDirectory() as home:
         os.makedirs(os.path.join(home, "log"))
 
@@ -399,14 +410,17 @@ def main(argv: List[str] | None = None) -> int:
             return statistics.median(samples)
 
         rows.append(("start to first answer: master", "ms", startup("minros master") * 1e3,
-                     startup("Debian rosmaster") * 1e3))
+                     startup("Debian rosmaster") * 1e3,
+                     startup("baseline master") * 1e3 if base else 0.0))
         rows.append(("start to first answer: core", "ms", startup("minros core") * 1e3,
-                     startup("Debian roscore") * 1e3))
+                     startup("Debian roscore") * 1e3,
+                     startup("baseline core") * 1e3 if base else 0.0))
 
         # Both masters run side by side; every repetition uses fresh ones and measures them in
         # turn, and the table shows medians (a shared 2-core machine is noisy).
         samples: Dict[str, Dict[str, List[float]]] = {
-            kind: {} for kind in ("minros master", "Debian rosmaster")}
+            kind: {} for kind in ("minros master", "Debian rosmaster")
+            + (("baseline master",) if base else ())}
         calls = 40 if args.quick else 100
         for _rep in range(reps):
             running = {kind: Running(kind, home) for kind in samples}
@@ -426,16 +440,20 @@ def main(argv: List[str] | None = None) -> int:
                     m.stop()
         ours = {k: statistics.median(v) for k, v in samples["minros master"].items()}
         deb = {k: statistics.median(v) for k, v in samples["Debian rosmaster"].items()}
-        rows.append(("one getPid call (kept-alive)", "us", ours["latency"], deb["latency"]))
-        rows.append(("register 200 publishers", "ms", ours["reg200"], deb["reg200"]))
-        rows.append(("register 2000 publishers", "ms", ours["reg2000"], deb["reg2000"]))
-        rows.append(("getSystemState, 2200 topics", "ms", ours["state"], deb["state"]))
-        rows.append((f"50 clients x {calls} getParam", "ms", ours["conc"], deb["conc"]))
+        old = {k: statistics.median(v) for k, v in samples.get("baseline master", {}).items()}
+        for metric, unit, key in (("one getPid call (kept-alive)", "us", "latency"),
+                                  ("register 200 publishers", "ms", "reg200"),
+                                  ("register 2000 publishers", "ms", "reg2000"),
+                                  ("getSystemState, 2200 topics", "ms", "state"),
+                                  (f"50 clients x {calls} getParam", "ms", "conc")):
+            rows.append((metric, unit, ours[key], deb[key], old.get(key, 0.0)))
 
-    print(f"{'metric':34} {'unit':>4} {'minros':>10} {'Debian':>10} {'ratio':>7}")
-    print("-" * 69)
-    for metric, unit, mine, theirs in rows:
-        print(f"{metric:34} {unit:>4} {mine:10.1f} {theirs:10.1f} {theirs / mine:6.2f}x")
+    extra = f" {'baseline':>10} {'base/minros':>11}" if base else ""
+    print(f"{'metric':34} {'unit':>4} {'minros':>10} {'Debian':>10} {'ratio':>7}{extra}")
+    print("-" * (69 + len(extra)))
+    for metric, unit, mine, theirs, older in rows:
+        extra = f" {older:10.1f} {older / mine:10.2f}x" if base else ""
+        print(f"{metric:34} {unit:>4} {mine:10.1f} {theirs:10.1f} {theirs / mine:6.2f}x{extra}")
     print(f"\n50 concurrent clients: minros {50 * calls / ours['conc'] * 1e3:.0f} calls/s, "
           f"Debian {50 * calls / deb['conc'] * 1e3:.0f} calls/s (clients are threads of one "
           f"Python process; medians of {reps} fresh runs; 2 shared cores)")

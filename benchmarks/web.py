@@ -111,7 +111,7 @@ def role_raw_sub(topic: str, seconds: float) -> None:
 def role_pub_farm(index: int, nodes: int, per_node: int, rate: float, seconds: float) -> None:
     """``nodes`` nodes of ``per_node`` String topics each, in this one process (Node objects
     of their own: 200 processes would not fit the machine), each topic published at ``rate``."""
-    from minros.client.topics import _PublisherImpl
+    from minros.client.publication import Publication
     from minros.node import Node
     from std_msgs.msg import String
 
@@ -123,7 +123,7 @@ def role_pub_farm(index: int, nodes: int, per_node: int, rate: float, seconds: f
         node.init(name, args_key=(name,))
         for k in range(per_node):
             topic = f"/{name}/t{k}"
-            impl = _PublisherImpl(node, topic, topic, String)
+            impl = Publication(node, topic, topic, String)
             impl.queue_size = 2
             node.add_publication(impl)
             pubs.append(impl)

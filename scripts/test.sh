@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The test command of the README: builds the venv, installs minros with its test tools,
-# installs Debian's ROS 1 reference when running as root (or with sudo), checks ruff,
-# then runs the whole suite. Usage: bash scripts/test.sh [pytest args...]
+# installs Debian's ROS 1 reference when running as root (or with sudo), checks ruff, the
+# import contracts and the types, then runs the whole suite. Usage: bash scripts/test.sh [pytest args...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "$(id -u)" -eq 0 ] || sudo -n true 2>/dev/null; then
@@ -28,6 +28,7 @@ if command -v npm >/dev/null; then
 fi
 .venv/bin/ruff check src stubs tests benchmarks examples
 .venv/bin/lint-imports  # the layers of docs/architecture.md (contracts in pyproject.toml)
+.venv/bin/mypy  # the types of the modules [tool.mypy] lists in pyproject.toml
 
 # Every Python the README promises: the unit and integration tests also run on the oldest and
 # the newest CPython (pyenv's, on this project's image), in venvs of their own, beside the main

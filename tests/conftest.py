@@ -83,3 +83,11 @@ def tf_oracle():
 
 
 __all__ = ["PYTHON", "REFERENCE_PYTHON", "Proc", "free_port", "reference_env", "ros_env"]
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    """Every hypothesis test is in the `fuzz` tier (property and fuzz tests, many examples
+    each): `pytest tests/unit -m "not fuzz"` is the quick run, and CI runs every tier."""
+    for item in items:
+        if getattr(getattr(item, "obj", None), "is_hypothesis_test", False):
+            item.add_marker(pytest.mark.fuzz)

@@ -8,6 +8,9 @@ public names to them.
 
 Names are imported on first use (PEP 562), so ``import minros.wire.tcpros`` or a command-line tool
 does not pay for the whole client library, and one layer can be used without the others.
+Importing this package changes nothing else: the message import hook (``<pkg>.msg`` of any
+package on ROS_PACKAGE_PATH) and the ``cv2.imshow`` hook are installed by ``import rospy`` and
+``init_node``, where a user program needs them, not in the master or the tools.
 """
 
 from __future__ import annotations
@@ -16,15 +19,7 @@ import importlib
 import os
 from typing import Any, Dict
 
-from minros.client.imshow import install as _install_imshow
-from minros.msgs import install_import_hook as _install_import_hook
-
 __version__ = "0.1.0"
-
-# `from my_pkg.msg import Foo` for any package on ROS_PACKAGE_PATH, without a build step.
-_install_import_hook()
-# cv2.imshow in an OpenCV without GUI publishes its windows for `minros web` (client/imshow.py).
-_install_imshow()
 
 _EXCEPTIONS = ("ROSException", "ROSSerializationException", "ROSInitException",
                "ROSInterruptException", "ROSTimeMovedBackwardsException", "ROSInternalException",

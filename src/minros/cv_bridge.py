@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import re
 import sys
-from typing import Dict, Tuple
+from typing import Any, Dict, Tuple
 
 import numpy as np
 
@@ -68,7 +68,7 @@ class CvBridge:
         self.numpy_type_to_cvtype.update({v: k for k, v in _DTYPE_TO_DEPTH.items()})
 
     # -- type helpers (same names as cv_bridge) --
-    def dtype_with_channels_to_cvtype2(self, dtype, n_channels: int) -> str:
+    def dtype_with_channels_to_cvtype2(self, dtype: Any, n_channels: int) -> str:
         try:
             return f"{_DTYPE_TO_DEPTH[np.dtype(dtype).name]}C{n_channels}"
         except KeyError:
@@ -88,7 +88,7 @@ class CvBridge:
         return np.dtype(_DEPTHS[depth]).name, channels
 
     # -- conversions --
-    def imgmsg_to_cv2(self, img_msg, desired_encoding: str = "passthrough") -> np.ndarray:
+    def imgmsg_to_cv2(self, img_msg: Any, desired_encoding: str = "passthrough") -> np.ndarray:
         """A numpy image of ``img_msg``; with ``passthrough`` a view onto the message data."""
         dtype_name, channels = self.encoding_to_dtype_with_channels(img_msg.encoding)
         dtype = np.dtype(dtype_name).newbyteorder(">" if img_msg.is_bigendian else "<")
@@ -113,7 +113,8 @@ class CvBridge:
             return image
         return _convert(image, img_msg.encoding, desired_encoding)
 
-    def cv2_to_imgmsg(self, cvim: np.ndarray, encoding: str = "passthrough", header=None):
+    def cv2_to_imgmsg(self, cvim: np.ndarray, encoding: str = "passthrough",
+                      header: Any = None) -> Any:
         """A sensor_msgs/Image holding a copy of ``cvim``'s pixels."""
         from sensor_msgs.msg import Image
 
@@ -139,7 +140,8 @@ class CvBridge:
         img_msg.step = len(img_msg.data) // img_msg.height if img_msg.height else 0
         return img_msg
 
-    def compressed_imgmsg_to_cv2(self, cmprs_img_msg, desired_encoding: str = "passthrough"):
+    def compressed_imgmsg_to_cv2(self, cmprs_img_msg: Any,
+                                 desired_encoding: str = "passthrough") -> np.ndarray:
         """Decode a sensor_msgs/CompressedImage (jpeg, png, ...) into a numpy image."""
         import cv2
 
@@ -151,7 +153,7 @@ class CvBridge:
             return image
         return _convert(image, "bgr8" if image.ndim == 3 else "mono8", desired_encoding)
 
-    def cv2_to_compressed_imgmsg(self, cvim: np.ndarray, dst_format: str = "jpg"):
+    def cv2_to_compressed_imgmsg(self, cvim: np.ndarray, dst_format: str = "jpg") -> Any:
         """Encode ``cvim`` as a sensor_msgs/CompressedImage in ``dst_format`` (jpg, png, ...)."""
         import cv2
 

@@ -32,7 +32,7 @@ import os
 import signal
 import sys
 import threading
-from typing import Any, Callable, Dict, Iterable, List, Tuple
+from typing import Any, Callable, Deque, Dict, Iterable, List, OrderedDict, Set, Tuple
 
 from minros import logfiles, rosenv
 from minros.names import ANYTYPE, GLOBALNS, SEP, canonicalize_name, is_global, is_private, ns_join
@@ -253,7 +253,7 @@ class ParamDictionary:
         with self.lock:
             return self.tree.has(key)
 
-    def set_param(self, key: str, value: Any, notify_task: Callable[[list], Any] | None = None,
+    def set_param(self, key: str, value: Any, notify_task: Callable[[List[Any]], Any] | None = None,
                   caller_id: str | None = None) -> None:
         """Set ``key`` (the setter, ``caller_id``, is not told of its own change)."""
         with self.lock:
@@ -264,7 +264,7 @@ class ParamDictionary:
                 if updates:
                     notify_task(updates)
 
-    def delete_param(self, key: str, notify_task: Callable[[list], Any] | None = None) -> None:
+    def delete_param(self, key: str, notify_task: Callable[[List[Any]], Any] | None = None) -> None:
         """KeyError when ``key`` is not set; subscribers learn it as the value ``{}``."""
         with self.lock:
             self.tree.delete(key)
@@ -385,7 +385,7 @@ class Registrations:
         if self.type == Registrations.SERVICE:
             raise InternalException("service_api must be specified for Registrations.SERVICE")
         callers = self.map.get(key, [])
-        if (caller_id, caller_api) in callers:
+        if caller_api is not None and (caller_id, caller_api) in callers:
             callers.remove((caller_id, caller_api))
             if not callers:
                 del self.map[key]
@@ -536,14 +536,16 @@ class CallbackPool:
         self.workers = workers
         self.timeout = timeout
         self._call = call or self._xmlrpc_call
-        self._lock = threading.Condition()
+        mutex = threading.RLock()
+        self._lock = threading.Condition(mutex)  # work to do
+        self._drained = threading.Condition(mutex)  # nothing queued or in flight
         # api -> deque of [coalesce_key, method, args, on_result]
-        self._queues: Dict[str, collections.deque] = {}
-        self._ready: collections.deque = collections.deque()  # apis with work and not in flight
-        self._busy: set = set()
+        self._queues: Dict[str, Deque[Any]] = {}
+        self._ready: Deque[str] = collections.deque()  # apis with work and not in flight
+        self._busy: Set[str] = set()
         self._threads: List[threading.Thread] = []
         self._stopped = False
-        self._proxies: collections.OrderedDict = collections.OrderedDict()
+        self._proxies: OrderedDict[str, Any] = collections.OrderedDict()
         self._proxies_lock = threading.Lock()
 
     def queue(self, api: str, method: str, args: Tuple[Any, ...], coalesce: Any | None = None,
@@ -604,12 +606,13 @@ class CallbackPool:
                     pass
             with self._lock:
                 self._busy.discard(api)
-                q = self._queues.get(api)
-                if q:
+                if self._queues.get(api):
                     self._ready.append(api)
                     self._lock.notify()
                 else:
                     self._queues.pop(api, None)
+                    if not self._busy and not self._queues:
+                        self._drained.notify_all()
 
     def _xmlrpc_call(self, api: str, method: str, args: Tuple[Any, ...]) -> Any:
         with self._proxies_lock:
@@ -631,6 +634,11 @@ class CallbackPool:
     def pending(self) -> int:
         with self._lock:
             return sum(len(q) for q in self._queues.values()) + len(self._busy)
+
+    def join(self, timeout: float | None = None) -> bool:
+        """Wait until every queued callback has been made; False if ``timeout`` ran out."""
+        with self._lock:
+            return self._drained.wait_for(lambda: not self._busy and not self._queues, timeout)
 
     def stop(self) -> None:
         with self._lock:
@@ -954,13 +962,13 @@ class Master:
             host = rosenv.get_bind_address(hostname)
         self.pool = CallbackPool(workers, callback_timeout)
         self.handler = MasterHandler(self.pool)
+        self._stopped = threading.Event()
         # Stop once the reply to the shutdown call has reached the caller.
         self.handler._on_shutdown = lambda reason: xmlrpc.after_reply(self._stopped.set)
         bind = rosenv.get_bind_address() if host is None else host
         self.server = xmlrpc.XmlRpcServer(self.handler, bind, port,
                                           ipv6=":" in bind or rosenv.use_ipv6(), allowed=allowed,
                                           on_refused=_report_refusal, what="the master")
-        self._stopped = threading.Event()
         self.uri = ""
 
     def start(self) -> Master:

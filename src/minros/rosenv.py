@@ -209,7 +209,7 @@ def is_local_address(hostname: str, env: Mapping[str, str] | None = None) -> boo
     """Whether ``hostname`` resolves to loopback or to one of this machine's addresses."""
     family = 0 if use_ipv6(env) else socket.AF_INET
     try:
-        ips = [a[4][0] for a in socket.getaddrinfo(hostname, 0, family, 0, socket.SOL_TCP)]
+        ips = [str(a[4][0]) for a in socket.getaddrinfo(hostname, 0, family, 0, socket.SOL_TCP)]
     except (OSError, UnicodeError):
         return False
     if any(ip.startswith("127.") or ip == "::1" for ip in ips):
@@ -246,7 +246,7 @@ def parse_allowed_hosts(text: str) -> Tuple[Network, ...]:
             raise ValueError(f"{ALLOWED_HOSTS_VAR}: [{entry}] is neither an address, a network "
                              "(10.0.0.0/24) nor a host name this machine can resolve") from None
         for info in infos:
-            networks.append(ipaddress.ip_network(info[4][0].split("%", 1)[0]))
+            networks.append(ipaddress.ip_network(str(info[4][0]).split("%", 1)[0]))
     return tuple(networks)
 
 

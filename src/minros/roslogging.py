@@ -20,6 +20,7 @@ import os
 import sys
 import time
 from pathlib import Path
+from types import FrameType
 from typing import Any, Callable, Dict, Mapping, Optional, Tuple
 
 from minros import packages, rosenv
@@ -87,16 +88,16 @@ def format_console_line(fmt: str, *, severity: str, message: str, wall_time: flo
 class _Sources:
     """Where the console gets simulated time and the node's name (the client library's)."""
 
-    ros_time: Callable[[], Optional[float]] = staticmethod(lambda: None)  # type: ignore[assignment]
-    node_name: Callable[[], str] = staticmethod(lambda: "<unknown_node_name>")  # type: ignore[assignment]
+    ros_time: Callable[[], Optional[float]] = staticmethod(lambda: None)
+    node_name: Callable[[], str] = staticmethod(lambda: "<unknown_node_name>")
 
 
 def set_console_sources(ros_time: Callable[[], Optional[float]],
                         node_name: Callable[[], str]) -> None:
     """Called once by the client library: ``ros_time()`` is the simulated time or None on the
     wall clock, ``node_name()`` the node's name."""
-    _Sources.ros_time = staticmethod(ros_time)  # type: ignore[assignment]
-    _Sources.node_name = staticmethod(node_name)  # type: ignore[assignment]
+    _Sources.ros_time = staticmethod(ros_time)
+    _Sources.node_name = staticmethod(node_name)
 
 
 class RosStreamHandler(logging.Handler):
@@ -152,7 +153,7 @@ class RospyLogger(logging.getLoggerClass()):  # type: ignore[misc]
     """A logger whose records name a method's caller ``Class.method``, as rospy's do."""
 
     def findCaller(self, stack_info: bool = False, stacklevel: int = 1) -> Tuple[Any, ...]:
-        frame = sys._getframe(1)
+        frame: Optional[FrameType] = sys._getframe(1)
         while frame is not None and os.path.normcase(frame.f_code.co_filename) == _LOGGING_FILE:
             frame = frame.f_back
         for _ in range(stacklevel - 1):

@@ -12,6 +12,7 @@ from minros.msgs.fill import (  # noqa: F401
     fill_message_args,
     get_printable_message_args,
 )
+from minros.msgs.importer import install_import_hook
 from minros.msgs.message import (  # noqa: F401
     Message,
     RosMsgUnicodeErrors,
@@ -22,6 +23,9 @@ from minros.msgs.message import (  # noqa: F401
 )
 from minros.msgs.registry import import_class
 from minros.msgs.tval import Duration, Time, TVal
+
+# genpy finds classes by importing <pkg>.msg: packages on ROS_PACKAGE_PATH need the hook
+install_import_hook()
 
 __all__ = ["Message", "MessageException", "DeserializationError", "SerializationError",
            "check_type", "get_message_class", "get_service_class", "strify_message",

@@ -3,8 +3,13 @@ catkin-era code still imports (minros.packages, minros.msgs, minros.names, minro
 
 from __future__ import annotations
 
+from minros.msgs import install_import_hook
+
 from . import exceptions, message, names, network, packages, rosenv  # noqa: F401
 from .launcher import load_manifest
+
+# code that uses roslib (load_manifest) imports the messages of packages on ROS_PACKAGE_PATH
+install_import_hook()
 
 __version__ = "1.7.0"
 __all__ = ["load_manifest", "set_interactive", "is_interactive"]

@@ -1,5 +1,5 @@
 """rospy.msg: AnyMsg, the publish-argument convention and the framing of rospy's buffers
-(minros.client.topics, minros.rospy_internals.msg)."""
+(minros.client.msg, minros.rospy_internals.msg)."""
 
 from minros.rospy_internals.msg import (  # noqa: F401
     AnyMsg,

@@ -10,6 +10,7 @@ import json
 import os
 import re
 import signal
+import socket
 import struct
 import subprocess
 from pathlib import Path
@@ -18,6 +19,7 @@ from typing import List, Optional
 import pytest
 
 from support import PYTHON, Proc, wait_until
+from zenoh_support import require_zenoh
 
 
 def _events(path: Path) -> List[dict]:
@@ -304,7 +306,8 @@ def test_10_the_master_restarts(learner):
 
 
 def test_11_a_topic_across_two_masters_through_a_relay(learner):
-    me = learner(11)
+    me = learner(11, "--via", "relay")
+    assert me.facts["variant"] == "relay"
     assert me.env["ROS_MASTER_URI"] == me.facts["master_b"]
     me.traced("me.jsonl", "topic", "echo", "-n", "1", "/chatter")
     shown = me.show(str(me.path("me.jsonl")), "--topic", "/chatter")
@@ -315,11 +318,111 @@ def test_11_a_topic_across_two_masters_through_a_relay(learner):
     me.stop()
 
 
-def test_the_zenoh_variant_is_refused_in_one_line(tmp_path):
-    done = subprocess.run([PYTHON, "-m", "minros", "learn", "11", "--via", "zenoh", "--dir",
+def _sockets(pid: int) -> List[tuple]:
+    """The TCP sockets ``pid`` listens on and the UDP sockets it has bound, as (protocol,
+    address, port), from /proc (the namespace's socket tables, matched by inode)."""
+    inodes = set()
+    for fd in os.listdir(f"/proc/{pid}/fd"):
+        try:
+            link = os.readlink(f"/proc/{pid}/fd/{fd}")
+        except OSError:
+            continue
+        if link.startswith("socket:["):
+            inodes.add(link[len("socket:["):-1])
+    found = []
+    for proto in ("tcp", "tcp6", "udp", "udp6"):
+        lines = Path(f"/proc/{pid}/net/{proto}").read_text().splitlines()[1:]
+        for cols in (line.split() for line in lines):
+            if cols[9] not in inodes or (proto.startswith("tcp") and cols[3] != "0A"):
+                continue  # not this process's, or a TCP socket that is not listening
+            address, port = cols[1].split(":")
+            raw = bytes.fromhex(address)
+            if len(raw) == 4:
+                host = socket.inet_ntop(socket.AF_INET, raw[::-1])
+            else:
+                host = socket.inet_ntop(socket.AF_INET6, b"".join(
+                    raw[i:i + 4][::-1] for i in range(0, 16, 4)))
+            found.append((proto, host, int(port, 16)))
+    return found
+
+
+def test_11_a_topic_across_two_masters_through_minros_zenoh(learner):
+    require_zenoh()
+    me = learner(11)  # the default where eclipse-zenoh is installed
+    assert me.facts["variant"] == "zenoh" and "minros learn check 11 CALLERID KEY" in me.task
+    assert f"listens on tcp/127.0.0.1:{me.facts['zenoh_port']}" in me.task
+    # nothing reaches the LAN: the bridges listen on loopback only and scout no multicast
+    for name in ("bridge_a", "bridge_b"):
+        bound = _sockets(me.facts["pids"][name])
+        assert bound and all(host == "127.0.0.1" and proto == "tcp"
+                             for proto, host, _port in bound), (name, bound)
+    assert ("tcp", "127.0.0.1", me.facts["zenoh_port"]) in _sockets(me.facts["pids"]["bridge_a"])
+    assert not (me.folder / "bridge_a.jsonl").exists()  # untraced: the others show its calls
+    me.traced("me.jsonl", "topic", "echo", "-n", "1", "/chatter")
+    shown = me.show(*map(str, sorted(me.folder.glob("*.jsonl"))), "--topic", "/chatter")
+    # master B's trace: the bridge registered /chatter there as a publisher
+    assert re.search(r'/minros_zenoh -> /master +registerPublisher\("/minros_zenoh", '
+                     r'"/chatter", "std_msgs/String"', shown), shown
+    mine = me.show(str(me.path("me.jsonl")), "--topic", "/chatter")
+    sender = re.findall(r"callerid=(/\w+)", mine)[1]  # the publisher's header, the second
+    assert sender == "/minros_zenoh"
+    keys = me.run("zenoh", "keys", "/chatter")  # asks master B and the bridge there
+    assert keys.returncode == 0, keys.stderr
+    key = keys.stdout.strip()
+    assert key == "7374645f6d7367732f537472696e67/992ce8a1687cec8c8bd883ec73ca41d1/*/chatter"
+    code, out = me.check("/talker", key)
+    assert code == 1 and "reached master B through the bridges" in out, out
+    out = me.wrong_then_right([sender, "std_msgs/String"], "one part of the key", [sender, key])
+    assert "Master B's trace shows /minros_zenoh's registerPublisher for /chatter" in out
+    assert "no call from your node" in out
+    me.stop()
+
+
+def test_the_page_starts_exercise_11_through_minros_zenoh_and_stops_it(tmp_path):
+    """The Learn view's server side (minros.web.learning) with the real runner: what a page's
+    Start runs for exercise 11, checked and stopped as the page does it."""
+    from minros.web.learning import LearnHub
+
+    require_zenoh()
+    home = tmp_path / "ros_home"
+    (home / "log").mkdir(parents=True)
+    hub = LearnHub(tmp_path / "learn")
+    try:
+        run = hub.start("page", 11)
+        wait_until(lambda: hub.status("page")["state"] != "starting", 90, what="the start")
+        status = hub.status("page")
+        assert status["state"] == "running", status
+        assert status["variant"] == "zenoh" and "key expression" in status["task"]
+        assert [p["name"] for p in status["processes"]] == [
+            "master", "master_b", "talker", "bridge_a", "bridge_b"]
+        env = {k: v for k, v in os.environ.items()
+               if not k.startswith(("ROS_", "MINROS_")) and k != "PYTHONPATH"}
+        env.update(ROS_HOME=str(home), ROS_MASTER_URI=run.facts["master_b"],
+                   ROS_HOSTNAME="localhost")
+        echo = subprocess.run([PYTHON, "-m", "minros", "trace", "-o", run.facts["me"], "--",
+                               PYTHON, "-m", "minros", "topic", "echo", "-n", "1", "/chatter"],
+                              env=env, capture_output=True, text=True, timeout=60)
+        assert echo.returncode == 0, echo.stderr
+        key = "7374645f6d7367732f537472696e67/992ce8a1687cec8c8bd883ec73ca41d1/*/chatter"
+        verdict = hub.check(11, f"/minros_zenoh {key}")
+        assert verdict["ok"], verdict
+        pids = [p["pid"] for p in status["processes"]]
+        hub.stop("page")
+        wait_until(lambda: hub.status("page")["state"] == "stopped", 60, what="the stop")
+        assert hub.status("page")["reason"] == "stopped from the page"
+        assert not [pid for pid in pids if _alive(pid)], "the page's start left processes"
+    finally:
+        hub.close()
+
+
+def test_without_eclipse_zenoh_the_zenoh_variant_is_refused_in_one_line(tmp_path):
+    # as if the extra were not installed: the module cannot be found
+    code = ("import sys; sys.modules['zenoh'] = None; from minros.cli.main import main; "
+            "sys.argv[0] = 'minros'; sys.exit(main())")
+    done = subprocess.run([PYTHON, "-c", code, "learn", "11", "--via", "zenoh", "--dir",
                            str(tmp_path)], capture_output=True, text=True, timeout=60)
-    assert done.returncode == 1 and done.stderr.count("\n") == 1
-    assert "minros zenoh does not exist yet" in done.stderr and "--via relay" in done.stderr
+    assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+    assert "pip install minros[zenoh]" in done.stderr and "--via relay" in done.stderr
     assert not list(tmp_path.iterdir())
 
 

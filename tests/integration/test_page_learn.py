@@ -31,6 +31,7 @@ from support import (
     wait_for_master,
     wait_until,
 )
+from zenoh_support import require_zenoh
 
 
 def _alive(pid: int) -> bool:
@@ -213,6 +214,53 @@ def test_a_learner_starts_exercise_1_answers_wrong_then_right_and_stops_it(serve
         view.locator(".learn-check").click()
         tab.page.wait_for_function("!document.querySelector('.learn-check').disabled")
         assert view.locator(".learn-verdict.right").count() == 1
+    finally:
+        tab.close()
+
+
+def test_exercise_11_starts_from_the_page_through_minros_zenoh(server, browser, shots):
+    require_zenoh()
+    tab = Page(browser, server, shots)
+    try:
+        tab.open("learn")
+        view = tab.view("learn")
+        view.locator('.learn-item[data-number="11"]').click()
+        assert "Start runs master, master_b, talker, bridge_a, bridge_b" in view.locator(
+            ".learn-state").inner_text()
+        view.locator(".learn-start").click()
+        _running(tab, 11, timeout=90_000)
+        facts = server.facts(11)
+        assert facts["variant"] == "zenoh"
+        pids = list(facts["pids"].values())
+        assert len(pids) == 5 and all(_alive(pid) for pid in pids)
+        task = view.locator(".learn-task").inner_text()
+        assert f"listens on tcp/127.0.0.1:{facts['zenoh_port']}" in task
+        # master B's trace, in the view: the bridge there registered /chatter as a publisher
+        chatter = view.locator('.learn-trace .wire-section[data-section="topic /chatter"]')
+        chatter.get_by_text('registerPublisher("/minros_zenoh", "/chatter"').first.wait_for(
+            timeout=20_000)
+        env = dict(server.env, ROS_MASTER_URI=facts["master_b"], ROS_HOSTNAME="localhost")
+        done = subprocess.run([PYTHON, "-m", "minros", "trace", "-o", facts["me"], "--",
+                               PYTHON, "-m", "minros", "topic", "echo", "-n", "1", "/chatter"],
+                              env=env, capture_output=True, text=True, timeout=60,
+                              cwd=facts["dir"])
+        assert done.returncode == 0 and "hello world" in done.stdout, done.stderr
+        keys = subprocess.run([PYTHON, "-m", "minros", "zenoh", "keys", "/chatter"], env=env,
+                              capture_output=True, text=True, timeout=60)
+        assert keys.returncode == 0, keys.stderr
+        answer = view.locator(".learn-answer")
+        answer.fill(f"/minros_zenoh {keys.stdout.strip()}")
+        view.locator(".learn-check").click()
+        right = view.locator(".learn-verdict.right")
+        right.wait_for(timeout=20_000)
+        assert "callerid=/minros_zenoh" in right.inner_text()
+        tab.page.wait_for_timeout(300)
+        tab.shot("learn_zenoh")
+        view.locator(".learn-stop").click()
+        tab.page.wait_for_function("minrosPage.views.get('learn').state.run.state === 'stopped'",
+                                   timeout=40_000)
+        assert not [pid for pid in pids if _alive(pid)]
+        assert not _left_in(Path(facts["dir"]))
     finally:
         tab.close()
 

@@ -67,7 +67,7 @@ def test_search_param(master_env):
 NODE = r'''
 import json, time, sys
 import rospy
-import minros.client.params as P
+from minros import node as N
 
 rospy.init_node("pnode")
 out = {
@@ -82,11 +82,11 @@ rospy.set_param("relative_written", "yes")
 out["cached1"] = rospy.get_param_cached("/watched")
 out["cached_missing"] = rospy.get_param_cached("/not_there", "dflt")
 calls = []
-original = P._call_master
+original = N.master().raw
 def counting(method, *args):
     calls.append(method)
     return original(method, *args)
-P._call_master = counting
+N.master().raw = counting
 print("RESULT1 " + json.dumps(out), flush=True)
 deadline = time.monotonic() + 20
 value = out["cached1"]
@@ -138,11 +138,11 @@ from minros import node
 rospy.init_node("unset_node")
 calls = []
 me = node.default_node()
-original = me.master_call
+original = me.master.raw
 def counting(method, *args):
     calls.append(method)
     return original(method, *args)
-me.master_call = counting
+me.master.raw = counting
 first = [rospy.get_param_cached("/later", "dflt") for _ in range(5)]
 print("RESULT1 " + json.dumps({"values": first, "master_calls": calls}), flush=True)
 deadline = time.monotonic() + 20

@@ -385,9 +385,9 @@ def test_master_restart_reregisters_and_reconnects(scripts, ros_home):
 SYNC_FLOODER = r'''
 import time
 import rospy
-import minros.client.topics
+import minros.transport.tcpros_pubsub
 from std_msgs.msg import UInt8MultiArray
-minros.client.topics.SYNC_SEND_TIMEOUT = 1.0  # rospy's socket timeout is 60 s; shortened for the test
+minros.transport.tcpros_pubsub.SYNC_SEND_TIMEOUT = 1.0  # rospy's socket timeout is 60 s; shortened for the test
 rospy.init_node("sync_flooder")
 pub = rospy.Publisher("/sync_flood", UInt8MultiArray, queue_size=None)
 print("ready", flush=True)

@@ -38,6 +38,8 @@ again = CameraInfoManager("front_cam", "file://" + sys.argv[1] + "/${NAME}.yaml"
 again.loadCameraInfo()
 info = again.getCameraInfo()
 print("reloaded", list(info.K), info.width, info.distortion_model, flush=True)
+# the handler marks the manager calibrated before its answer is sent: stay up to send it
+rospy.spin()
 '''
 
 CALIBRATOR = r'''

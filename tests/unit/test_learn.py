@@ -16,6 +16,7 @@ from minros.cli import learn as learn_cli
 from minros.learn import catalog
 from minros.learn.evidence import connections, latency
 from minros.learn.model import tokens
+from zenoh_support import require_zenoh
 
 MASTER = "http://localhost:11311/"
 ME = "http://localhost:40001/"
@@ -72,12 +73,18 @@ def test_the_list_has_at_least_ten_short_exercises_numbered_from_one():
 def test_every_task_fills_its_fields_and_names_the_check_command():
     facts = {"dir": "/d", "me": "/d/me.jsonl", "master": MASTER, "master_b": TALKER,
              "port": 1, "port_b": 2, "python": "python3", "master_pid": 7, "reading": "x",
-             "frame_id": "attic", "temperature": 1.0, "variance": 0.5, "bridge_text": "relay",
+             "frame_id": "attic", "temperature": 1.0, "variance": 0.5, "zenoh_port": 3,
              "door_latch": "1", "window_latch": "0", "field": "value"}
     for ex in learn.exercises():
-        text = ex.task_text(facts)
-        assert not re.search(r"<[a-z_]+>", text), (ex.number, text)  # no missing fact
-        assert f"minros learn check {ex.number} {ex.answer_form}" in text
+        for variant in ex.variants:
+            text = ex.task_text(dict(facts, variant=variant))
+            assert not re.search(r"<[a-z_]+>", text), (ex.number, variant, text)  # all filled
+            assert f"minros learn check {ex.number} {ex.form(variant)}" in text
+    eleven = learn.exercise(11)
+    assert eleven.form("relay") == "CALLERID N" and eleven.form("zenoh") == "CALLERID KEY"
+    zenoh = eleven.task_text(dict(facts, variant="zenoh"))
+    assert "listens on tcp/127.0.0.1:3," in zenoh and "key expression" in zenoh
+    assert "how many TCPROS" in eleven.task_text(dict(facts, variant="relay"))
 
 
 def test_answers_are_read_as_words_whatever_the_learner_copied():
@@ -354,34 +361,162 @@ def test_10_the_master_restarts():
 # --------------------------------------------------------------------------- 11
 
 
-def _across() -> List[dict]:
+def _across(sender: str = "/relay") -> List[dict]:
     b = "http://localhost:11312/"
     return [{"ev": "node", "t": 0.5, "pid": 1, "node": "/me", "name": "/me", "uri": ME},
             call("registerSubscriber", ["/me", "/chatter", "*", ME],
                  [1, "Subscribed", ["http://localhost:40009/"]], uri=b)] + conn(
         1, "connect", {"topic": "/chatter", "callerid": "/me"},
-        {"topic": "/chatter", "callerid": "/relay", "type": "std_msgs/String"})
+        {"topic": "/chatter", "callerid": sender, "type": "std_msgs/String",
+         "md5sum": catalog.STRING_MD5})
 
 
-def test_11_a_topic_across_two_masters():
-    facts = {"master_b": "http://localhost:11312/", "hops": 2}
+def test_11_a_topic_across_two_masters_through_a_relay():
+    facts = {"master_b": "http://localhost:11312/", "hops": 2, "variant": "relay"}
     right = attempt(11, "/relay 2", _across(), facts, master=[])
     assert right.ok and "Master A's trace has no call from your node (/me)" in right.text
+    assert "--via zenoh does the same" in right.text
     assert "master A" in attempt(11, "/talker 2", _across(), facts).text
     assert "pipe, not TCPROS" in attempt(11, "/relay 3", _across(), facts).hint
-    on_a = attempt(11, "/relay 2", _across(), {"master_b": "http://localhost:9/"})
+    on_a = attempt(11, "/relay 2", _across(),
+                   {"master_b": "http://localhost:9/", "variant": "relay"})
     assert not on_a.ok and "ROS_MASTER_URI=http://localhost:9/" in on_a.hint
 
 
-def test_the_relay_is_one_variant_of_exercise_11_and_zenoh_is_planned(tmp_path):
-    from minros.learn.session import LearnError, Runner
+KEY = "7374645f6d7367732f537472696e67/992ce8a1687cec8c8bd883ec73ca41d1/*/chatter"
+ZENOH = {"master_b": "http://localhost:11312/", "variant": "zenoh", "answer_form": "CALLERID KEY"}
 
+
+def _master_b_heard_the_bridge() -> List[dict]:
+    return [call("registerPublisher", ["/minros_zenoh", "/chatter", "std_msgs/String",
+                                       "http://localhost:40011/"],
+                 [1, "Registered [/minros_zenoh] as publisher of [/chatter]", []],
+                 served=True, node="/master", uri="")]
+
+
+def test_11_through_zenoh_the_sender_and_the_key():
+    mine = _across("/minros_zenoh")
+    right = attempt(11, f"/minros_zenoh {KEY}", mine, ZENOH, master=[],
+                    master_b=_master_b_heard_the_bridge())
+    assert right.ok, right
+    assert "Master B's trace shows /minros_zenoh's registerPublisher for /chatter" in right.text
+    assert f"under {KEY}" in right.text and "no call from your node (/me)" in right.text
+    # quoted, with commas, as a learner may paste it
+    assert attempt(11, f'"/minros_zenoh", "{KEY}"', mine, ZENOH).ok
+    # without master B's trace the text still says what happened, not what a trace shows
+    assert "registered /chatter as a publisher on master B" in attempt(
+        11, f"/minros_zenoh {KEY}", mine, ZENOH).text
+
+
+@pytest.mark.parametrize("answer, text, hint", [
+    (f"/talker {KEY}", "/talker publishes on master A", "reached master B through the bridges"),
+    (f"/rosout {KEY}", "not who sent you the message", "callerid field of the second header"),
+    ("/minros_zenoh", "now the key", "minros zenoh keys /chatter"),
+    ("/minros_zenoh std_msgs/String", "is not the key", "one part of the key"),
+    (f"/minros_zenoh ros1_discovery_info/*/pub/{KEY}", "is not the key", "beacon"),
+    ("/minros_zenoh 537472696e67/992ce8a1687cec8c8bd883ec73ca41d1/*/chatter", "is not the key",
+     "hex of the type's whole name, std_msgs/String"),
+    (f"/minros_zenoh {KEY.replace('992c', '0000')}", "is not the key", "md5sum of the publisher"),
+    (f"/minros_zenoh {KEY.replace('/*/', '/robot/')}", "is not the key", "namespace is '*'"),
+    (f"/minros_zenoh {KEY}/", "is not the key", "no '/' at either end"),
+    (f"/minros_zenoh {KEY.replace('/*/', '/')}", "is not the key", "four parts"),
+    (f"/minros_zenoh {KEY.replace('chatter', 'Chatter')}", "is not the key", "topic's name"),
+])
+def test_11_through_zenoh_wrong_answers_get_a_hint_that_names_the_mistake(answer, text, hint):
+    result = attempt(11, answer, _across("/minros_zenoh"), ZENOH)
+    assert not result.ok and text in result.text and hint in result.hint, result
+
+
+def test_11_through_zenoh_needs_the_learners_subscription_on_master_b():
+    assert "has no registerSubscriber" in attempt(11, "x", [], ZENOH).text
+    on_a = attempt(11, f"/minros_zenoh {KEY}", _across("/minros_zenoh"),
+                   dict(ZENOH, master_b="http://localhost:9/"))
+    assert not on_a.ok and "ROS_MASTER_URI=http://localhost:9/" in on_a.hint
+    asked = attempt(11, "", _across("/minros_zenoh"), ZENOH)
+    assert not asked.ok and asked.hint == "minros learn check 11 CALLERID KEY"
+
+
+def test_the_checkers_key_is_minros_zenohs():
+    from minros.zenoh.keys import data_key
+
+    for topic, type_name, md5 in (("/chatter", "std_msgs/String", catalog.STRING_MD5),
+                                  ("/robot/scan", "sensor_msgs/LaserScan", "9" * 32)):
+        assert catalog.zenoh_key(topic, type_name, md5) == data_key(topic, type_name, md5)
+
+
+def _without_zenoh(monkeypatch) -> None:
+    import sys
+
+    monkeypatch.setitem(sys.modules, "zenoh", None)  # find_spec raises: as if not installed
+
+
+def test_exercise_11_goes_through_zenoh_when_it_is_installed(tmp_path):
+    from minros.learn.session import Runner
+
+    require_zenoh()
     ex = learn.exercise(11)
-    assert list(ex.variants) == ["relay"] and "zenoh" in ex.planned
-    with pytest.raises(LearnError, match="minros zenoh does not exist yet"):
+    assert list(ex.variants) == ["zenoh", "relay"] and not ex.planned
+    assert ex.default_variant == "zenoh" and ex.unavailable() == {}
+    assert Runner(ex, tmp_path).variant == "zenoh"
+    assert Runner(ex, tmp_path, variant="relay").variant == "relay"
+    bridges = [p for p in ex.processes("zenoh") if p.argv[:2] == ("minros", "zenoh")]
+    assert [p.master for p in bridges] == ["a", "b"]
+    for bridge in bridges:  # nothing reaches the LAN: loopback endpoints, no scouting
+        assert "--no-multicast-scouting" in bridge.argv
+        listen = [bridge.argv[i + 1] for i, arg in enumerate(bridge.argv) if arg == "--listen"]
+        assert listen and all(e.startswith("tcp/127.0.0.1:") for e in listen), bridge.argv
+
+
+def test_without_eclipse_zenoh_the_relay_is_the_default_and_zenoh_says_why(
+        tmp_path, monkeypatch, capsys):
+    from minros.learn.session import LearnError, Runner
+    from minros.web.learning import exercise_json
+
+    _without_zenoh(monkeypatch)
+    ex = learn.exercise(11)
+    assert ex.default_variant == "relay" and Runner(ex, tmp_path).variant == "relay"
+    assert "pip install minros[zenoh]" in ex.unavailable()["zenoh"]
+    with pytest.raises(LearnError) as err:
         Runner(ex, tmp_path, variant="zenoh")
+    assert str(err.value) == ("--via zenoh: the Zenoh bridge needs the eclipse-zenoh package, "
+                              "which minros installs as an extra: pip install minros[zenoh]; "
+                              "--via relay runs without it")
     with pytest.raises(LearnError, match="no variant 'carrier-pigeon'"):
         Runner(ex, tmp_path, variant="carrier-pigeon")
+    assert learn_cli.main(["11", "--via", "zenoh", "--dir", str(tmp_path)]) == 1
+    err_text = capsys.readouterr().err
+    assert err_text.count("\n") == 1 and "pip install minros[zenoh]" in err_text
+    assert not list(tmp_path.iterdir())  # refused before anything started
+    listed = exercise_json(ex, tmp_path)
+    assert listed["variant"] == "relay" and listed["answer_form"] == "CALLERID N"
+    assert listed["planned"]["zenoh"].startswith("zenoh: the Zenoh bridge needs")
+
+    # a start without --via says in one line why it is not through Zenoh
+    class Started(Runner):
+        def start(self):
+            raise LearnError(f"(the test stops here: {self.variant})")
+
+    monkeypatch.setattr("minros.learn.session.Runner", Started)
+    assert learn_cli.main(["11", "--dir", str(tmp_path)]) == 1
+    out, err = capsys.readouterr()
+    assert out.splitlines()[1] == (
+        "(not --via zenoh here: the Zenoh bridge needs the eclipse-zenoh package, which minros "
+        "installs as an extra: pip install minros[zenoh])")
+    assert "(the test stops here: relay)" in err
+
+
+def test_a_start_gives_each_port_field_a_free_port(tmp_path):
+    from minros.learn.model import Exercise, Process
+    from minros.learn.session import Runner, _port_fields
+
+    ex = learn.exercise(11)
+    assert _port_fields(ex.processes("zenoh")) == ["zenoh_port"]
+    assert _port_fields(ex.processes("relay")) == []
+    one = Exercise(98, "ports", "Ports", 1, "ports", task="{zenoh_port}", answer_form="",
+                   check=lambda a: None, variants={"": (Process("x", ("m", "{zenoh_port}")),)})
+    runner = Runner(one, tmp_path)
+    facts = runner._facts()
+    assert isinstance(facts["zenoh_port"], int) and 0 < facts["zenoh_port"] < 65536
 
 
 # --------------------------------------------------------------------------- the command
@@ -398,6 +533,30 @@ def test_the_command_lists_and_refuses_in_one_line(tmp_path, capsys):
     assert "there is no exercise 42" in capsys.readouterr().err
     assert learn_cli.main(["check", "one"]) == 1
     assert "not an exercise number" in capsys.readouterr().err
+
+
+def test_an_exercise_whose_traces_grow_too_big_stops(tmp_path):
+    import threading
+
+    from minros.learn import session
+    from minros.learn.session import Runner
+
+    said: List[str] = []
+    runner = Runner(learn.exercise(1), tmp_path, say=said.append)
+    runner.folder.mkdir(parents=True)
+    (runner.folder / "master.jsonl").write_bytes(b"x" * 3000)
+    (runner.folder / "master.log").write_bytes(b"x" * 9000)  # logs do not count
+    assert runner.too_big(limit=4000) == ""
+    (runner.folder / "me.jsonl").write_bytes(b"x" * 2000)
+    assert runner.too_big(limit=4000).startswith(f"its traces in {runner.folder} passed")
+    (runner.folder / "talker.jsonl").write_bytes(b"x" * (session.TRACE_LIMIT - 4000))
+    session_every = session.SIZE_EVERY
+    try:
+        session.SIZE_EVERY = 0.0
+        runner.wait(threading.Event(), poll=0.01, limit=5.0)
+    finally:
+        session.SIZE_EVERY = session_every
+    assert len(said) == 1 and said[0].startswith("minros learn: stopping: its traces in")
 
 
 def test_an_exercise_left_running_stops_by_itself(tmp_path):

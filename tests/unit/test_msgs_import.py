@@ -22,7 +22,7 @@ def _make_package(root: Path, name: str = "my_pkg") -> Path:
 def test_import_hook_finds_user_packages(tmp_path: Path) -> None:
     _make_package(tmp_path / "src")
     code = (
-        "import minros.msgs\n"
+        "import minros.msgs\nminros.msgs.install_import_hook()\n"
         "from my_pkg.msg import Num, Pair\n"
         "from my_pkg.srv import AddTwo, AddTwoRequest, AddTwoResponse\n"
         "import my_pkg.msg as m\n"
@@ -41,7 +41,7 @@ def test_import_hook_finds_user_packages(tmp_path: Path) -> None:
 def test_import_hook_leaves_other_imports_alone(tmp_path: Path) -> None:
     _make_package(tmp_path / "src")
     code = (
-        "import minros.msgs, importlib\n"
+        "import minros.msgs, importlib\nminros.msgs.install_import_hook()\n"
         "for name in ('no_such_module_xyz', 'my_pkg.nothing', 'std_msgs.msg.Nope'):\n"
         "    try:\n"
         "        importlib.import_module(name)\n"

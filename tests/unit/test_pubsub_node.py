@@ -1,4 +1,5 @@
-"""Pure parts of minros.node and minros.client.topics: slave-API argument checks, frames, names."""
+"""Pure parts of minros.node and minros.client: slave-API argument checks, frames, names
+(the connections themselves: test_transport_tcpros.py)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import pytest
 
 from minros import node
 from minros.client import topics
+from minros.exceptions import ROSSerializationException
 
 
 @pytest.fixture
@@ -36,6 +38,31 @@ def test_request_topic_validation(api):
     assert api.requestTopic("/a", "/", [["TCPROS"]])[0] == -1
 
 
+def test_request_topic_answers_the_first_offered_protocol_the_node_speaks(api):
+    """The seam: the subscriber's order decides, among the protocols the node has handlers for."""
+    from minros.transport.base import ProtocolHandler
+
+    class Fake(ProtocolHandler):
+        protocol = "FAKEROS"
+
+        def answer(self, topic, offer):
+            return ["FAKEROS", "fakehost", 7]
+
+        def connect(self, answer, topic, buff_size, reuse_big, tcp_nodelay):
+            raise AssertionError("not in this test")
+
+    node_ = api._node
+    node_.registries.publications["/t"] = object()
+    assert api.requestTopic("/a", "/t", [["UDPROS"], ["TCPROS"]]) == [
+        1, "ready on localhost:4321", ["TCPROS", "localhost", 4321]]
+    node_.protocols.insert(0, Fake())
+    assert api.requestTopic("/a", "/t", [["TCPROS"], ["FAKEROS"]])[2][0] == "TCPROS"
+    assert api.requestTopic("/a", "/t", [["FAKEROS"], ["TCPROS"]]) == [
+        1, "ready on fakehost:7", ["FAKEROS", "fakehost", 7]]
+    assert api.requestTopic("/a", "/t", [["UDPROS"], "junk"]) == [
+        0, "no supported protocol implementations", []]
+
+
 def test_publisher_update_validation(api):
     assert api.publisherUpdate("/a", "/t", "http://x:1/") == [
         -1, "ERROR: param [publishers] must be a list", -1]
@@ -57,7 +84,9 @@ def test_master_uri_and_bus_calls(api):
 
 
 def test_counters_saturate_for_xmlrpc():
-    assert node._xmlrpc_ints([1, [2 ** 40, True], "x"]) == [1, [2 ** 31 - 1, True], "x"]
+    from minros.node.slave_api import xmlrpc_ints
+
+    assert xmlrpc_ints([1, [2 ** 40, True], "x"]) == [1, [2 ** 31 - 1, True], "x"]
 
 
 def test_pre_init_names_use_namespace_and_remaps():
@@ -84,7 +113,7 @@ def test_serialize_frame_small_and_large():
 def test_serialize_frame_reports_the_bad_field():
     from std_msgs.msg import Int32
 
-    with pytest.raises(topics.ROSSerializationException):
+    with pytest.raises(ROSSerializationException):
         topics.serialize_frame(Int32(data="not a number"))
 
 
@@ -103,88 +132,6 @@ def test_any_msg_round_trip():
     raw = topics.AnyMsg().deserialize(b"\x02\x00\x00\x00hi")
     assert raw._buff == b"\x02\x00\x00\x00hi"
     assert topics.serialize_frame(raw) == b"\x06\x00\x00\x00\x02\x00\x00\x00hi"
-
-
-class _Impl:
-    resolved_name = "/t"
-
-    def __init__(self):
-        self.removed = []
-
-    def _remove_connection(self, conn):
-        self.removed.append(conn)
-
-
-@pytest.mark.parametrize("queue_size", [None, 0])
-def test_connection_stream_is_byte_exact_under_backpressure(queue_size):
-    """Frames of all sizes through a tiny socket buffer: partial sends are resumed in order
-    (synchronous and queued modes; queue_size=0 is unbounded, so nothing may be dropped)."""
-    import socket
-    import threading
-
-    from minros.wire import tcpros
-
-    a, b = socket.socketpair()
-    a.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)
-    conn = topics._PubConnection(_Impl(), a, ("local", 0), {"callerid": "/s"}, queue_size)
-    payloads = [bytes([i % 256]) * size for i, size in enumerate([10, 70_000, 5, 200_000, 3000, 1])]
-    frames = [topics.serialize_frame(topics.AnyMsg(p)) for p in payloads]
-    received: list = []
-
-    def read():
-        reader = tcpros.FrameReader()
-        while len(received) < len(payloads):
-            chunk = b.recv(1000)
-            if not chunk:
-                break
-            received.extend(bytes(f) for f in reader.feed(chunk))
-
-    thread = threading.Thread(target=read)
-    thread.start()
-    for frame in frames:
-        conn.write(frame)
-    thread.join(10)
-    conn.close()
-    b.close()
-    assert received == payloads
-
-
-def test_close_interrupts_a_synchronous_send_to_a_slow_reader():
-    """queue_size=None holds the connection while a reader keeps taking bytes; unregister and
-    shutdown must still close it at once (the trickling reader never lets the send finish)."""
-    import socket
-    import threading
-    import time
-
-    a, b = socket.socketpair()
-    conn = topics._PubConnection(_Impl(), a, ("local", 0), {"callerid": "/s"}, None)
-    stop = threading.Event()
-
-    def trickle():
-        while not stop.wait(0.05):
-            try:
-                b.recv(4096)
-            except OSError:
-                return
-
-    reader = threading.Thread(target=trickle, daemon=True)
-    reader.start()
-    sender = threading.Thread(target=conn.write, args=(bytes(8 << 20),), daemon=True)
-    sender.start()
-    try:
-        deadline = time.monotonic() + 5
-        while conn.stat_bytes == 0 and time.monotonic() < deadline:  # the send is under way
-            time.sleep(0.01)
-        assert conn.stat_bytes > 0 and sender.is_alive()
-        closer = threading.Thread(target=conn.close, daemon=True)
-        closer.start()
-        closer.join(3)
-        assert not closer.is_alive(), "close() waited for the slow reader"
-        sender.join(3)
-        assert not sender.is_alive() and conn.done
-    finally:
-        stop.set()
-        b.close()
 
 
 def test_hand_written_genpy_style_class_is_published_through_its_serialize():

@@ -11,10 +11,13 @@ from minros.wire import rosapi
 def test_triplets_and_unwrap():
     assert rosapi.triplet(rosapi.SUCCESS, "", 3) == [1, "", 3]
     assert rosapi.unwrap([1, "ok", 5]) == 5
-    with pytest.raises(rosapi.RemoteError) as info:
+    with pytest.raises(rosapi.CallerError) as info:
         rosapi.unwrap([-1, "no such node", ""])
     assert info.value.code == rosapi.ERROR and info.value.msg == "no such node"
-    with pytest.raises(rosapi.RemoteError):
+    with pytest.raises(rosapi.CalleeFailure) as failed:
+        rosapi.unwrap([0, "internal", 0])
+    assert failed.value.code == rosapi.FAILURE and isinstance(failed.value, rosapi.RemoteError)
+    with pytest.raises(rosapi.CalleeFailure, match="malformed"):
         rosapi.unwrap("nonsense")
 
 

@@ -153,3 +153,16 @@ def test_launch_helpers(monkeypatch: pytest.MonkeyPatch):
     monkeypatch.setattr(roslaunch.launch, "printerrlog", said.append)  # the stand-in is the module
     roslaunch.launch.validate_master_launch(roslaunch.core.Master(uri="http://localhost:9/"), True)
     assert said == ["WARNING: ROS_MASTER_URI port [11311] does not match this roscore [9]"]
+
+
+def test_runner_reads_each_answer_of_a_parameter_multicall():
+    """system.multicall answers each call as [triplet], or a fault struct: the launch stops at
+    the first that is no success and names it."""
+    from minros.launch.rosmodel import RLException
+    from minros.launch.rosrunner import _check_all
+
+    _check_all([[[1, "parameter /a set", 0]], [[1, "parameter /b set", 0]]], "Failed")
+    with pytest.raises(RLException, match=r"^Failed to set parameter: cannot set /b$"):
+        _check_all([[[1, "", 0]], [[-1, "cannot set /b", 0]]], "Failed to set parameter")
+    with pytest.raises(RLException, match=r"^Failed: boom$"):
+        _check_all([{"faultCode": 1, "faultString": "boom"}], "Failed")

@@ -13,6 +13,7 @@ import pytest
 import rospy
 import rospy.core
 import rospy.impl.registration as registration
+import rospy.impl.transport
 import rospy.msg
 import rospy.names
 from geometry_msgs.msg import PointStamped
@@ -32,7 +33,7 @@ def test_the_stand_ins_are_the_adapter_modules():
 
     assert rospy.core is core and registration is reg
     assert rospy.names.get_name() == minros_node.get_caller_id()
-    assert rospy.names._mappings is minros_node.default_node().argv_mappings
+    assert rospy.names._mappings is minros_node.default_node().names.argv_mappings
 
 
 def test_topic_manager_is_the_nodes_registry():
@@ -172,3 +173,80 @@ print("ok")
     out = run_python(code, {})
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "ok"
+
+
+class _Capture(rospy.impl.transport.Transport):
+    """A rospy transport of rospy code's own (as rospy's tests write them)."""
+
+    def __init__(self, endpoint_id: str) -> None:
+        super().__init__(rospy.impl.transport.OUTBOUND, endpoint_id)
+        self.endpoint_id = endpoint_id
+        self.data = b""
+
+    def write_data(self, data: bytes) -> bool:
+        self.data += data
+        self.stat_bytes += len(data)
+        self.stat_num_msg += 1
+        return True
+
+
+def _frame(msg) -> bytes:
+    buff = io.BytesIO()
+    rospy.msg.serialize_message(buff, 0, msg)
+    return buff.getvalue()
+
+
+def test_a_rospy_transport_is_a_connection_of_the_publication():
+    """rospy's Transport is a transport of minros's seam: the node's publication sends it the
+    latched message, frames it through write_data, counts and lists it by its endpoint."""
+    from minros.transport.base import Transport as SeamTransport
+
+    tm = registration.get_topic_manager()
+    impl = tm.acquire_impl("pub", "/rospy_internals/seam", String)
+    try:
+        impl.is_latch = True
+        impl.publish(String("latched"))
+        a, b = _Capture("/a"), _Capture("/b")
+        assert isinstance(a, SeamTransport)
+        assert impl.add_connection(a) and impl.add_connection(b)
+        assert a.data == b.data == _frame(String("latched"))
+        impl.publish(String("only b"), connection_override=b)
+        assert b.data.endswith(_frame(String("only b"))) and a.data == _frame(String("latched"))
+        assert impl.has_connection("/a") and not impl.has_connection("/c")
+        assert impl.get_num_connections() == 2 and impl.latch.data == "only b"
+        info = {row[1]: row for row in impl.get_stats_info()}
+        assert info["/a"][:4] == [a.id, "/a", "o", "UNKNOWN"]
+        assert info["/a"][6] == "UNKNOWN connection to [/a]"
+        assert [a.id, len(a.data), 1, True] in impl.get_stats()[2]
+        impl.remove_connection(a)
+        assert not impl.has_connection("/a") and impl.has_connection("/b")
+    finally:
+        tm.release_impl("pub", "/rospy_internals/seam")
+
+
+def test_topic_connection_handler_replaces_a_subscribers_old_connection():
+    """An inbound subscriber checked by rospy's handler joins the node's publication as a
+    rospy TCPROSTransport; the same subscriber connecting again replaces it, and a transport
+    that closes leaves the publication."""
+    tm = registration.get_topic_manager()
+    impl = tm.acquire_impl("pub", "/rospy_internals/served", String)
+    handler = TCPROSHandler()
+    header = {"topic": "/rospy_internals/served", "md5sum": String._md5sum, "callerid": "/sub"}
+    pairs = [socket.socketpair() for _ in range(2)]
+    try:
+        for ours, theirs in pairs:
+            theirs.settimeout(5)
+            assert handler.topic_connection_handler(ours, ("h", 1), header) is None
+            assert sockets.read_header(theirs)["type"] == "std_msgs/String"
+        assert len(impl.connections) == 1 and impl.has_connection("/sub")
+        assert pairs[0][1].recv(1) == b""  # the first connection was closed
+        impl.publish(String("to the second"))
+        second = pairs[1][1]
+        assert struct.unpack("<I", second.recv(4))[0] == len(_frame(String("to the second"))) - 4
+        impl.connections[0].close()
+        assert not impl.has_connections()
+    finally:
+        tm.release_impl("pub", "/rospy_internals/served")
+        for pair in pairs:
+            for sock in pair:
+                sock.close()

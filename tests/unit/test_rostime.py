@@ -2,8 +2,8 @@
 
 Most tests drive the *simulated* clock (``_set_rostime``, what a /clock message does) as a fake
 clock: waits then end exactly when the test moves time, so nothing here depends on how fast
-the machine is. A thread that must be blocked before time moves is detected through the
-condition variable's waiter list, not by sleeping.
+the machine is. A thread that must be blocked before time moves is detected by the clock's
+condition variable itself (an event set as a thread starts waiting on it), not by sleeping.
 """
 
 from __future__ import annotations
@@ -20,6 +20,25 @@ from minros.exceptions import (
     ROSInterruptException,
     ROSTimeMovedBackwardsException,
 )
+
+
+class WatchedCondition(threading.Condition):
+    """The clock's condition, telling the test when a thread starts waiting on it. The event is
+    set before the wait releases the lock, and moving the clock takes the lock: a test that saw
+    it can move the clock knowing the waiter is registered."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.waiting = threading.Event()
+
+    def wait(self, timeout=None):
+        self.waiting.set()
+        return super().wait(timeout)
+
+
+@pytest.fixture(autouse=True)
+def watched_clock(monkeypatch):
+    monkeypatch.setattr(rostime._clock, "cond", WatchedCondition())
 
 
 @pytest.fixture
@@ -42,15 +61,11 @@ def wallclock():
     rostime._clock.initialized, rostime._clock.sim_time = saved
 
 
-def waiters() -> int:
-    return len(rostime._clock.cond._waiters)  # CPython's Condition keeps its waiters here
-
-
-def wait_for_waiters(count: int, timeout: float = 5.0) -> None:
-    deadline = time.monotonic() + timeout
-    while waiters() < count:
-        assert time.monotonic() < deadline, "no thread started waiting on the clock"
-        time.sleep(0.001)
+def wait_for_waiter(timeout: float = 5.0) -> None:
+    """Until a thread (again) waits on the clock."""
+    waiting = rostime._clock.cond.waiting
+    assert waiting.wait(timeout), "no thread started waiting on the clock"
+    waiting.clear()
 
 
 def in_thread(fn):
@@ -122,7 +137,7 @@ def test_sim_clock_reads_last_clock_message(clock):
 
 def test_sim_sleep_wakes_exactly_when_clock_reaches_target(clock):
     t, result = in_thread(lambda: (rostime.sleep(1.0), Time.now())[1])
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(100, 500000000))
     assert t.is_alive()
     rostime._set_rostime(Time(101))
@@ -135,7 +150,7 @@ def test_sim_sleep_accepts_duration_and_negative_returns_at_once(clock):
     rostime.sleep(Duration(-1))  # negative: no wait at all, clock never moves
     rostime.sleep(-0.5)
     t, result = in_thread(lambda: rostime.sleep(Duration(0, 1000)))
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(100, 1000))
     t.join(5)
     assert not t.is_alive() and result == {"value": None}
@@ -143,7 +158,7 @@ def test_sim_sleep_accepts_duration_and_negative_returns_at_once(clock):
 
 def test_sim_sleep_raises_when_time_moves_backwards(clock):
     t, result = in_thread(lambda: rostime.sleep(5))
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(98))
     t.join(5)
     assert isinstance(result.get("error"), ROSTimeMovedBackwardsException)
@@ -154,9 +169,9 @@ def test_sim_sleep_waits_for_first_clock_message_when_at_zero(clock):
     rostime._set_rostime(Time(0))
     assert Time.now().is_zero()
     t, result = in_thread(lambda: (rostime.sleep(1), Time.now())[1])
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(50))  # first tick: the sleep starts counting from here
-    wait_for_waiters(1)
+    wait_for_waiter()
     assert t.is_alive()
     rostime._set_rostime(Time(51))
     t.join(5)
@@ -210,7 +225,7 @@ def test_rate_remaining_and_cycle_accounting(clock):
 def test_rate_sleep_blocks_until_cycle_end(clock):
     rate = Rate(4)  # 0.25 s
     t, result = in_thread(lambda: (rate.sleep(), Time.now())[1])
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(100, 200000000))
     assert t.is_alive()
     rostime._set_rostime(Time(100, 250000000))
@@ -222,7 +237,7 @@ def test_rate_sleep_blocks_until_cycle_end(clock):
 def test_rate_time_backwards_raises_unless_reset(clock):
     rate = Rate(1)
     t, result = in_thread(rate.sleep)
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(90))
     t.join(5)
     assert isinstance(result.get("error"), ROSTimeMovedBackwardsException)
@@ -230,7 +245,7 @@ def test_rate_time_backwards_raises_unless_reset(clock):
     rostime._set_rostime(Time(100))
     rate = Rate(1, reset=True)
     t, result = in_thread(rate.sleep)
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(90))
     t.join(5)
     assert result == {"value": None}
@@ -258,7 +273,7 @@ def test_timer_event_fields_and_periodic_calls(clock):
 
     timer = Timer(Duration(0, 100000000), callback)
     try:
-        wait_for_waiters(1)
+        wait_for_waiter()
         rostime._set_rostime(Time(100, 100000000))
         assert fired.acquire(timeout=5)
         first = events[0]
@@ -267,7 +282,7 @@ def test_timer_event_fields_and_periodic_calls(clock):
         assert first.current_expected == Time(100, 100000000)
         assert first.current_real == Time(100, 100000000)
 
-        wait_for_waiters(1)
+        wait_for_waiter()
         rostime._set_rostime(Time(100, 230000000))  # late: real differs from expected
         assert fired.acquire(timeout=5)
         second = events[1]
@@ -285,7 +300,7 @@ def test_timer_event_fields_and_periodic_calls(clock):
 def test_timer_shutdown_stops_callbacks(clock):
     calls: list = []
     timer = Timer(Duration(1), calls.append)
-    wait_for_waiters(1)
+    wait_for_waiter()
     timer.shutdown()
     timer.join(5)
     assert not timer.is_alive()  # woke up for the shutdown without time moving
@@ -296,7 +311,7 @@ def test_timer_shutdown_stops_callbacks(clock):
 def test_oneshot_timer_fires_once(clock):
     calls: list = []
     timer = Timer(Duration(1), calls.append, oneshot=True)
-    wait_for_waiters(1)
+    wait_for_waiter()
     rostime._set_rostime(Time(101))
     timer.join(5)
     assert not timer.is_alive()

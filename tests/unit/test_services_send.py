@@ -122,7 +122,7 @@ def test_send_all_stops_at_node_shutdown(monkeypatch):
     with a, b:
         a.settimeout(0.1)
         stop = threading.Event()
-        monkeypatch.setattr(services, "_is_shutdown", stop.is_set)
+        monkeypatch.setattr(services.node, "is_shutdown", stop.is_set)
         threading.Timer(0.3, stop.set).start()
         start = time.monotonic()
         with pytest.raises(TransportTerminated, match="^node shutdown$"):

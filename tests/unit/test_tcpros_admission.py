@@ -19,15 +19,29 @@ from minros.wire.admission import Admission, Connection, Limits, Refused
 MD5 = "992ce8a1687cec8c8bd883ec73ca41d1"
 
 
+SERVED = {"error": "Internal error processing topic [/chatter]"}
+
+
 class FakePublication:
+    """A closed publication: the handshake is served, and refused."""
+
     type = "std_msgs/String"
     md5sum = MD5
+    closed = True
+    queue_size = None
+    tcp_nodelay = False
 
     def __init__(self, name: str) -> None:
         self.resolved_name = name
 
-    def accept_subscriber(self, sock, addr, header):
-        return "handshake served"
+    def header_fields(self):
+        return {"topic": self.resolved_name, "type": self.type, "md5sum": MD5, "callerid": "/p"}
+
+    def add_connection(self, transport):
+        raise AssertionError("a closed publication takes no connection")
+
+    def remove_connection(self, transport):
+        pass
 
     def get_stats(self):
         return [self.resolved_name, 0, []]
@@ -50,7 +64,7 @@ def tcpros_node(master: Master, limits: Limits) -> tuple:
     node = Node(argv=["prog", f"__master:={master.uri}", "__hostname:=127.0.0.1"])
     node.init("tcpros_probe", args_key=("tcpros_probe",))
     node.add_publication(FakePublication("/chatter"))
-    node._tcpros_admission = Admission(limits, what="node [/tcpros_probe]")
+    node.tcpros_limits = limits
     return node, node.tcpros_address()[1]
 
 
@@ -80,7 +94,7 @@ def test_a_trickled_connection_header_cannot_extend_its_deadline(master):
                 break
         assert closed and 0.4 < time.monotonic() - start < 3.0
         s.close()
-        assert handshake(port) == {"error": "handshake served"}
+        assert handshake(port) == SERVED
     finally:
         node.signal_shutdown("test over")
 
@@ -94,8 +108,8 @@ def test_an_announced_header_holds_nothing_and_blocks_nobody(master):
             s.sendall(struct.pack("<I", 1 << 20) + b"ab")  # a 1 MiB header announced
             hostile.append(s)
         for _ in range(5):
-            assert handshake(port) == {"error": "handshake served"}
-        assert node._tcpros_admission.held() <= 20 * 6
+            assert handshake(port) == SERVED
+        assert node.tcpros_server.admission.held() <= 20 * 6
     finally:
         for s in hostile:
             s.close()
@@ -111,9 +125,9 @@ def test_a_full_tcpros_server_closes_its_slowest_handshakes(master):
             s.sendall(b"\x10")
             tricklers.append(s)
         for _ in range(5):
-            assert handshake(port) == {"error": "handshake served"}
-        assert node._tcpros_admission.evictions >= 5
-        assert node._tcpros_admission.live() <= 10
+            assert handshake(port) == SERVED
+        assert node.tcpros_server.admission.evictions >= 5
+        assert node.tcpros_server.admission.live() <= 10
     finally:
         for s in tricklers:
             s.close()

@@ -40,6 +40,7 @@ class FakeRunner:
     made: list = []
     log: list = []
     hold = False  # start waits until the test opens its gate
+    too_big_text = ""  # what too_big says: "" while the traces may grow
 
     def __init__(self, exercise, base, variant="", say=print, stop_hint="") -> None:
         if variant and variant not in exercise.variants:
@@ -66,6 +67,9 @@ class FakeRunner:
             self.procs[process.name] = FakeProc(1000 + i)
         return facts
 
+    def too_big(self):
+        return FakeRunner.too_big_text
+
     def stop(self):
         FakeRunner.log.append(("stop", self.exercise.number))
         for proc in self.procs.values():
@@ -77,6 +81,7 @@ class FakeRunner:
 @pytest.fixture
 def hub(tmp_path):
     FakeRunner.made, FakeRunner.log, FakeRunner.hold = [], [], False
+    FakeRunner.too_big_text = ""
     made = LearnHub(tmp_path / "learn", runner=FakeRunner, grace=0.3)
     yield made
     made.close()
@@ -127,7 +132,15 @@ def test_the_list_names_every_exercise_with_its_form_what_it_starts_and_a_previe
     assert "ROS_MASTER_URI=<master>" in first["preview"]
     assert f"{hub.base}/01-register-subscriber/me.jsonl" in first["preview"]
     eleven = listed[10]
-    assert eleven["variants"] == ["relay"] and "zenoh" in eleven["planned"]
+    assert eleven["variants"] == ["zenoh", "relay"]
+    # a start without a variant (the page's) runs the first that can start here
+    assert eleven["variant"] == learn.exercise(11).default_variant
+    assert eleven["answer_form"] == learn.exercise(11).form()
+    if eleven["variant"] == "zenoh":
+        assert eleven["planned"] == {} and "bridge_a" in eleven["processes"]
+        assert "key expression" in eleven["preview"]
+    else:  # without eclipse-zenoh: why, in the about line
+        assert "pip install minros[zenoh]" in eleven["planned"]["zenoh"]
     assert listed[4]["processes"] == []  # the md5sum is worked out by hand
 
 
@@ -249,6 +262,24 @@ def test_an_exercise_stops_at_the_time_limit(tmp_path):
         hub.close()
 
 
+def test_an_exercise_whose_traces_grow_too_big_stops(tmp_path):
+    FakeRunner.made, FakeRunner.log, FakeRunner.too_big_text = [], [], ""
+    hub = LearnHub(tmp_path / "learn", runner=FakeRunner, size_every=0.05)
+    try:
+        page, outbox, _ = session(learn=hub)
+        send(page, op="learn_watch")
+        send(page, op="learn_start", id="s", number=7)
+        frames(outbox, "learn", run_state("running"))
+        FakeRunner.too_big_text = "its traces in /x passed 200 MB (start it again)"
+        stopped = frames(outbox, "learn", run_state("stopped"))["run"]
+        assert stopped["reason"] == "its traces in /x passed 200 MB (start it again)"
+        assert FakeRunner.log == [("start", 7), ("stop", 7)]
+        page.close()
+    finally:
+        FakeRunner.too_big_text = ""
+        hub.close()
+
+
 def test_the_server_stopping_stops_the_exercise(hub):
     page, outbox, _ = session(learn=hub)
     send(page, op="learn_start", id="s", number=1)
@@ -288,7 +319,8 @@ def test_a_failed_start_says_why(tmp_path):
     ({"number": "1"}, "status", "Expected field number to be one of ('int',). Invalid value: 1"),
     ({"number": True}, "status", "number is an exercise's number (1, 2, ...), not true or false"),
     ({}, "status", "Expected a number field but none was found."),
-    ({"number": 11, "variant": "zenoh"}, "reply", "--via zenoh: minros zenoh does not exist yet"),
+    ({"number": 11, "variant": "pigeon"}, "reply",
+     "exercise 11 has no variant 'pigeon' (variants: zenoh, relay)"),
     ({"number": 1, "variant": "relay"}, "reply", "exercise 1 has no variant 'relay' (variants: none)"),
 ])
 def test_a_start_the_catalog_does_not_have_is_refused_with_what_to_do(tmp_path, msg, op, text):

@@ -386,8 +386,9 @@ def _peers(topic: Any) -> set:
 
 
 def _lookup_node(name: str) -> str | None:
+    from minros import node
+
     try:
-        code, _msg, uri = minros.get_master().lookupNode(name)
-    except Exception:  # noqa: BLE001 - an unreachable master means "not yet"
+        return node.master().lookup_node(name)
+    except Exception:  # noqa: BLE001 - unknown, or an unreachable master: "not yet"
         return None
-    return uri if code == 1 else None

@@ -145,7 +145,7 @@ class Bag:
     def __enter__(self) -> Bag:
         return self
 
-    def __exit__(self, exc_type, exc_value, traceback) -> None:
+    def __exit__(self, exc_type: Any, exc_value: Any, traceback: Any) -> None:
         self.close()
 
     # rosbag's internals, which tools and tests reach for: the open file and where the file

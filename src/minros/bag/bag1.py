@@ -523,7 +523,7 @@ class Bag1Writer:
                                              callerid, None if latch is None else str(latch))
         return conn.id
 
-    def write(self, conn_id: int, t_ns: int, data) -> None:
+    def write(self, conn_id: int, t_ns: int, data: Any) -> None:
         self._w.write(self._conns[conn_id], t_ns, data)
 
     def set_compression(self, compression: str) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import struct
 from pathlib import Path
-from typing import Dict, Iterator, List, Optional, Tuple
+from typing import Any, Dict, Iterator, List, Optional, Tuple
 
 from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
@@ -31,7 +31,7 @@ _COMPRESSION = {"none": CompressionType.NONE, "lz4": CompressionType.LZ4,
                 "zstd": CompressionType.ZSTD, "bz2": CompressionType.ZSTD}
 
 
-def _conn(channel, schema) -> ConnInfo:
+def _conn(channel: Any, schema: Any) -> ConnInfo:
     meta = channel.metadata or {}
     return ConnInfo(channel.id, channel.topic, schema.name if schema else "",
                     meta.get("md5sum", "*"),
@@ -70,7 +70,7 @@ class McapReader:
             self._f.close()
             raise
 
-    def _load_summary(self, summary) -> None:
+    def _load_summary(self, summary: Any) -> None:
         self.connections: Dict[int, ConnInfo] = {
             cid: _conn(ch, summary.schemas.get(ch.schema_id)) for cid, ch in summary.channels.items()}
         stats = summary.statistics
@@ -171,7 +171,7 @@ class McapWriter:
         self.connections[cid] = ConnInfo(cid, topic, datatype, md5sum, msg_def, callerid, latching)
         return cid
 
-    def write(self, conn_id: int, t_ns: int, data) -> None:
+    def write(self, conn_id: int, t_ns: int, data: Any) -> None:
         seq = self._seq.get(conn_id, 0)
         self._seq[conn_id] = seq + 1
         self._w.add_message(conn_id, log_time=t_ns, data=bytes(data), publish_time=t_ns, sequence=seq)

@@ -365,17 +365,21 @@ class Recorder:
         import minros
         from minros import names
         from minros.tools.master import Master, MasterException, call_node
+        from minros.wire.rosapi import RemoteError, unwrap
 
         node = names.script_resolve_name("rosbag", self.opts.node or "")
         master = Master(minros.get_caller_id())
         try:
-            uri = master.call("lookupNode", node)
+            uri = master.lookup_node(node)
         except MasterException:
             return []
         finally:
             master.close()
-        code, _msg, subs = call_node(uri, "getSubscriptions", minros.get_caller_id())
-        return [t for t, _type in subs] if code == 1 else []
+        try:
+            subs = unwrap(call_node(uri, "getSubscriptions", minros.get_caller_id()))
+        except RemoteError:
+            return []
+        return [t for t, _type in subs]
 
     def _warn_drops(self, now: float) -> None:
         if self.queue.new_drops and now - self.last_warn >= WARN_INTERVAL:

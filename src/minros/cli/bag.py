@@ -44,7 +44,7 @@ def _fail(text: str, status: int = 1) -> int:
 # ---------------------------------------------------------------------------------------------
 # record
 
-def _handle_split(option, opt_str, value, parser) -> None:
+def _handle_split(option: Any, opt_str: Any, value: Any, parser: Any) -> None:
     parser.values.split = True
     if parser.rargs and parser.rargs[0].isdigit():
         print('Use of "--split <MAX_SIZE>" has been deprecated.  Please use --split --size '
@@ -127,7 +127,7 @@ def _run_node(fn: Callable[[], int]) -> int:
 # play
 
 def _collect(attr: str) -> Callable:
-    def handle(option, opt_str, value, parser) -> None:
+    def handle(option: Any, opt_str: Any, value: Any, parser: Any) -> None:
         found = []
         for arg in parser.rargs:
             if arg.startswith("-") and len(arg) > 1:

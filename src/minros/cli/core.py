@@ -17,7 +17,7 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import List
+from typing import Any, List
 from urllib.parse import urlparse
 
 from minros import logfiles
@@ -40,7 +40,7 @@ def _version() -> str:
         return "0.0.0"
 
 
-def _port_from_env(env) -> int | None:
+def _port_from_env(env: Any) -> int | None:
     uri = env.get("ROS_MASTER_URI")
     if not uri:
         return None
@@ -59,20 +59,22 @@ def _master_running(port: int) -> bool:
             pass
     except OSError:
         return False
-    from minros.wire.xmlrpc import ServerProxy
+    from minros.wire.masterapi import MasterClient
 
+    master = MasterClient(f"http://127.0.0.1:{port}/", "/roscore", timeout=1.0)
     try:
-        with ServerProxy(f"http://127.0.0.1:{port}/", timeout=1.0) as proxy:
-            code, _msg, _pid = proxy.getPid("/roscore")
-            return code == 1
+        master.get_pid()
+        return True
     except Exception:  # noqa: BLE001 - whatever listens there is not a master
         return False
+    finally:
+        master.close()
 
 
 class _Console:
     """stdout that never raises: a closed terminal or pipe must not stop the clean shutdown."""
 
-    def __init__(self, stream) -> None:
+    def __init__(self, stream: Any) -> None:
         self.stream = stream
 
     def write(self, text: str) -> None:

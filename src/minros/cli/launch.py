@@ -11,7 +11,7 @@ import argparse
 import os
 import sys
 from pathlib import Path
-from typing import List, Tuple
+from typing import Any, List, Tuple
 
 from minros import names, packages
 from minros.launch.config import LaunchConfig, LaunchError
@@ -216,7 +216,7 @@ def _add_core_params(config: LaunchConfig) -> None:
         config.params.setdefault(key, value)
 
 
-def _print_node_args(config: LaunchConfig, runner, wanted: str) -> int:
+def _print_node_args(config: LaunchConfig, runner: Any, wanted: str) -> int:
     """``roslaunch --args NODE``: the node's environment and command line, as roslaunch prints
     them (``ROS_NAMESPACE="/g" NAME="value" exe args remaps __name:=n``)."""
     resolved = names.script_resolve_name("roslaunch", wanted)

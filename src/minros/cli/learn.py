@@ -98,7 +98,10 @@ def _start(argv: List[str], prog: str) -> int:
     parser.add_argument("number", metavar="N", help="the exercise (minros learn --list)")
     _dir_option(parser)
     parser.add_argument("--via", default="", metavar="VARIANT",
-                        help="how exercise 11's masters are joined (relay; zenoh later)")
+                        help="how exercise 11's masters are joined: zenoh (a minros zenoh "
+                             "bridge on each, on loopback; the default when the eclipse-zenoh "
+                             "package is installed) or relay (a node on each, joined by a "
+                             "pipe; the default otherwise)")
     parser.add_argument("--seed", type=int, help="fix the exercise's random choices")
     args = parser.parse_args(argv)
     number = _number(args.number, prog)
@@ -110,6 +113,9 @@ def _start(argv: List[str], prog: str) -> int:
     previous = watch.install((signal.SIGINT, signal.SIGTERM))
     try:
         print(f"minros learn {number}: {ex.title} (about {ex.minutes} minutes)", flush=True)
+        if not args.via:
+            for variant, why in ex.unavailable().items():
+                print(f"(not --via {variant} here: {why})", flush=True)
         facts = runner.start()
         print("", flush=True)
         print(ex.task_text(facts), flush=True)

@@ -17,7 +17,7 @@ import os
 import shlex
 import sys
 import time
-from typing import List, Optional
+from typing import Any, List, Optional
 
 USAGE = """usage: minros trace [-o FILE] [--messages] [--frames N] [--bytes N] [--] COMMAND [ARGS...]
        minros trace show [--follow] [--topic T] [--service S] [--node N] [--frames N|all] [--all] FILE...
@@ -186,7 +186,7 @@ def _show(argv: List[str], prog: str) -> int:
     return 0
 
 
-def _follow(paths: List[str], flt) -> int:
+def _follow(paths: List[str], flt: Any) -> int:
     from minros.tools.trace import merge, show
 
     follower = merge.Follower(paths)

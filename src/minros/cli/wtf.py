@@ -28,6 +28,7 @@ from urllib.parse import urlparse
 
 from minros import packages, rosenv
 from minros.tools.master import Master, MasterException, call_node
+from minros.wire.rosapi import RemoteError, unwrap
 
 # ---------------------------------------------------------------------------------------------
 # the model (roswtf.model, roswtf.context, roswtf.rules)
@@ -467,13 +468,17 @@ def _compute_online_context(ctx: WtfContext) -> None:
             return
         t0 = time.time()
         try:
-            code, _msg, bus_info = call_node(uri, "getBusInfo", "/roswtf", timeout=NODE_TIMEOUT)
+            answer = call_node(uri, "getBusInfo", "/roswtf", timeout=NODE_TIMEOUT)
         except OSError:
             return  # ping_check reports it
+        try:
+            bus_info, refused = unwrap(answer), False
+        except RemoteError:
+            bus_info, refused = None, True
         with lock:
             if time.time() - t0 > 1.0:
                 ctx.warnings.append(WtfWarning(f"Communication with node [{node}] is very slow"))
-            if code != 1:
+            if refused:
                 ctx.warnings.append(WtfWarning(f"Node [{node}] would not return bus info"))
             elif not bus_info:
                 if node not in ctx.service_providers:

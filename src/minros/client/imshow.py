@@ -217,7 +217,8 @@ class _Cv2Finder:
             sys.meta_path.insert(0, self)
         if spec is None or spec.loader is None:
             return None
-        spec.loader = _PatchingLoader(spec.loader)
+        patching: Any = _PatchingLoader(spec.loader)  # importlib's protocol, not its ABC
+        spec.loader = patching
         return spec
 
 

@@ -1,8 +1,9 @@
 """``rospy.init_node``: the composition root of the client library.
 
 It names the process's node and starts it (:mod:`minros.node`), then wires the pieces above
-the node runtime to it in one readable sequence: the signal handlers, the node clock (with a
-/clock subscription on simulated time), and logging (log file, /rosout, logger services).
+the node runtime to it in one readable sequence: the message import hook and the cv2.imshow
+hook (as ``import rospy`` does), the signal handlers, the node clock (with a /clock subscription
+on simulated time), and logging (log file, /rosout, logger services).
 Nothing below this module reaches up to start these: the client library is a plain stack.
 """
 
@@ -14,8 +15,9 @@ import threading
 from typing import Any, Dict, List
 
 from minros import node
-from minros.client import rosout_log, rostime, statistics
+from minros.client import imshow, rosout_log, rostime, statistics
 from minros.client.topics import Subscriber
+from minros.msgs import install_import_hook
 from minros.signals import SignalWatch
 
 __all__ = ["init_node"]
@@ -52,6 +54,9 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
               disable_rosout: bool = False, disable_signals: bool = False,
               xmlrpc_port: int = 0, tcpros_port: int = 0) -> None:
     """Register this process as the node ``name`` with the master (rospy.init_node)."""
+    # a program using `minros` as its rospy gets what `import rospy` installs
+    install_import_hook()
+    imshow.install()
     me = node.default_node()
     args_key = (name, list(sys.argv if argv is None else argv), anonymous, log_level,
                 disable_rostime, disable_signals)
@@ -63,9 +68,8 @@ def init_node(name: str, argv: List[str] | None = None, anonymous: bool = False,
     use_sim_time = False
     if not disable_rostime:
         try:
-            code, _msg, value = me.master_call("getParam", "/use_sim_time")
-            use_sim_time = code == 1 and bool(value)
-        except Exception:
+            use_sim_time = bool(me.master.get_param("/use_sim_time"))
+        except Exception:  # unset (MasterError), or the master is away: wall time
             use_sim_time = False
     rostime.start_node_time(use_sim_time)
     statistics.install()  # subscriptions read /enable_statistics when they are made

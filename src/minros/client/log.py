@@ -23,7 +23,7 @@ import os
 import sys
 import threading
 import time
-from typing import Any, Dict, Tuple
+from typing import Any, Dict, Mapping, Tuple
 
 from minros import logfiles, node
 from minros.client import rostime
@@ -104,7 +104,7 @@ FILE_FORMAT = "[%(name)s][%(levelname)s] %(asctime)s: %(message)s"
 
 
 def node_log_filename(caller_id: str, mappings: Dict[str, str] | None = None,
-                      env: Dict[str, str] | None = None) -> str:
+                      env: Mapping[str, str] | None = None) -> str:
     """Where rospy writes a node's log: ``__log:=FILE``, else ``$ROS_LOG_DIR/<node>.log``.
 
     The node name has its slashes turned into underscores, without the leading one
@@ -147,7 +147,7 @@ def start_file_logging(caller_id: str) -> None:
 _Key = Tuple[str, int, int]
 
 
-def _frame_key(frame) -> _Key:
+def _frame_key(frame: Any) -> _Key:
     """Identifies one call site: file, line and bytecode offset of the caller."""
     return (frame.f_code.co_filename, frame.f_lineno, frame.f_lasti)
 
@@ -219,7 +219,7 @@ def _user_frame():
     return frame.f_back.f_back.f_back  # type: ignore[union-attr]
 
 
-def _function_name(frame) -> str:
+def _function_name(frame: Any) -> str:
     """``Class.method`` when the caller is a method (as rospy reports it), else the function."""
     name = frame.f_code.co_name
     owner = frame.f_locals.get("self")

@@ -1,5 +1,10 @@
 """rospy's MasterProxy: the master's XML-RPC API with the caller_id filled in and names
-resolved, and a dict-like view of the parameter server (``get_master()['/foo']``)."""
+resolved, and a dict-like view of the parameter server (``get_master()['/foo']``).
+
+Both halves sit on the one master client (:class:`minros.wire.masterapi.MasterClient`): the
+method calls return the raw ``[code, msg, value]`` triplet, as rospy's do, and the dict view is
+:class:`minros.client.params.ParamServer`, the parameter API rospy's functions use too.
+"""
 
 from __future__ import annotations
 
@@ -7,8 +12,8 @@ import os
 from typing import Any, Callable, Dict, Iterator
 
 from minros import node, rosenv
-from minros.client import params
-from minros.exceptions import ROSException
+from minros.client.params import ParamServer
+from minros.wire.masterapi import MasterClient
 from minros.wire.xmlrpc import ServerProxy
 
 __all__ = ["MasterProxy", "get_master"]
@@ -29,61 +34,48 @@ class MasterProxy:
     also a dict-like view of the parameter server."""
 
     def __init__(self, uri: str) -> None:
-        self.target = ServerProxy(uri, timeout=node.XMLRPC_TIMEOUT)
+        self._client = MasterClient(uri, node.get_caller_id, node.XMLRPC_TIMEOUT)
+        self._params = ParamServer(lambda: self._client)
+
+    @property
+    def target(self) -> ServerProxy:
+        """The XML-RPC proxy of the master (rospy's attribute)."""
+        return self._client._proxy()
 
     def __getattr__(self, key: str) -> Callable[..., Any]:
-        if key.startswith("__"):
+        if key.startswith("_"):
             raise AttributeError(key)
         remap = _MASTER_ARG_REMAP.get(key, [])
 
         def call(*args: Any) -> Any:
-            full = [node.get_caller_id(), *args]
+            full = list(args)
             for i in remap:
-                if i + 1 < len(full):
-                    full[i + 1] = node.resolve_name(full[i + 1])
-            return getattr(self.target, key)(*full)
+                if i < len(full):
+                    full[i] = node.resolve_name(full[i])
+            return self._client.raw(key, *full)
 
         return call
 
     def __getitem__(self, key: str) -> Any:
-        code, _msg, value = self.target.getParam(node.get_caller_id(), node.resolve_name(key))
-        if code != 1:
-            raise KeyError(key)
-        return value
+        return self._params.get(key)
 
     def __setitem__(self, key: str, value: Any) -> None:
-        self.target.setParam(node.get_caller_id(), node.resolve_name(key), value)
+        self._params.set(key, value)
 
     def __delitem__(self, key: str) -> None:
-        code, msg, _ = self.target.deleteParam(node.get_caller_id(), node.resolve_name(key))
-        if code == -1:
-            raise KeyError(key)
-        if code != 1:
-            raise ROSException(f"cannot delete parameter: {msg}")
+        self._params.delete(key)
 
     def __contains__(self, key: str) -> bool:
-        code, msg, value = self.target.hasParam(node.get_caller_id(), node.resolve_name(key))
-        if code != 1:
-            raise ROSException(f"cannot check parameter on server: {msg}")
-        return bool(value)
+        return self._params.has(key)
 
     def __iter__(self) -> Iterator[str]:
-        code, msg, value = self.target.getParamNames(node.get_caller_id())
-        if code != 1:
-            raise ROSException(f"cannot retrieve parameter names: {msg}")
-        return iter(value)
+        return iter(self._params.names())
 
     def search_param(self, key: str) -> str | None:
-        key = node.get_mappings().get(key, key)
-        code, msg, value = self.target.searchParam(node.get_caller_id(), key)
-        if code == 1:
-            return value
-        if code == -1:
-            return None
-        raise ROSException(f"cannot search for parameter: {msg}")
+        return self._params.search(key)
 
     def get_param_cached(self, key: str) -> Any:
-        return params.get_param_cached(key)
+        return self._params.get_cached(key)
 
 
 def get_master(env: Dict[str, str] | None = None) -> MasterProxy:

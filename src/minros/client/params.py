@@ -6,20 +6,24 @@ on the master (``subscribeParam``) and keeps a local tree fresh from the master'
 ``paramUpdate`` calls; plain ``get_param`` answers from that tree too once a key is cached, and
 ``set_param`` updates it, as rospy does.
 
-The first section names the node context shared with ``minros.client.services`` (the node runtime's
-own functions): both work before ``init_node``.
+:class:`ParamServer` is the API written once, over one master client; the rospy functions use
+the node's master, rospy's ``MasterProxy`` (``get_master()[key]``) its own. It works before
+``init_node`` (caller id ``/unnamed`` in the namespace, master from ``__master:=`` or
+ROS_MASTER_URI).
 """
 
 from __future__ import annotations
 
 import threading
 import warnings
-from typing import Any, Dict, List
+from typing import Any, Callable, Dict, List
 
 from minros import names, node
 from minros.exceptions import ROSException
+from minros.wire.masterapi import MasterClient, MasterError, RemoteError
 
 __all__ = [
+    "ParamServer",
     "delete_param",
     "get_param",
     "get_param_cached",
@@ -28,19 +32,6 @@ __all__ = [
     "search_param",
     "set_param",
 ]
-
-# --------------------------------------------------------------------------- node context
-# The node runtime answers these before init_node too (caller id ``/unnamed`` in the namespace,
-# master from ``__master:=`` or ROS_MASTER_URI), so this module and minros.client.services use it as is.
-
-_caller_id = node.get_caller_id
-_node_uri = node.get_node_uri
-_mappings = node.get_mappings
-_resolve = node.resolve_name
-_is_shutdown = node.is_shutdown
-_wait_for_shutdown = node.wait_for_shutdown
-_call_master = node.master_call
-
 
 # --------------------------------------------------------------------------- the cache
 
@@ -164,7 +155,8 @@ def _install_update_handler() -> None:
         _update_handler_installed = True
 
 
-# --------------------------------------------------------------------------- public API
+# --------------------------------------------------------------------------- the API
+
 
 class _Unspecified:
     def __repr__(self) -> str:
@@ -174,44 +166,107 @@ class _Unspecified:
 _unspecified: Any = _Unspecified()
 
 
+class ParamServer:
+    """The parameter server as rospy presents it, over the master ``master()`` returns: names
+    resolved against the node, values answered from the node's cache once a key is cached."""
+
+    def __init__(self, master: Callable[[], MasterClient]) -> None:
+        self._master = master
+
+    def get(self, param_name: str, default: Any = _unspecified) -> Any:
+        """The value of ``param_name``; ``default`` if unset, else KeyError(param_name)."""
+        resolved = node.resolve_name(param_name)
+        try:
+            return _cache.get(resolved)
+        except KeyError:
+            pass
+        try:
+            return self._master().get_param(resolved)
+        except RemoteError:
+            if default is not _unspecified:
+                return default
+            raise KeyError(param_name) from None
+
+    def get_cached(self, param_name: str, default: Any = _unspecified) -> Any:
+        """Like ``get``, but subscribes to the key and answers locally from then on."""
+        resolved = node.resolve_name(param_name)
+        try:
+            return _cache.get(resolved)
+        except KeyError:
+            pass
+        if _cache.is_unset(resolved):  # subscribed, and not set since: no need to ask again
+            if default is not _unspecified:
+                return default
+            raise KeyError(param_name)
+        if not node.get_node_uri():
+            # no node to receive paramUpdate: a plain lookup is the best we can do
+            return self.get(param_name, default)
+        _install_update_handler()
+        value = node.subscribe_param(resolved)
+        if isinstance(value, dict) and not value:  # subscribeParam answers {} for an unset key
+            _cache.mark_unset(resolved)
+            if default is not _unspecified:
+                return default
+            raise KeyError(param_name)
+        _cache.set(resolved, value)
+        return value
+
+    def set(self, param_name: str, param_value: Any) -> None:
+        """Set ``param_name``; a dict replaces the whole namespace below the name."""
+        resolved = node.resolve_name(param_name)
+        try:
+            self._master().set_param(resolved, param_value)
+        except RemoteError as exc:
+            raise ROSException(f"cannot set parameter: {exc}") from None
+        try:
+            _cache.update(resolved, param_value)
+        except KeyError:
+            pass
+
+    def has(self, param_name: str) -> bool:
+        """Whether ``param_name`` is set (a key or a namespace)."""
+        try:
+            return self._master().has_param(node.resolve_name(param_name))
+        except RemoteError as exc:
+            raise ROSException(f"cannot check parameter on server: {exc}") from None
+
+    def delete(self, param_name: str) -> None:
+        """Delete ``param_name``; KeyError(param_name) if it is not set."""
+        try:
+            self._master().delete_param(node.resolve_name(param_name))
+        except MasterError:
+            raise KeyError(param_name) from None
+        except RemoteError as exc:
+            raise ROSException(f"cannot delete parameter: {exc}") from None
+
+    def search(self, param_name: str) -> str | None:
+        """The closest key named ``param_name`` up the node's namespace, or None."""
+        key = node.get_mappings().get(param_name, param_name)  # rospy maps the unresolved key
+        try:
+            return self._master().search_param(key)
+        except RemoteError as exc:
+            raise ROSException(f"cannot search for parameter: {exc}") from None
+
+    def names(self) -> List[str]:
+        """Every parameter key on the server."""
+        try:
+            return self._master().get_param_names()
+        except RemoteError as exc:
+            raise ROSException(f"Unable to retrieve parameter names: {exc}") from None
+
+
+#: the node's parameter server (rospy's module functions below)
+_server = ParamServer(node.master)
+
+
 def get_param(param_name: str, default: Any = _unspecified) -> Any:
     """The value of ``param_name``; ``default`` if unset, else KeyError(param_name)."""
-    resolved = _resolve(param_name)
-    try:
-        return _cache.get(resolved)
-    except KeyError:
-        pass
-    code, _msg, value = _call_master("getParam", resolved)
-    if code != 1:
-        if default is not _unspecified:
-            return default
-        raise KeyError(param_name)
-    return value
+    return _server.get(param_name, default)
 
 
 def get_param_cached(param_name: str, default: Any = _unspecified) -> Any:
     """Like ``get_param``, but subscribes to the key and answers locally from then on."""
-    resolved = _resolve(param_name)
-    try:
-        return _cache.get(resolved)
-    except KeyError:
-        pass
-    if _cache.is_unset(resolved):  # subscribed, and not set since: no need to ask again
-        if default is not _unspecified:
-            return default
-        raise KeyError(param_name)
-    if not _node_uri():
-        # no node to receive paramUpdate: a plain lookup is the best we can do
-        return get_param(param_name, default)
-    _install_update_handler()
-    value = node.subscribe_param(resolved)
-    if isinstance(value, dict) and not value:  # subscribeParam answers {} for an unset key
-        _cache.mark_unset(resolved)
-        if default is not _unspecified:
-            return default
-        raise KeyError(param_name)
-    _cache.set(resolved, value)
-    return value
+    return _server.get_cached(param_name, default)
 
 
 def set_param(param_name: str, param_value: Any) -> None:
@@ -219,48 +274,24 @@ def set_param(param_name: str, param_value: Any) -> None:
     if not names.is_legal_name(param_name):
         warnings.warn(f"'{param_name}' is not a legal ROS graph resource name. This may cause problems with "
                       "other ROS tools", stacklevel=2)
-    resolved = _resolve(param_name)
-    code, msg, _value = _call_master("setParam", resolved, param_value)
-    if code != 1:
-        raise ROSException(f"cannot set parameter: {msg}")
-    try:
-        _cache.update(resolved, param_value)
-    except KeyError:
-        pass
+    _server.set(param_name, param_value)
 
 
 def has_param(param_name: str) -> bool:
     """Whether ``param_name`` is set (a key or a namespace)."""
-    code, msg, value = _call_master("hasParam", _resolve(param_name))
-    if code != 1:
-        raise ROSException(f"cannot check parameter on server: {msg}")
-    return bool(value)
+    return _server.has(param_name)
 
 
 def delete_param(param_name: str) -> None:
     """Delete ``param_name``; KeyError(param_name) if it is not set."""
-    code, msg, _value = _call_master("deleteParam", _resolve(param_name))
-    if code == -1:
-        raise KeyError(param_name)
-    if code != 1:
-        raise ROSException(f"cannot delete parameter: {msg}")
+    _server.delete(param_name)
 
 
 def search_param(param_name: str) -> str | None:
     """The closest key named ``param_name`` up the node's namespace, or None."""
-    mappings = _mappings()
-    key = mappings.get(param_name, param_name)  # rospy maps the unresolved key
-    code, msg, value = _call_master("searchParam", key)
-    if code == 1:
-        return value
-    if code == -1:
-        return None
-    raise ROSException(f"cannot search for parameter: {msg}")
+    return _server.search(param_name)
 
 
 def get_param_names() -> List[str]:
     """Every parameter key on the server."""
-    code, msg, value = _call_master("getParamNames")
-    if code != 1:
-        raise ROSException(f"Unable to retrieve parameter names: {msg}")
-    return value
+    return _server.names()

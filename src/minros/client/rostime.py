@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Callable, Union
+from typing import Any, Callable, Union
 
 from minros import node
 from minros.exceptions import (
@@ -146,7 +146,7 @@ def get_time() -> float:
     return get_rostime().to_sec()
 
 
-def on_clock(msg) -> None:
+def on_clock(msg: Any) -> None:
     """A ``rosgraph_msgs/Clock`` from /clock (``init_node`` subscribes it on simulated time)."""
     _set_rostime(msg.clock)
 
@@ -250,7 +250,7 @@ class Rate:
     """Sleep in a loop at ``hz``, accounting for the time spent between sleeps (rospy.Rate)."""
 
     def __init__(self, hz: float, reset: bool = False) -> None:
-        self.last_time = get_rostime()
+        self.last_time: _MsgTime = get_rostime()
         self.sleep_dur = Duration(0, int(1e9 / hz))
         self._reset = reset
 
@@ -287,7 +287,7 @@ class Rate:
 class TimerEvent:
     """What a Timer callback is told about the current and the previous call."""
 
-    def __init__(self, last_expected, last_real, current_expected, current_real, last_duration) -> None:
+    def __init__(self, last_expected: Any, last_real: Any, current_expected: Any, current_real: Any, last_duration: Any) -> None:
         #: when the previous callback should have run (None on the first call)
         self.last_expected = last_expected
         #: when the previous callback actually ran (None on the first call)

@@ -28,11 +28,12 @@ import threading
 import time
 import traceback
 import warnings
-import xmlrpc.client
+from types import TracebackType
 from typing import Any, Callable, Dict
 
 from minros import names, node
 from minros.client.log import logerr, loginfo, logwarn, logwarn_throttle
+from minros.client.msg import stamp_header
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
@@ -42,15 +43,11 @@ from minros.exceptions import (
     TransportTerminated,
 )
 from minros.msgs import reader_for
-from minros.wire import admission, sockets, tcpros, trace
+from minros.transport.tcpros_base import connect, negotiate
+from minros.wire import admission, sockets, tcpros
+from minros.wire.handshake import Handshake, Role, State
+from minros.wire.masterapi import MasterError, RemoteError
 from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
-
-# the node context (answers before init_node too)
-_caller_id = node.get_caller_id
-_is_shutdown = node.is_shutdown
-_call_master = node.master_call
-_resolve = node.resolve_name
-_wait_for_shutdown = node.wait_for_shutdown
 
 __all__ = [
     "Service",
@@ -60,7 +57,7 @@ __all__ = [
     "wait_for_service",
 ]
 
-DEFAULT_BUFF_SIZE = 65536
+DEFAULT_BUFF_SIZE = tcpros.DEFAULT_BUFF_SIZE
 #: how often wait_for_service retries (rospy's interval)
 WAIT_FOR_SERVICE_INTERVAL = 0.3
 #: connect timeout of a service call; the response itself may take as long as the handler
@@ -92,12 +89,12 @@ _logger = logging.getLogger("rospy.service")
 def _send_all(sock: socket.socket, data: Any) -> None:
     """Send ``data`` completely; give up at node shutdown or on a peer stalled for
     SEND_STALL_TIMEOUT seconds (TransportTerminated)."""
-    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=_is_shutdown)
+    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=node.is_shutdown)
 
 
 # --------------------------------------------------------------------------- server
 
-def _convert_return_to_response(response: Any, response_class: type) -> Any:
+def _convert_return_to_response(response: Any, response_class: Any) -> Any:
     """Turn what a handler returned into a response message (rospy's rules and texts)."""
     if getattr(response, "_type", None) == response_class._type and hasattr(response, "serialize"):
         return response
@@ -119,7 +116,8 @@ def _convert_return_to_response(response: Any, response_class: type) -> Any:
         raise ServiceException(f"handler returned wrong number of values: {exc}") from None
 
 
-def _default_error_handler(exc: BaseException, exc_type, exc_value, tb) -> None:
+def _default_error_handler(exc: BaseException, exc_type: type[BaseException] | None,
+                           exc_value: BaseException | None, tb: TracebackType | None) -> None:
     logerr(f"Error processing request: {exc}\n{traceback.format_exception(exc_type, exc_value, tb)}")
 
 
@@ -132,7 +130,7 @@ class Service:
     "error processing request: ..." (after ``error_handler(e, type, value, tb)`` ran).
     """
 
-    def __init__(self, name: str, service_class: type, handler: Callable[[Any], Any],
+    def __init__(self, name: str, service_class: Any, handler: Callable[[Any], Any],
                  buff_size: int = DEFAULT_BUFF_SIZE,
                  error_handler: Callable[..., None] | None = None) -> None:
         if not name or not isinstance(name, str):
@@ -141,7 +139,7 @@ class Service:
             warnings.warn(f"'{name}' is not a legal ROS graph resource name. This may cause problems "
                           "with other ROS tools", stacklevel=2)
         self.name = name
-        self.resolved_name = _resolve(name)
+        self.resolved_name = node.resolve_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
@@ -184,7 +182,7 @@ class Service:
 
     def _header_fields(self) -> Dict[str, str]:
         return {"service": self.resolved_name, "type": self.service_class._type,
-                "md5sum": self.service_class._md5sum, "callerid": _caller_id()}
+                "md5sum": self.service_class._md5sum, "callerid": node.get_caller_id()}
 
     def _handle_connection(self, sock: socket.socket, header: Dict[str, str],
                            conn: admission.Connection) -> None:
@@ -202,19 +200,19 @@ class Service:
         within the header timeout), its bytes count against the node's budget, and a
         persistent connection waiting for its next request may be closed to make room."""
         sock.settimeout(_POLL)  # every wait, sending or receiving, wakes up to check for shutdown
-        error = tcpros.service_header_error(header, self.resolved_name, self.service_class._md5sum)
-        if error is None and self.done:
-            error = f"[{_caller_id()}] is not a provider of  [{self.resolved_name}]"
-        if error is not None:
-            _send_all(sock, tcpros.encode_error_header(error))
-            logwarn(f"Could not process inbound connection: {error}{header}")
+        refuse = None
+        if self.done:
+            refuse = f"[{node.get_caller_id()}] is not a provider of  [{self.resolved_name}]"
+        handshake = Handshake(Role.SERVICE_SERVER, self._header_fields(), refuse=refuse)
+        _send_all(sock, handshake.opening_received(header))
+        if handshake.state is State.REJECTED:
+            logwarn(f"Could not process inbound connection: {handshake.error}{header}")
             return
-        _send_all(sock, tcpros.encode_header(self._header_fields()))
-        if header.get("probe") == "1":  # wait_for_service checking we are alive
+        if handshake.state is State.CLOSED:  # a probe: wait_for_service checking we are alive
             return
-        persistent = header.get("persistent", "").lower() in ("1", "true")
+        persistent = handshake.persistent
         reader = tcpros.FrameReader(buff_size=max(self.buff_size, 16), first_chunk=_FIRST_CHUNK)
-        source = sockets.FrameSource(sock, reader, stop=_is_shutdown, guard=conn)
+        source = sockets.FrameSource(sock, reader, stop=node.is_shutdown, guard=conn)
         while not self.done:
             conn.idle()
             wait_until = None if persistent else time.monotonic() + conn.limits.head_timeout
@@ -235,7 +233,7 @@ class Service:
             try:
                 _send_all(sock, self._respond(request))
             except TransportTerminated as exc:
-                if not _is_shutdown():
+                if not node.is_shutdown():
                     # the client left (or stalled) mid-response: one line, then the next one
                     # (rospy sends the error through the error handler and logs twice)
                     logerr(f"incoming connection failed: [{self.resolved_name}] response to "
@@ -252,7 +250,7 @@ class Service:
             with self._lock:
                 self.seq += 1
                 seq = self.seq
-            tcpros.stamp_header(response, seq)
+            stamp_header(response, seq)
             buff = _Buffer()
             response.serialize(buff)
             # ok byte + length, then the response as written (not copied into one buffer)
@@ -324,7 +322,7 @@ class _Buffer:
 
 # --------------------------------------------------------------------------- client
 
-def _args_kwds_to_request(request_class: type, args: tuple, kwds: dict) -> Any:
+def _args_kwds_to_request(request_class: Any, args: tuple, kwds: dict) -> Any:
     """A request from call arguments: one request instance, positional fields or keywords."""
     if args and kwds:
         raise TypeError("publish() can be called with arguments or keywords, but not both.")
@@ -346,12 +344,12 @@ def _args_kwds_to_request(request_class: type, args: tuple, kwds: dict) -> Any:
 def _lookup_service(resolved_name: str) -> str:
     """The ``rosrpc://`` URI of a service from the master (rospy's error texts)."""
     try:
-        code, msg, uri = _call_master("lookupService", resolved_name)
+        uri = node.master().lookup_service(resolved_name)
     except OSError:
         raise ServiceException("unable to contact master") from None
-    if code != 1:
-        _logger.error("[%s]: lookup service failed with message [%s]", resolved_name, msg)
-        raise ServiceException(f"service [{resolved_name}] unavailable")
+    except RemoteError as exc:
+        _logger.error("[%s]: lookup service failed with message [%s]", resolved_name, exc)
+        raise ServiceException(f"service [{resolved_name}] unavailable") from None
     try:
         parse_rosrpc_uri(uri)
     except ParameterInvalid:
@@ -359,23 +357,13 @@ def _lookup_service(resolved_name: str) -> str:
     return uri
 
 
-def _connect(host: str, port: int, timeout: float) -> socket.socket:
-    """TCP connection to a service; every address of ``host`` is tried (localhost may be ::1)."""
-    sock = socket.create_connection((host, port), timeout=timeout)
-    try:
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    except OSError:  # not fatal: only latency
-        pass
-    return trace.watch(sock, "connect")
-
-
 class ServiceProxy:
     """A callable handle on a remote service: ``proxy(1, 2)``, ``proxy(req)``, ``proxy(a=1, b=2)``."""
 
-    def __init__(self, name: str, service_class: type, persistent: bool = False,
+    def __init__(self, name: str, service_class: Any, persistent: bool = False,
                  headers: Dict[str, str] | None = None) -> None:
         self.name = name
-        self.resolved_name = _resolve(name)
+        self.resolved_name = node.resolve_name(name)
         self.service_class = service_class
         self.request_class = service_class._request_class
         self.response_class = service_class._response_class
@@ -400,7 +388,7 @@ class ServiceProxy:
 
     def _header_fields(self) -> Dict[str, str]:
         fields = {"service": self.resolved_name, "md5sum": self.service_class._md5sum,
-                  "callerid": _caller_id()}
+                  "callerid": node.get_caller_id()}
         fields.update({str(k): str(v) for k, v in self.headers.items()})  # user headers win, as in rospy
         return fields
 
@@ -410,17 +398,12 @@ class ServiceProxy:
         self.uri = uri
         host, port = parse_rosrpc_uri(uri)
         try:
-            sock = _connect(host, port, CONNECT_TIMEOUT)
+            sock = connect(host, port, CONNECT_TIMEOUT, nodelay=True)
         except OSError as exc:
             raise ServiceException(f"unable to connect to service: {exc}") from None
         try:
-            _send_all(sock, tcpros.encode_header(self._header_fields()))
-            header = sockets.read_header(sock)
-            if "error" in header:
-                raise TransportInitError("remote error reported: {}".format(header["error"]))
-            for required in ("md5sum", "type"):
-                if required not in header:
-                    raise TransportInitError(f"header missing required field [{required}]")
+            header = negotiate(sock, Handshake(Role.SERVICE_CLIENT, self._header_fields()),
+                               send=_send_all)
         except (TransportException, OSError) as exc:
             sockets.close(sock)
             raise ServiceException(f"unable to connect to service: {exc}") from None
@@ -428,7 +411,7 @@ class ServiceProxy:
         self._sock = sock
         self._server_header = header
         self._source = sockets.FrameSource(sock, tcpros.FrameReader(buff_size=self.buff_size, ok_byte=True),
-                                           stop=_is_shutdown)
+                                           stop=node.is_shutdown)
 
     def _drop(self) -> None:
         sock, self._sock = self._sock, None
@@ -451,7 +434,7 @@ class ServiceProxy:
             try:
                 # as rospy: a request is numbered once connected, and sent in that order
                 self.seq += 1
-                tcpros.stamp_header(request, self.seq)
+                stamp_header(request, self.seq)
                 buff = _Buffer()
                 request.serialize(buff)
                 frame = buff.frame(tcpros.frame_prefix(buff.size))
@@ -465,7 +448,7 @@ class ServiceProxy:
                 self._drop()
                 if isinstance(exc, tcpros.FrameError) and "closed" in str(exc):
                     exc = TransportTerminated(_PEER_GONE)  # rospy's words for a peer gone mid-reply
-                if _is_shutdown():
+                if node.is_shutdown():
                     raise ROSInterruptException("node shutdown interrupted service call") from None
                 raise ServiceException(f"transport error completing service call: {exc}") from None
             except BaseException:
@@ -497,16 +480,17 @@ class ServiceProxy:
 def _probe_service(resolved_name: str, timeout: float) -> str | None:
     """Is the service registered and accepting connections? Sends a probe header and closes."""
     try:
-        code, _msg, uri = _call_master("lookupService", resolved_name)
-    except (xmlrpc.client.Error, ValueError) as exc:  # OSError (master down) goes to the caller
-        raise TransportInitError(f"master lookup failed: {exc}") from None
-    if code != 1:
+        uri = node.master().lookup_service(resolved_name)
+    except MasterError:  # not registered (yet)
         return None
+    except RemoteError as exc:  # OSError (master down) goes to the caller
+        raise TransportInitError(f"master lookup failed: {exc}") from None
     host, port = parse_rosrpc_uri(uri)
-    sock = _connect(host, port, timeout)
+    sock = connect(host, port, timeout, nodelay=True)
     try:
-        _send_all(sock, tcpros.encode_header({"probe": "1", "md5sum": "*", "callerid": _caller_id(),
-                                              "service": resolved_name}))
+        negotiate(sock, Handshake(Role.SERVICE_CLIENT, {
+            "probe": "1", "md5sum": "*", "callerid": node.get_caller_id(),
+            "service": resolved_name}), send=_send_all)
     finally:
         sockets.close(sock)
     return uri
@@ -523,10 +507,10 @@ def wait_for_service(service: str, timeout: float | None = None) -> None:
         timeout = timeout.to_sec()
     if timeout == 0.0:
         raise ValueError("timeout must be non-zero")
-    resolved_name = _resolve(service)
+    resolved_name = node.resolve_name(service)
     deadline = None if not timeout else time.monotonic() + timeout
     contact_failed = False
-    while not _is_shutdown():
+    while not node.is_shutdown():
         remaining = None if deadline is None else deadline - time.monotonic()
         if remaining is not None and remaining <= 0:
             break
@@ -543,8 +527,8 @@ def wait_for_service(service: str, timeout: float | None = None) -> None:
         pause = WAIT_FOR_SERVICE_INTERVAL
         if deadline is not None:
             pause = min(pause, max(0.0, deadline - time.monotonic()))
-        if _wait_for_shutdown(pause):
+        if node.wait_for_shutdown(pause):
             break
-    if _is_shutdown():
+    if node.is_shutdown():
         raise ROSInterruptException("rospy shutdown")
     raise ROSException(f"timeout exceeded while waiting for service {resolved_name}")

@@ -138,7 +138,7 @@ class ConnectionStatistics:
         self.publisher.unregister()
 
 
-def _spread(values: List[Any], duration: type) -> tuple:
+def _spread(values: List[Any], duration: Any) -> tuple:
     """(mean, standard deviation, maximum) of durations; zeros for none."""
     if not values:
         return duration(0), duration(0), duration(0)

@@ -27,13 +27,16 @@ class DynamicReconfigureCallbackException(DynamicReconfigureException):
 
 def find_reconfigure_services() -> List[str]:
     """The namespaces of every dynamic_reconfigure server (services ending in /set_parameters)."""
-    import minros
+    from minros import node
+    from minros.exceptions import ROSException
+    from minros.wire.masterapi import RemoteError
 
-    code, msg, state = minros.get_master().getSystemState()
-    if code != 1:
-        raise minros.ROSException(f"cannot get the system state from the master: {msg}")
+    try:
+        services = node.master().get_system_state().services
+    except RemoteError as exc:
+        raise ROSException(f"cannot get the system state from the master: {exc}") from None
     suffix = "/set_parameters"
-    return sorted(name[:-len(suffix)] for name, _providers in state[2] if name.endswith(suffix))
+    return sorted(name[:-len(suffix)] for name, _providers in services if name.endswith(suffix))
 
 
 def get_parameter_names(descr: Any) -> Any:

@@ -119,16 +119,16 @@ def get_or_generate_uuid(options_runid: str | None = None,
         return options_runid
     uri = get_master_uri()
     if master_is_up(uri):
-        from minros.wire.xmlrpc import ServerProxy
+        from minros.tools.master import Master
 
-        proxy = ServerProxy(uri, timeout=5.0)
+        master = Master("/roslaunch", uri)
         try:
-            code, _msg, value = proxy.getParam("/roslaunch", "/run_id")
-        except OSError:
-            code, value = 0, None
+            value = master.get_param("/run_id")
+        except Exception:  # unset, or the master went away: a new one
+            value = None
         finally:
-            proxy.close()
-        if code == 1 and value:
+            master.close()
+        if value:
             return str(value)
     return str(uuid.uuid1())
 

@@ -28,7 +28,7 @@ from minros.launch.nodeproc import (
     create_master_process,
     create_node_process,
 )
-from minros.launch.procmon import ProcessListener, start_process_monitor
+from minros.launch.procmon import ProcessListener, ProcessMonitor, start_process_monitor
 from minros.launch.rosmodel import (  # noqa: F401 - roslaunch.launch has them too
     PHASE_RUN,
     PHASE_SETUP,
@@ -41,10 +41,24 @@ from minros.launch.rosmodel import (  # noqa: F401 - roslaunch.launch has them t
     printlog_bold,
     setup_env,
 )
+from minros.wire.masterapi import MasterClient, MasterError, MasterFailure, RemoteError
+from minros.wire.rosapi import unwrap
 
 _TIMEOUT_MASTER_START = 10.0  # seconds
 _TIMEOUT_MASTER_STOP = 10.0  # seconds
 _ID = "/roslaunch"  # the caller id of the launch's master calls
+
+
+def _check_all(answers: List[Any], what: str) -> None:
+    """RLException naming the first of a system.multicall's answers (each ``[triplet]``, or a
+    fault struct) that is no success."""
+    for answer in answers:
+        if isinstance(answer, dict):
+            raise RLException(f"{what}: {answer.get('faultString', answer)}")
+        try:
+            unwrap(answer[0] if isinstance(answer, list) and len(answer) == 1 else answer)
+        except RemoteError as exc:
+            raise RLException(f"{what}: {exc}") from None
 
 
 class RLTestTimeoutException(RLException):
@@ -59,7 +73,7 @@ def validate_master_launch(m: Any, is_core: bool, is_rostest: bool = False) -> N
         if not is_core:
             raise RLException(f"ERROR: unable to contact ROS master at [{m.uri}]")
         try:
-            reverse = [info[4][0] for info in socket.getaddrinfo(host, 0, 0, 0, socket.SOL_TCP)]
+            reverse = [str(info[4][0]) for info in socket.getaddrinfo(host, 0, 0, 0, socket.SOL_TCP)]
             printerrlog(f"WARNING: IP addresses {','.join(reverse)} for local hostname '{host}' do "
                         "not appear to match\n    any local IP address "
                         f"({','.join(rosenv.get_local_addresses())}). Your ROS nodes may fail to "
@@ -168,42 +182,51 @@ class ROSLaunchRunner:
         """Add a listener (before processes start)."""
         self.listeners.add_process_listener(listener)
 
+    def _monitor(self) -> ProcessMonitor:
+        if self.pm is None:
+            raise RLException("this launch has stopped: its process monitor is shut down")
+        return self.pm
+
     # -- the master and its parameters
+    def _master(self) -> MasterClient:
+        """The launch's master, called as roslaunch (``/roslaunch``)."""
+        return MasterClient(self.config.master.uri, _ID)
+
     def _load_parameters(self) -> None:
         """Clear the launch's clear_params namespaces, then set its parameters: one multicall
         each."""
-        master = self.config.master
+        master = self._master()
         last = None
         try:
-            proxy = master.get()
-            multi = master.get_multi()
-            for ns in _unify_clear_params(self.config.clear_params):
-                if proxy.hasParam(_ID, ns)[2]:
-                    multi.deleteParam(_ID, ns)
-            for code, msg, _ in multi():
-                if code != 1:
-                    raise RLException(f"Failed to clear parameter: {msg}")
-            multi = master.get_multi()
+            calls = [{"methodName": "deleteParam", "params": [_ID, ns]}
+                     for ns in _unify_clear_params(self.config.clear_params)
+                     if master.has_param(ns)]
+            _check_all(master.multicall(calls) if calls else [], "Failed to clear parameter")
+            calls = []
             for last in self.config.params.values():
-                multi.setParam(_ID, last.key, last.value)
-            for code, msg, _ in multi():
-                if code != 1:
-                    raise RLException(f"Failed to set parameter: {msg}")
+                calls.append({"methodName": "setParam", "params": [_ID, last.key, last.value]})
+            _check_all(master.multicall(calls) if calls else [], "Failed to set parameter")
         except RLException:
             raise
         except Exception as exc:
             printerrlog(f"load_parameters: unable to set parameters (last param was [{last}]): {exc}")
             raise
+        finally:
+            master.close()
 
-    def _check_and_set_run_id(self, param_server: Any, run_id: str) -> None:
-        code, _, present = param_server.hasParam(_ID, "/run_id")
-        if code == 1 and not present:
+    def _check_and_set_run_id(self, master: MasterClient, run_id: str) -> None:
+        try:
+            present = master.has_param("/run_id")
+        except RemoteError:
+            present = True  # then getParam tells
+        if not present:
             printlog_bold(f"setting /run_id to {run_id}")
-            param_server.setParam(_ID, "/run_id", run_id)
+            master.set_param("/run_id", run_id)
             return
-        code, _, value = param_server.getParam(_ID, "/run_id")
-        if code != 1:
-            raise RLException("ERROR: unable to retrieve /run_id from parameter server")
+        try:
+            value = master.get_param("/run_id")
+        except RemoteError:
+            raise RLException("ERROR: unable to retrieve /run_id from parameter server") from None
         if value != run_id:
             raise RLException(f"run_id on parameter server does not match declared run_id: "
                               f"{value} vs {run_id}")
@@ -223,7 +246,7 @@ class ROSLaunchRunner:
                                       self.timeout, master_logger_level=self.master_logger_level,
                                       sigint_timeout=self.sigint_timeout,
                                       sigterm_timeout=self.sigterm_timeout)
-            self.pm.register_core_proc(p)
+            self._monitor().register_core_proc(p)
             if not p.start():
                 raise RLException("ERROR: unable to auto-start master process")
             deadline = time.time() + _TIMEOUT_MASTER_START
@@ -232,12 +255,15 @@ class ROSLaunchRunner:
         if not m.is_running():
             raise RLException(f"ERROR: could not contact master [{m.uri}]")
         printlog_bold(f"ROS_MASTER_URI={m.uri}")
-        param_server = m.get()
-        self._check_and_set_run_id(param_server, self.run_id)
-        if self.server_uri:
-            host, port = rosenv.parse_http_host_and_port(self.server_uri)
-            param_server.setParam(_ID, f"/roslaunch/uris/{_hostname_to_rosname(host)}__{port}",
-                                  self.server_uri)
+        master = self._master()
+        try:
+            self._check_and_set_run_id(master, self.run_id)
+            if self.server_uri:
+                host, port = rosenv.parse_http_host_and_port(self.server_uri)
+                master.set_param(f"/roslaunch/uris/{_hostname_to_rosname(host)}__{port}",
+                                 self.server_uri)
+        finally:
+            master.close()
         return not running
 
     # -- executables and nodes
@@ -260,19 +286,25 @@ class ROSLaunchRunner:
 
     def _launch_core_nodes(self) -> None:
         """Start the core nodes (rosout) the master does not know yet."""
-        master = self.config.master.get()
+        master = self._master()
         pending = []
-        for node in self.config.nodes_core:
-            name = names.ns_join(node.namespace, node.name)
-            code, msg, _ = master.lookupNode(_ID, name)
-            if code == -1:
-                pending.append(node)
-            elif code == 1:
+        try:
+            for node in self.config.nodes_core:
+                name = names.ns_join(node.namespace, node.name)
+                try:
+                    master.lookup_node(name)
+                except MasterError:  # not known yet
+                    pending.append(node)
+                    continue
+                except MasterFailure as exc:
+                    print("WARN: master is not behaving well (unexpected return value when "
+                          "looking up node)", file=sys.stderr)
+                    self.logger.error("ERROR: master return [%s][%s] on lookupNode call",
+                                      exc.code, exc)
+                    continue
                 print(f"core service [{name}] found")
-            else:
-                print("WARN: master is not behaving well (unexpected return value when looking up node)",
-                      file=sys.stderr)
-                self.logger.error("ERROR: master return [%s][%s] on lookupNode call", code, msg)
+        finally:
+            master.close()
         for node in pending:
             name = names.ns_join(node.namespace, node.name)
             _proc, success = self.launch_node(node, core=True)
@@ -308,7 +340,8 @@ class ROSLaunchRunner:
         except NodeParamsException as exc:
             printerrlog(f"ERROR: cannot launch node of type [{node.package}/{node.type}]: {exc}")
             return (node.name or f"{node.package}/{node.type}"), False
-        (self.pm.register_core_proc if core else self.pm.register)(process)
+        pm = self._monitor()
+        (pm.register_core_proc if core else pm.register)(process)
         node.process_name = process.name
         success = process.start()
         if not success:
@@ -321,7 +354,7 @@ class ROSLaunchRunner:
 
     def is_node_running(self, node: Any) -> bool:
         name = getattr(node, "process_name", None)
-        return bool(name) and self.pm.has_process(name)
+        return name is not None and bool(name) and self._monitor().has_process(name)
 
     # -- running
     def spin_once(self) -> bool:
@@ -375,7 +408,7 @@ class ROSLaunchRunner:
         if not success:
             raise RLException(f"test [{test.test_name}] failed to launch")
         deadline = time.time() + test.time_limit
-        while self.pm.mainthread_spin_once() and self.is_node_running(test):
+        while self._monitor().mainthread_spin_once() and self.is_node_running(test):
             if time.time() > deadline:
                 raise RLTestTimeoutException(
                     f"max time [{test.time_limit}s] allotted for test [{test.test_name}] of type "

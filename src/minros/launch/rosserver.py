@@ -44,6 +44,7 @@ from minros.launch.rosmodel import (
     set_child_mode,
 )
 from minros.launch.rosrunner import ROSLaunchRunner, ROSRemoteRunnerIF
+from minros.wire.rosapi import RemoteError, unwrap
 from minros.wire.xmlrpc_node import XmlRpcHandler, XmlRpcNode
 
 # rosgraph_msgs/Log levels
@@ -292,9 +293,10 @@ class ROSLaunchChildNode(ROSLaunchNode):
         name = self.name
         try:
             server = xmlrpc.client.ServerProxy(self.server_uri)
-            code, msg, _ = server.register(name, self.uri)
-            if code != 1:
-                raise RLException(f"unable to register with roslaunch server: {msg}")
+            try:
+                unwrap(server.register(name, self.uri))
+            except RemoteError as exc:
+                raise RLException(f"unable to register with roslaunch server: {exc}") from None
         except Exception:
             raise RLException(f"Exception while registering with roslaunch parent "
                               f"[{self.server_uri}]: {traceback.format_exc()}") from None

@@ -25,6 +25,7 @@ from minros.launch.rosmodel import (
     setup_env,
 )
 from minros.launch.runner import LaunchRunner
+from minros.wire.rosapi import RemoteError, unwrap
 
 # ---------------------------------------------------------------------------------------------
 # roslaunch.node_args
@@ -211,12 +212,11 @@ def list_processes(roslaunch_uris: Optional[Sequence[str]] = None) -> List[NetPr
         from minros.tools.master import call_node
 
         try:
-            code, _msg, (active, dead) = call_node(uri, "list_processes")
-        except (OSError, ValueError, TypeError, xmlrpc.client.Error):
+            active, dead = unwrap(call_node(uri, "list_processes"))
+        except (OSError, ValueError, TypeError, xmlrpc.client.Error, RemoteError):
             continue
-        if code == 1:
-            procs += [NetProcess(a[0], a[1], True, uri) for a in active]
-            procs += [NetProcess(d[0], d[1], False, uri) for d in dead]
+        procs += [NetProcess(a[0], a[1], True, uri) for a in active]
+        procs += [NetProcess(d[0], d[1], False, uri) for d in dead]
     return procs
 
 

@@ -40,18 +40,12 @@ POLL_INTERVAL = 0.05
 LOG_ROTATION_INTERVAL = 1.0
 
 
-def _xmlrpc_proxy(uri: str, timeout: float = 5.0) -> Any:
-    from minros.wire.xmlrpc import ServerProxy
-
-    return ServerProxy(uri, timeout=timeout)
-
-
 def master_is_up(uri: str, timeout: float = 1.0) -> bool:
     from minros.tools.master import Master
 
     master = Master("/roslaunch", uri, timeout)
     try:
-        master.getPid()  # raises unless the master answers SUCCESS
+        master.get_pid()  # raises unless the master answers SUCCESS
         return True
     except Exception:
         return False
@@ -269,8 +263,10 @@ class LaunchRunner:
         self._counter += 1
         return f"{resolved.lstrip('/')}-{self._counter}"
 
-    def _proxy(self) -> Any:
-        return _xmlrpc_proxy(self.master_uri)
+    def _master(self) -> Any:
+        from minros.tools.master import Master
+
+        return Master("/roslaunch", self.master_uri)
 
     def _start_master(self) -> None:
         if master_is_up(self.master_uri):
@@ -304,17 +300,20 @@ class LaunchRunner:
             time.sleep(0.05)
 
     def _setup_run_id(self) -> None:
-        proxy = self._proxy()
-        code, _msg, value = proxy.getParam("/roslaunch", "/run_id")
-        if code == 1:
+        from minros.tools.master import MasterError
+
+        master = self._master()
+        try:
+            value = master.get_param("/run_id")
+        except MasterError:  # not set
+            self.run_id = self.run_id or str(uuid.uuid1())
+            self.out(f"setting /run_id to {self.run_id}")
+            master.set_param("/run_id", self.run_id)
+        else:
             if self.run_id and value != self.run_id:
                 raise LaunchError(f"run_id on parameter server does not match declared run_id: "
                                   f"{value} vs {self.run_id}")
             self.run_id = value
-        else:
-            self.run_id = self.run_id or str(uuid.uuid1())
-            self.out(f"setting /run_id to {self.run_id}")
-            proxy.setParam("/roslaunch", "/run_id", self.run_id)
         self.log_dir = log_root(self.env) / self.run_id
         try:
             self.log_dir.mkdir(parents=True, exist_ok=True)
@@ -323,37 +322,46 @@ class LaunchRunner:
         renew_latest_log_dir(self.log_dir)
 
     def _load_parameters(self) -> None:
-        proxy = self._proxy()
-        caller = "/roslaunch"
+        from minros.tools.master import MasterException
+
+        master = self._master()
         for ns in self.config.clear_params:
-            code, _msg, present = proxy.hasParam(caller, ns)
-            if code == 1 and present:
-                proxy.deleteParam(caller, ns)
+            try:
+                if master.has_param(ns):
+                    master.delete_param(ns)
+            except MasterException:
+                pass
         for command in self.config.rosparam_commands:
-            self._rosparam_command(proxy, command)
+            self._rosparam_command(master, command)
         last = None
         try:
             for key, value in self.config.params.items():
                 last = key
-                code, msg, _ = proxy.setParam(caller, key, value)
-                if code != 1:
-                    raise LaunchError(f"unable to set parameter [{key}]: {msg}")
+                try:
+                    master.set_param(key, value)
+                except MasterException as exc:
+                    raise LaunchError(f"unable to set parameter [{key}]: {exc}") from None
         except LaunchError:
             raise
         except Exception as exc:
             raise LaunchError(f"load_parameters: unable to set parameters (last param was [{last}]): {exc}") from None
 
-    def _rosparam_command(self, proxy: Any, command: Tuple[str, ...]) -> None:
+    def _rosparam_command(self, master: Any, command: Tuple[str, ...]) -> None:
+        from minros.tools.master import MasterException
+
         if command[0] == "delete":
-            code, msg, _ = proxy.deleteParam("/roslaunch", command[1])
-            if code != 1:
+            try:
+                master.delete_param(command[1])
+            except MasterException:
                 self.err(f"WARNING: rosparam delete: parameter [{command[1]}] is not set")
             return
         _dump, path, key = command
-        code, _msg, value = proxy.getParam("/roslaunch", key)
+        try:
+            data = master.get_param(key)
+        except MasterException:
+            data = {}
         import yaml
 
-        data = value if code == 1 else {}
         try:
             Path(path).write_text(yaml.safe_dump(data, default_flow_style=False))
         except OSError as exc:

@@ -1,7 +1,7 @@
 """The exercises of ``minros learn``, as data, and their checkers (pure functions).
 
 Each exercise starts what it needs (a master or two, small nodes from
-:mod:`minros.learn.actors`, every process traced into the exercise's folder), asks one
+:mod:`minros.learn.actors`, ``minros zenoh`` bridges, traced into the exercise's folder), asks one
 question the wire answers, and checks the learner's answer against the learner's own trace
 (``me*.jsonl`` in the folder) and the traces of what it started. A wrong answer gets a hint
 that names what the answer was instead (a port where a URI was asked, the other side's
@@ -11,12 +11,13 @@ md5sum, ...) and where to look.
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import json
 import math
 import random
 import re
 import struct
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 from minros.learn.evidence import Conn, calls, connections, latency, node_names, replied
 from minros.learn.model import Attempt, Exercise, Process, Result, same_uri
@@ -36,6 +37,28 @@ def _master(which: str = "a") -> Process:
 def _actor(name: str, role: str, *args: str, ready: Tuple[str, ...] = (), master: str = "a",
            **more: Any) -> Process:
     return Process(name, ("minros.learn.actors", role, *args), master=master, ready=ready, **more)
+
+
+def _zenoh_bridge(name: str, which: str, *endpoints: str, ready: Tuple[str, ...]) -> Process:
+    """``minros zenoh`` on master ``which``, on loopback only: a Zenoh peer listens on every
+    interface unless told where, and finds others by UDP multicast unless told not to.
+
+    Untraced: a bridge asks its master for the graph ten times a second, which would add
+    some 50 kB/s to its trace; what it does on the wire with the talker, the master and the
+    learner, the traces of those show from their side (its calls as served)."""
+    return Process(name, ("minros", "zenoh", *endpoints, "--no-multicast-scouting"),
+                   master=which, ready=ready, traced=False, node="/minros_zenoh")
+
+
+def _zenoh_missing() -> str:
+    """What the zenoh variant lacks here: the eclipse-zenoh package (minros.zenoh.available,
+    which this layer may not import, asks the same), found without importing it."""
+    try:
+        found = importlib.util.find_spec("zenoh") is not None
+    except (ImportError, ValueError):  # a broken or None entry in sys.modules
+        found = False
+    return "" if found else ("the Zenoh bridge needs the eclipse-zenoh package, which minros "
+                             "installs as an extra: pip install minros[zenoh]")
 
 
 def _no_trace(a: Attempt, what: str) -> Result:
@@ -578,7 +601,9 @@ def _check_master_restart(a: Attempt) -> Result:
 # --------------------------------------------------------------------------- 11
 
 
-def _check_two_masters(a: Attempt) -> Result:
+def _received_on_b(a: Attempt) -> Union[Result, Conn]:
+    """The connection through which the learner's subscriber on master B got /chatter (with
+    an answer to check), or the verdict on why there is none yet."""
     regs = [ev for ev in calls(a.mine, "registerSubscriber", "/chatter") if replied(ev)]
     if not regs:
         return _no_trace(a, "registerSubscriber call for /chatter")
@@ -589,33 +614,124 @@ def _check_two_masters(a: Attempt) -> Result:
     conns = [c for c in connections(a.mine, topic="/chatter", side="connect") if c.inn]
     if not conns:
         return _no_trace(a, "connection to /chatter's publisher")
-    asked = _words_or_ask(a, "CALLERID N")
-    if asked:
-        return asked
-    callerid = conns[-1].inn.get("callerid", "")
+    return _words_or_ask(a, str(a.facts.get("answer_form", "CALLERID N"))) or conns[-1]
+
+
+def _wrong_sender(names: List[str], callerid: str) -> Optional[Result]:
+    if names[:1] == [callerid]:
+        return None
+    if names[:1] == ["/talker"]:
+        return Result(False, "/talker publishes on master A, which your node never talked "
+                      "to.", hint="The callerid of the publisher's header you received [5].")
+    return Result(False, "That is not who sent you the message.",
+                  hint="The callerid field of the second header of [5].")
+
+
+def _calls_from(events: Sequence[Dict[str, Any]], names: Sequence[str]) -> List[Dict[str, Any]]:
+    """The calls a master's trace shows it served for the nodes ``names``."""
+    return [ev for ev in events if ev.get("ev") == "xmlrpc.serve" and names
+            and (ev.get("args") or [""])[0] in names]
+
+
+def _check_two_masters(a: Attempt) -> Result:
+    if a.facts.get("variant") == "zenoh":
+        return _check_two_masters_zenoh(a)
+    conn = _received_on_b(a)
+    if isinstance(conn, Result):
+        return conn
+    callerid = conn.inn.get("callerid", "")
     hops = int(a.facts.get("hops", 2))
     names = [w for w in a.words if w.startswith("/")]
     numbers = [int(w) for w in a.words if w.isdigit()]
-    if names[:1] != [callerid]:
-        if names[:1] == ["/talker"]:
-            return Result(False, "/talker publishes on master A, which your node never talked "
-                          "to.", hint="The callerid of the publisher's header you received [5].")
-        return Result(False, "That is not who sent you the message.",
-                      hint="The callerid field of the second header of [5].")
+    wrong = _wrong_sender(names, callerid)
+    if wrong:
+        return wrong
     if numbers[:1] != [hops]:
         return Result(False, "The sender is right; count the TCPROS connections again.",
                       hint="From /talker to the relay on master A, from the relay to you on "
                            "master B; the relay's two halves talk through a pipe, not TCPROS.")
     me = node_names(a.mine)
-    heard = [ev for ev in a.traces.get("master", []) if ev.get("ev") == "xmlrpc.serve"
-             and me and (ev.get("args") or [""])[0] in me]
+    heard = _calls_from(a.traces.get("master", []), me)
     return Result(True, f"Right: {callerid} registered /chatter on master B and sent you the "
                   f"messages it receives from /talker on master A: {hops} TCPROS connections, "
                   "one on each master. Master A's trace has "
                   + (f"{len(heard)} calls" if heard else "no call")
                   + f" from your node ({me[0] if me else '?'}): each master keeps its own graph, "
-                  "and only the relay is on both. A Zenoh bridge (minros zenoh, when it exists) "
-                  "does the same with a Zenoh network in the middle.")
+                  "and only the relay is on both. minros learn 11 --via zenoh does the same "
+                  "with a minros zenoh bridge on each master and a Zenoh network in between.")
+
+
+def zenoh_key(topic: str, type_name: str, md5sum: str, namespace: str = "*") -> str:
+    """The key expression minros zenoh (and zenoh-bridge-ros1) carries a topic's messages
+    under: the type's name in hex, its md5sum, the bridge namespace, the name without its
+    slashes (minros.zenoh.keys.data_key, which this layer may not import)."""
+    return f"{type_name.encode().hex()}/{md5sum}/{namespace}/{topic.strip('/')}"
+
+
+def _wrong_key(word: str, key: str, type_name: str, md5sum: str) -> str:
+    """A hint for a key that is not ``key`` ("" when ``word`` does not look like a key)."""
+    parts = word.split("/")
+    want = key.split("/")
+    if word.startswith("ros1_discovery_info/"):
+        return ("That is the key of a bridge's beacon, which declares that /chatter exists; "
+                "the messages themselves go under the key that follows the class (pub/).")
+    if word == type_name or word == md5sum:
+        return ("That is one part of the key: the key is <the type's name in hex>/<md5sum>/"
+                "<bridge namespace>/<topic without its slash> (minros zenoh keys /chatter).")
+    if word != word.strip("/"):
+        return ("A Zenoh key expression has no '/' at either end: the topic goes in without "
+                "its leading slash.")
+    if len(parts) != 4:
+        return ("A data key has four parts: <the type's name in hex>/<md5sum>/<bridge "
+                "namespace>/<topic without its slash>; minros zenoh keys /chatter prints it.")
+    if parts[0] != want[0]:
+        return (f"The first part is the hex of the type's whole name, {type_name} as it "
+                "arrived in your header: python3 -c 'print(b\"...\".hex())'.")
+    if parts[1] != want[1]:
+        return "The second part is the md5sum of the publisher's header you received [5]."
+    if parts[2] != want[2]:
+        return "These bridges run without --namespace: the bridge namespace is '*'."
+    return "The last part is the topic's name without its leading slash."
+
+
+def _check_two_masters_zenoh(a: Attempt) -> Result:
+    conn = _received_on_b(a)
+    if isinstance(conn, Result):
+        return conn
+    callerid = conn.inn.get("callerid", "")
+    type_name = conn.inn.get("type", "")
+    md5sum = conn.inn.get("md5sum", "")
+    key = zenoh_key("/chatter", type_name, md5sum)
+    names = [w for w in a.words if w.startswith("/")]
+    wrong = _wrong_sender(names, callerid)
+    if wrong:
+        if names[:1] == ["/talker"]:
+            wrong.hint += " /talker's messages reached master B through the bridges."
+        return wrong
+    keys = [w for w in a.words if not w.startswith("/")]
+    if not keys:
+        return Result(False, f"{callerid} is right; now the key the message crossed Zenoh under.",
+                      hint="With env.sh sourced: minros zenoh keys /chatter (it asks master B "
+                           "and the publisher for the type and md5sum).")
+    if keys[0] != key:
+        return Result(False, f"{callerid} is right; {keys[0]} is not the key /chatter "
+                      "crossed under.", hint=_wrong_key(keys[0], key, type_name, md5sum))
+    master_b = _calls_from(a.traces.get("master_b", []), [callerid])
+    registered = [ev for ev in master_b if ev.get("method") == "registerPublisher"
+                  and (ev.get("args") or ["", ""])[1:2] == ["/chatter"]]
+    on_b = (f" Master B's trace shows {callerid}'s registerPublisher for /chatter"
+            if registered else f" {callerid} registered /chatter as a publisher on master B")
+    me = node_names(a.mine)
+    heard = _calls_from(a.traces.get("master", []), me)
+    return Result(True, f"Right: the header you received says callerid={callerid}, the bridge "
+                  f"on master B, not /talker.{on_b}, as a node of that master; the bridge on "
+                  f"master A subscribed to /talker and put each message on Zenoh under {key} "
+                  f"(the hex of {type_name}, its md5sum, the bridge namespace '*', the topic), "
+                  "as the body alone, without TCPROS's length prefix. Two TCPROS connections, "
+                  "one on each master, and a Zenoh link between the bridges: master A's trace "
+                  "has " + (f"{len(heard)} calls" if heard else "no call")
+                  + f" from your node ({me[0] if me else '?'}). zenoh-bridge-ros1 uses the "
+                  "same keys, so a bridge of either kind could be at either end.")
 
 
 # --------------------------------------------------------------------------- the list
@@ -800,35 +916,54 @@ Question: which calls did /talker and /listener make to the new master about /ch
                               ready=("registerSubscriber", "/chatter")))}),
     Exercise(
         11, "two-masters", "A topic crossing two masters", 4,
-        "a topic crossing two masters (two masters and a relay)",
+        "a topic crossing two masters (two minros zenoh bridges, or a relay)",
         task="""Two masters: A at {master} and B at {master_b}.
 /talker publishes /chatter on master A. {bridge_text}
 In another terminal, subscribe on master B, traced (env.sh sets ROS_MASTER_URI={master_b}):
     source {dir}/env.sh
     minros trace -o {me} -- minros topic echo -n 1 /chatter
     minros trace show {dir}/*.jsonl --topic /chatter
-Question: whose callerid is in the publisher's header you received, and how many TCPROS
-connections did the message cross from /talker to you?
-    minros learn check 11 CALLERID N""",
+{question}
+    minros learn check 11 {answer_form}""",
         answer_form="CALLERID N", check=_check_two_masters,
-        variants={"relay": (
-            _master("a"), _master("b"),
-            _actor("talker", "talker", "--topic", "/chatter",
-                   ready=("registerPublisher", "/chatter")),
-            _actor("relay_a", "relay_out", "--topic", "/chatter", "--name", "relay",
-                   ready=("registerSubscriber", "/chatter"), stdout_pipe=True),
-            _actor("relay_b", "relay_in", "--topic", "/chatter", "--name", "relay",
-                   master="b", stdin_from="relay_a",
-                   ready=("registerPublisher", "/chatter")))},
-        planned={"zenoh": "minros zenoh does not exist yet: a bridge on each master, joined "
-                          "by a Zenoh network, will take the relay's place"}),
+        variants={
+            "zenoh": (
+                _master("a"), _master("b"),
+                _actor("talker", "talker", "--topic", "/chatter",
+                       ready=("registerPublisher", "/chatter")),
+                _zenoh_bridge("bridge_a", "a", "--listen", "tcp/127.0.0.1:{zenoh_port}",
+                              ready=("registerSubscriber", "/chatter")),
+                _zenoh_bridge("bridge_b", "b", "--connect", "tcp/127.0.0.1:{zenoh_port}",
+                              "--listen", "tcp/127.0.0.1:0",
+                              ready=("registerPublisher", "/chatter"))),
+            "relay": (
+                _master("a"), _master("b"),
+                _actor("talker", "talker", "--topic", "/chatter",
+                       ready=("registerPublisher", "/chatter")),
+                _actor("relay_a", "relay_out", "--topic", "/chatter", "--name", "relay",
+                       ready=("registerSubscriber", "/chatter"), stdout_pipe=True),
+                _actor("relay_b", "relay_in", "--topic", "/chatter", "--name", "relay",
+                       master="b", stdin_from="relay_a",
+                       ready=("registerPublisher", "/chatter")))},
+        requires={"zenoh": _zenoh_missing},
+        variant_facts={
+            "zenoh": {
+                "bridge": "/minros_zenoh", "hops": 2, "answer_form": "CALLERID KEY",
+                "bridge_text": "A minros zenoh bridge on each master joins them\n"
+                               "over Zenoh on this machine only: bridge_a (master A) listens on "
+                               "tcp/127.0.0.1:{zenoh_port},\nbridge_b (master B) connects to "
+                               "it; neither scouts by multicast, so nothing reaches the LAN.",
+                "question": "Question: whose callerid is in the publisher's header you received, "
+                            "and under which Zenoh\nkey expression did the message cross "
+                            "between the bridges (minros zenoh keys --help)?",
+            },
+            "relay": {
+                "bridge": "/relay", "hops": 2,
+                "bridge_text": "A relay republishes it on master B: one\nnode on each "
+                               "master, both named /relay, joined by a pipe (relay_a.jsonl and "
+                               "relay_b.jsonl).",
+                "question": "Question: whose callerid is in the publisher's header you received, "
+                            "and how many TCPROS\nconnections did the message cross from "
+                            "/talker to you?",
+            }}),
 )
-
-#: facts a variant adds (the bridge between the masters of exercise 11)
-VARIANT_FACTS: Mapping[Tuple[int, str], Mapping[str, Any]] = {
-    (11, "relay"): {
-        "bridge": "/relay", "hops": 2,
-        "bridge_text": "A relay republishes it on master B: one node on each master, both\n"
-                       "named /relay, joined by a pipe (relay_a.jsonl and relay_b.jsonl).",
-    },
-}

@@ -1,10 +1,14 @@
 """What an exercise is, as data: what it starts, what it asks, how an answer is checked.
 
-An :class:`Exercise` names the processes it starts (:class:`Process`: a master, or a small
-node of :mod:`minros.learn.actors`, each traced to its own file), the task text (a template
-filled with the facts of one start: ports, URIs, the folder, the random values it chose), and
-a checker: a pure function from an :class:`Attempt` (the learner's answer, the traces in the
-exercise's folder, the facts) to a :class:`Result` (right or not, what was found, a hint).
+An :class:`Exercise` names the processes it starts (:class:`Process`: a master, a small
+node of :mod:`minros.learn.actors` or a minros program such as ``minros zenoh``, each traced
+to its own file unless told not to), the task text (a template filled with the facts of one
+start: ports, URIs, the folder, the random values it chose), and a checker: a pure function
+from an :class:`Attempt` (the learner's answer, the traces in the exercise's folder, the
+facts) to a :class:`Result` (right or not, what was found, a hint). An exercise may come in
+variants (exercise 11: through Zenoh or a relay), each with its processes and facts; the
+default is the first that can start here (one needing a package that is not installed
+cannot).
 """
 
 from __future__ import annotations
@@ -29,7 +33,10 @@ class Process:
     master (``a`` or ``b``) its ROS_MASTER_URI names; a master process serves it. ``ready``
     is what its trace must show before the exercise is ready: ``("master",)`` (the master
     answers), or ``(method, name)``: a call of ``method`` about topic or service ``name``
-    that got its reply. ``stdin_from`` pipes another process's output into this one."""
+    that got its reply. ``stdin_from`` pipes another process's output into this one.
+    ``traced`` False runs it untraced (its output still goes to ``<name>.log``): a process
+    whose peers' traces already show all it does, and whose own would only grow; ``node``,
+    its ROS name, is then what its master must list for ``ready``."""
 
     name: str
     argv: Tuple[str, ...]
@@ -37,6 +44,8 @@ class Process:
     ready: Tuple[str, ...] = ()
     stdin_from: str = ""
     stdout_pipe: bool = False
+    traced: bool = True
+    node: str = ""
 
 
 @dataclass
@@ -93,10 +102,29 @@ class Exercise:
     files: Mapping[str, str] = field(default_factory=dict)
     #: variants named but not available yet, with the reason
     planned: Mapping[str, str] = field(default_factory=dict)
+    #: variants that need something this installation may lack: variant -> a function
+    #: returning what is missing and how to get it ("" when nothing is)
+    requires: Mapping[str, Callable[[], str]] = field(default_factory=dict)
+    #: facts a variant adds to each start (texts of its task, ``answer_form`` when its
+    #: answer differs); their strings are templates over the facts too
+    variant_facts: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+
+    def missing(self, variant: str) -> str:
+        """Why ``variant`` cannot start here ("" when it can)."""
+        if variant in self.planned:
+            return self.planned[variant]
+        need = self.requires.get(variant)
+        return need() if need is not None else ""
 
     @property
     def default_variant(self) -> str:
-        return next(iter(self.variants))
+        """The first variant that can start here (the first of all when none can)."""
+        return next((v for v in self.variants if not self.missing(v)), next(iter(self.variants)))
+
+    def unavailable(self) -> Dict[str, str]:
+        """The variants named but not startable here, with the reason."""
+        named = [*self.variants, *(v for v in self.planned if v not in self.variants)]
+        return {v: reason for v in named if (reason := self.missing(v))}
 
     def processes(self, variant: str = "") -> Tuple[Process, ...]:
         return self.variants[variant or self.default_variant]
@@ -105,8 +133,17 @@ class Exercise:
         """The masters the exercise starts (``a``, ``b``), in order."""
         return [p.master for p in self.processes(variant) if p.ready[:1] == ("master",)]
 
+    def form(self, variant: str = "") -> str:
+        """How ``variant``'s answer is given."""
+        extra = self.variant_facts.get(variant or self.default_variant, {})
+        return str(extra.get("answer_form", self.answer_form))
+
     def task_text(self, facts: Mapping[str, Any]) -> str:
-        return self.task.format_map(_Facts(facts)).strip("\n")
+        variant = str(facts.get("variant") or self.default_variant)
+        extra = {"answer_form": self.form(variant), **self.variant_facts.get(variant, {})}
+        known = _Facts({**extra, **facts})
+        filled = {k: v.format_map(known) if isinstance(v, str) else v for k, v in extra.items()}
+        return self.task.format_map(_Facts({**facts, **filled})).strip("\n")
 
 
 class _Facts(dict):

@@ -17,18 +17,17 @@ import shlex
 import shutil
 import signal
 import socket
+import string
 import subprocess
 import sys
 import threading
 import time
-import xmlrpc.client
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Optional
 
 from minros import rosenv
-from minros.learn.catalog import VARIANT_FACTS
 from minros.learn.model import Attempt, Exercise, Process
-from minros.wire.xmlrpc import ServerProxy
+from minros.wire.masterapi import MasterClient, RemoteError
 
 __all__ = ["LearnError", "Runner", "default_base", "folder_for", "load_attempt", "read_state"]
 
@@ -38,6 +37,12 @@ READY_TIMEOUT = 30.0
 #: an exercise left running stops after this long (its nodes' traces keep growing: every
 #: node probes its master once a second)
 RUN_LIMIT = 3600.0
+#: an exercise whose folder's traces pass this many bytes stops too (five minutes of any
+#: exercise write a few MB; the masters of exercise 11's zenoh variant trace the bridges'
+#: graph reads, some 110 kB/s together: 200 MB in half an hour)
+TRACE_LIMIT = 200 << 20
+#: how often the traces' size is looked at (seconds)
+SIZE_EVERY = 5.0
 STOP_GRACE = (("SIGINT", 5.0), ("SIGTERM", 3.0), ("SIGKILL", 3.0))
 
 
@@ -60,6 +65,18 @@ def _free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
+
+
+def _port_fields(processes: Iterable[Process]) -> List[str]:
+    """The ``{..._port}`` fields of the processes' arguments (each start gives each a free
+    port: a Zenoh endpoint, say), besides the masters' ``port`` and ``port_b``."""
+    names: List[str] = []
+    for process in processes:
+        for arg in process.argv:
+            for _text, name, _spec, _conv in string.Formatter().parse(arg):
+                if name and name.endswith("_port") and name not in names:
+                    names.append(name)
+    return names
 
 
 def _alive(pid: int) -> bool:
@@ -100,13 +117,15 @@ class Runner:
     def __init__(self, exercise: Exercise, base: Path, variant: str = "",
                  seed: Optional[int] = None, python: str = sys.executable,
                  say: Callable[[str], None] = print, stop_hint: str = "") -> None:
-        if variant and variant not in exercise.variants:
-            if variant in exercise.planned:
-                raise LearnError(f"--via {variant}: {exercise.planned[variant]}; use --via "
-                                 f"{exercise.default_variant}")
+        if variant and variant not in exercise.variants and variant not in exercise.planned:
             known = ", ".join(v for v in exercise.variants if v) or "none"
             raise LearnError(f"exercise {exercise.number} has no variant {variant!r} "
                              f"(variants: {known})")
+        missing = exercise.missing(variant) if variant else ""
+        if missing:
+            others = [v for v in exercise.variants if v != variant and not exercise.missing(v)]
+            instead = f"; --via {others[0]} runs without it" if others else ""
+            raise LearnError(f"--via {variant}: {missing}{instead}")
         self.exercise = exercise
         self.variant = variant or exercise.default_variant
         self.folder = folder_for(base, exercise)
@@ -181,9 +200,11 @@ class Runner:
         if "b" in masters:
             facts["port_b"] = _free_port()
             facts["master_b"] = f"http://localhost:{facts['port_b']}/"
+        for name in _port_fields(ex.processes(self.variant)):
+            facts.setdefault(name, _free_port())
         if ex.choose is not None:
             facts.update(ex.choose(self.rng))
-        facts.update(VARIANT_FACTS.get((ex.number, self.variant), {}))
+        facts.update(ex.variant_facts.get(self.variant, {}))
         if ex.slug == "md5sum":
             from minros.learn.catalog import READING_MSG
 
@@ -210,8 +231,9 @@ class Runner:
                if not k.startswith(("ROS_", "MINROS_")) and k != "PYTHONPATH"}
         master = facts["master_b"] if process.master == "b" else facts["master"]
         env.update(ROS_MASTER_URI=master, ROS_HOSTNAME="localhost", PYTHONUNBUFFERED="1",
-                   ROS_LOG_DIR=str(self.folder / "log"),
-                   MINROS_TRACE=str(self.folder / f"{process.name}.jsonl"))
+                   ROS_LOG_DIR=str(self.folder / "log"))
+        if process.traced:
+            env["MINROS_TRACE"] = str(self.folder / f"{process.name}.jsonl")
         return env
 
     def _start(self, process: Process, facts: Dict[str, Any]) -> None:
@@ -254,16 +276,19 @@ class Runner:
     def _ready(self, process: Process, facts: Dict[str, Any]) -> bool:
         if process.ready[:1] == ("master",):
             port = facts["port_b"] if process.master == "b" else facts["port"]
-            proxy = ServerProxy(f"http://127.0.0.1:{port}/", timeout=2.0)
+            master = MasterClient(f"http://127.0.0.1:{port}/", "/minros_learn", timeout=2.0)
             try:
-                return proxy.getPid("/minros_learn")[0] == 1
-            except (OSError, xmlrpc.client.Error):
+                master.get_pid()
+                return True
+            except (OSError, RemoteError):  # not up yet (MasterIOError is an OSError)
                 return False
             finally:
-                proxy.close()
+                master.close()
         if len(process.ready) != 2:
             return True
         method, name = process.ready
+        if not process.traced:
+            return self._registered(process, facts, method, name)
         for ev in _events(self.folder / f"{process.name}.jsonl"):
             args = ev.get("args") or []
             reply = ev.get("reply")
@@ -271,6 +296,25 @@ class Runner:
                     and args[1] == name and isinstance(reply, list) and reply[:1] == [1]):
                 return True
         return False
+
+    def _registered(self, process: Process, facts: Dict[str, Any], method: str,
+                    name: str) -> bool:
+        """Whether the master lists ``process`` (untraced: by its node name) as ``method``
+        made it: a publisher, subscriber or provider of ``name``."""
+        column = {"registerPublisher": 0, "registerSubscriber": 1, "registerService": 2}
+        if method not in column or not process.node:
+            raise LearnError(f"{process.name} is not traced: its readiness needs its node name "
+                             "and a register* call")
+        port = facts["port_b"] if process.master == "b" else facts["port"]
+        master = MasterClient(f"http://127.0.0.1:{port}/", "/minros_learn", timeout=2.0)
+        try:
+            state = master.get_system_state()
+        except (OSError, RemoteError):
+            return False
+        finally:
+            master.close()
+        return any(entry[0] == name and process.node in entry[1]
+                   for entry in state[column[method]])
 
     def _node_uri(self, name: str) -> str:
         for ev in _events(self.folder / f"{name}.jsonl"):
@@ -284,16 +328,37 @@ class Runner:
         """Until ``stop`` is set or ``limit`` seconds have passed, saying once when a process
         ends (the learner may end one on purpose: exercise 10 kills the master)."""
         deadline = time.monotonic() + limit
+        sized = time.monotonic()
         while not stop.wait(poll):
-            if time.monotonic() > deadline:
+            now = time.monotonic()
+            if now > deadline:
                 self.say(f"minros learn: stopping after {limit / 60:g} minutes (an exercise "
                          "takes five; start it again with the same command)")
                 return
+            if now - sized >= SIZE_EVERY:
+                sized = now
+                too_big = self.too_big()
+                if too_big:
+                    self.say(f"minros learn: stopping: {too_big}")
+                    return
             for name, proc in self.procs.items():
                 if name not in self.reported and proc.poll() is not None:
                     self.reported.add(name)
                     self.say(f"minros learn: {name} (pid {proc.pid}) ended, status "
                              f"{proc.returncode}")
+
+    def too_big(self, limit: int = TRACE_LIMIT) -> str:
+        """Why the exercise must stop for the size of its traces ("" while it need not)."""
+        size = 0
+        for path in self.folder.glob("*.jsonl"):
+            try:
+                size += path.stat().st_size
+            except OSError:
+                continue
+        if size <= limit:
+            return ""
+        return (f"its traces in {self.folder} passed {limit >> 20} MB (start it again with the "
+                "same command)")
 
     def stop(self) -> None:
         """Stop every process this runner started (SIGINT, then SIGTERM, then SIGKILL, each

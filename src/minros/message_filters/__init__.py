@@ -35,7 +35,7 @@ def _stamp_of(msg: Any, allow_headerless: bool) -> Any:
 
 
 def _is_wallclock() -> bool:
-    from rospy import rostime  # rospy's public clock API: is simulated time (/clock) in use?
+    from minros.client import rostime  # is simulated time (/clock) in use?
 
     return rostime.is_wallclock()
 

@@ -6,8 +6,9 @@
 
 Message classes honour genpy's contract (``__slots__``, ``_type``, ``_md5sum``, ``_full_text``,
 ``_has_header``, ``_slot_types``, constructors, ``serialize``/``deserialize``, YAML ``str()``)
-and produce genpy's bytes. Importing this package installs the import hook that makes
-``<pkg>.msg``/``<pkg>.srv`` of any package on ROS_PACKAGE_PATH importable without a build.
+and produce genpy's bytes. :func:`install_import_hook` makes ``<pkg>.msg``/``<pkg>.srv`` of any
+package on ROS_PACKAGE_PATH importable without a build; ``import rospy`` and ``init_node`` call
+it (importing this package does not).
 """
 
 from __future__ import annotations
@@ -51,6 +52,3 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list:
     return sorted(set(globals()) | set(__all__))
-
-
-install_import_hook()

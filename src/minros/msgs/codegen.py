@@ -339,8 +339,8 @@ class _DeserializerGen(_Writer):
                         self.emit(ind, f"{var} = {target} = _new({cls})")
                     self.tval(ind, var, bt)
                 elif bt == "string":
-                    n = self.length(ind)
-                    self.string_body(ind, target, n, fpath)
+                    length = self.length(ind)
+                    self.string_body(ind, target, length, fpath)
                 else:
                     var = self.tmp("_m")
                     cls = dep_name(bt)
@@ -498,7 +498,7 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
     """
     name = spec.short_name
     structs: Dict[str, str] = {}
-    deps = []
+    deps: List[str] = []
     for f in spec.fields:
         if not f.is_builtin:
             _collect_deps(f.base_type, get_spec, deps)

@@ -13,7 +13,7 @@ and genmsg's exceptions.
 from __future__ import annotations
 
 import os
-from typing import Any, Dict, List, Mapping, Sequence, Tuple
+from typing import Any, Dict, List, Mapping, Sequence, Tuple, overload
 
 from minros.names import package_resource_name
 
@@ -74,6 +74,12 @@ class MsgNotFound(Exception):
 
 # ---------------------------------------------------------------------------------------------
 # type names (genmsg.msgs)
+
+@overload
+def bare_msg_type(msg_type: str) -> str: ...
+@overload
+def bare_msg_type(msg_type: None) -> None: ...
+
 
 def bare_msg_type(msg_type: str | None) -> str | None:
     """``'std_msgs/String[]'`` -> ``'std_msgs/String'``."""

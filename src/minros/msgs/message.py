@@ -17,7 +17,7 @@ from .tval import Duration, Time, TVal
 
 __all__ = [
     "Message", "strify_message", "check_type", "DeserializationError", "SerializationError",
-    "struct_I", "isstring", "reader_for",
+    "struct_I", "isstring", "reader_for", "SERIALIZE_ERRORS",
 ]
 
 #: the uint32 of every length prefix (genpy.struct_I: genpy-generated modules use it)
@@ -60,8 +60,10 @@ _INT_WIDTHS = {
     "int64": (64, True), "char": (8, False), "uint8": (8, False), "uint16": (16, False),
     "uint32": (32, False), "uint64": (64, False),
 }
-_SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
-                     UnicodeError, IndexError, SerializationError)
+#: what a serializer raises for a field of the wrong type or range
+SERIALIZE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError,
+                    UnicodeError, IndexError, SerializationError)
+_SERIALIZE_ERRORS = SERIALIZE_ERRORS
 
 
 def _as_view(data: Any, zero_copy: bool) -> Any:
@@ -86,7 +88,7 @@ def _trailing(type_name: str, view: Any, end: int) -> DeserializationError:
         f"({end} of {len(view)} bytes used)")
 
 
-def reader_for(cls: type) -> Callable[[Any], Any]:
+def reader_for(cls: Any) -> Callable[[Any], Any]:
     """A function from serialized bytes to a new ``cls`` message: ``cls().deserialize(data)``,
     but for a generated class without first building default fields that the data replaces
     (a message with embedded messages reads 1.5-2x faster). Subscribers and bag readers
@@ -193,7 +195,7 @@ class Message:
                 end = self._deserialize_from(view, 0)
             except AttributeError:
                 # made without its constructor (cls.__new__): give it default fields first
-                self.__init__()
+                self.__class__.__init__(self)
                 end = self._deserialize_from(view, 0)
         except NotImplementedError:
             if type(self)._deserialize_from is not Message._deserialize_from:
@@ -221,7 +223,7 @@ class Message:
             try:
                 end = reader(self, view, 0)
             except AttributeError:
-                self.__init__()
+                self.__class__.__init__(self)
                 end = reader(self, view, 0)
         except struct.error:
             raise DeserializationError(f"{self._type}: message truncated") from None

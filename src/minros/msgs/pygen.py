@@ -22,7 +22,7 @@ import os
 import struct
 import sys
 import traceback
-from typing import Dict, Iterator, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple
 
 from minros.names import is_legal_resource_base_name
 
@@ -792,7 +792,8 @@ def compute_outfile_name(outdir: str, infile_name: str, ext: str) -> str:
 class Generator:
     """Writes one module per definition file of a package (genpy's MsgGenerator/SrvGenerator)."""
 
-    def __init__(self, what: str, ext: str, spec_loader_fn, generator_fn) -> None:
+    def __init__(self, what: str, ext: str, spec_loader_fn: Callable[..., Any],
+                 generator_fn: Callable[..., Any]) -> None:
         self.what = what
         self.ext = ext
         self.spec_loader_fn = spec_loader_fn

@@ -13,7 +13,7 @@ import linecache
 import os
 import threading
 from pathlib import Path
-from typing import Any, Dict, List, Tuple
+from typing import Any, Dict, List, Set, Tuple
 
 from .codegen import generate_source, numpy_class_name
 from .message import Message
@@ -298,7 +298,7 @@ class MsgContext:
                     queue.append(field.base_type)
         return None
 
-    def get_numpy_class(self, cls: type) -> type:
+    def get_numpy_class(self, cls: Any) -> type:
         """The ``numpy_msg`` variant of message class ``cls``."""
         found = self._numpy_classes.get(cls)
         if found is not None:
@@ -507,7 +507,7 @@ def list_types(package: str, kind: str = "msg") -> List[str]:
 def type_names_in(package_dir: Path, kind: str = "msg") -> List[str]:
     """Short names of the ``.msg`` (or ``.srv``) types of a package folder, sorted; for
     messages this includes the ones generated from ``action/*.action`` files."""
-    names = set()
+    names: Set[str] = set()
     suffix = "." + kind
     try:
         names.update(p[:-len(suffix)] for p in os.listdir(package_dir / kind) if p.endswith(suffix))

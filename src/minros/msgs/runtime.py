@@ -68,7 +68,7 @@ def _numpy_bytes(code: str, value: Any) -> memoryview:
             if array.size and (array.min() < info.min or array.max() > info.max):
                 raise ValueError(f"values outside the range of {target}")
     array = numpy.ascontiguousarray(array, dtype=target).reshape(-1)
-    return memoryview(array).cast("B")
+    return array.data.cast("B")
 
 
 def put_array(append: Callable[[Any], None], code: str, value: Any) -> None:
@@ -112,7 +112,7 @@ def _numpy_uint8(value: Any) -> memoryview:
         if array.size and (array.min() < 0 or array.max() > 255):
             raise ValueError("a uint8[] field holds values outside 0..255")
         array = array.astype(numpy.uint8)
-    return memoryview(numpy.ascontiguousarray(array).reshape(-1)).cast("B")
+    return numpy.ascontiguousarray(array).reshape(-1).data.cast("B")
 
 
 def unpack_array(code: str, count: int, view: memoryview, offset: int) -> tuple:

@@ -32,7 +32,7 @@ _INT_RANGES = {
 }
 
 
-def strategy_for(type_name: str, context: MsgContext | None = None, max_array: int = 3):
+def strategy_for(type_name: str, context: MsgContext | None = None, max_array: int = 3) -> Any:
     """A hypothesis strategy producing instances of message type ``type_name``."""
     from hypothesis import strategies as st
 
@@ -60,7 +60,8 @@ def strategy_for(type_name: str, context: MsgContext | None = None, max_array: i
         if base == "bool":
             return st.booleans()
         if base == "string":
-            return st.text(st.characters(blacklist_categories=("Cs",)), max_size=12)
+            surrogates: Any = ("Cs",)  # not UTF-8 encodable
+            return st.text(st.characters(blacklist_categories=surrogates), max_size=12)
         if base == "time":
             return st.builds(Time, st.integers(0, 2 ** 32 - 1), st.integers(0, 999999999))
         if base == "duration":
@@ -69,7 +70,7 @@ def strategy_for(type_name: str, context: MsgContext | None = None, max_array: i
 
     def message_strategy(name: str):
         if name not in cache:
-            cls = ctx.get_class(name)
+            cls: Any = ctx.get_class(name)
             spec = ctx.get_spec(name)
             fields = {attr: field_strategy(t) for attr, t in zip(cls.__slots__, spec.types)}
             cache[name] = st.builds(cls, **fields)
@@ -217,6 +218,7 @@ class ReferenceProcess:
             [python, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL, env=env, text=True, bufsize=1)
         self._selector = selectors.DefaultSelector()
+        assert self.proc.stdout is not None
         self._selector.register(self.proc.stdout, selectors.EVENT_READ)
 
     def request(self, **req: Any) -> Dict[str, Any]:

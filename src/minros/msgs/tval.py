@@ -202,23 +202,23 @@ class Duration(TVal):
 
     def __mul__(self, val: object):
         if isinstance(val, numbers.Integral):
-            return self.__class__(self.secs * val, self.nsecs * val)
+            return self.__class__(self.secs * int(val), self.nsecs * int(val))
         if isinstance(val, numbers.Real):
-            return self.__class__.from_sec(self.to_sec() * val)
+            return self.__class__.from_sec(self.to_sec() * float(val))
         return NotImplemented
 
     __rmul__ = __mul__
 
     def __floordiv__(self, val: object):
         if isinstance(val, numbers.Real):
-            return self.__class__.from_sec(self.to_sec() // val)
+            return self.__class__.from_sec(self.to_sec() // float(val))
         if isinstance(val, Duration):
             return int(self.to_sec() // val.to_sec())
         return NotImplemented
 
     def __truediv__(self, val: object):
         if isinstance(val, numbers.Real):
-            return self.__class__.from_sec(self.to_sec() / val)
+            return self.__class__.from_sec(self.to_sec() / float(val))
         if isinstance(val, Duration):
             return self.to_sec() / val.to_sec()
         return NotImplemented
@@ -248,4 +248,4 @@ class Duration(TVal):
 # genpy's Time and Duration list their fields in ``__slots__`` and code written for genpy
 # iterates them (YAML/JSON converters); here the slots live on TVal, so the subclasses name
 # them as a plain class attribute after creation (it no longer affects the layout).
-Time.__slots__ = Duration.__slots__ = ["secs", "nsecs"]  # type: ignore[misc]
+Time.__slots__ = Duration.__slots__ = ["secs", "nsecs"]  # type: ignore[assignment]

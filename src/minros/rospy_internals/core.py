@@ -18,7 +18,7 @@ import threading
 import types
 import warnings
 import xmlrpc.client
-from typing import Any, Callable, Dict, List, Optional
+from typing import Any, Callable, Dict, List, Mapping, Optional
 from urllib.parse import urlparse
 
 from minros import node as _node
@@ -98,10 +98,9 @@ class NullHandler(logging.Handler):
         pass
 
 
-def get_ros_root(required: bool = False, env: Optional[Dict[str, str]] = None) -> Optional[str]:
+def get_ros_root(required: bool = False, env: Optional[Mapping[str, str]] = None) -> Optional[str]:
     """ROS_ROOT (normalised), None when unset; ROSException then if ``required``."""
-    env = os.environ if env is None else env
-    root = env.get("ROS_ROOT")
+    root = (os.environ if env is None else env).get("ROS_ROOT")
     root = os.path.normpath(root) if root else None
     if required and not root:
         raise ROSException("ROS_ROOT is not set")
@@ -144,8 +143,8 @@ def is_initialized() -> bool:
 def set_initialized(initialized: bool) -> None:
     """Mark the node ready (rospy: names of new topics then resolve against the node)."""
     me = _node.default_node()
-    me.initialized = initialized
-    me._named = initialized or me._named
+    me.lifecycle.initialized = initialized
+    me.names.named = initialized or me.names.named
 
 
 # ---------------------------------------------------------------------------------------------
@@ -265,8 +264,10 @@ def _reopen() -> None:
         return
     fresh = _node.Node()
     # what rospy keeps in other globals than the shutdown flag survives, as there
-    fresh.caller_id, fresh.initialized, fresh._named = old.caller_id, old.initialized, old._named
-    fresh.argv_mappings, fresh._resolved_mappings = old.argv_mappings, old._resolved_mappings
+    fresh.names.caller_id, fresh.names.named = old.names.caller_id, old.names.named
+    fresh.names.argv_mappings = old.names.argv_mappings
+    fresh.names.resolved_mappings = old.names.resolved_mappings
+    fresh.lifecycle.initialized = old.lifecycle.initialized
     _node._default = fresh
 
 
@@ -292,7 +293,9 @@ class _LockedServerProxy(xmlrpc.client.ServerProxy):
 
     def _ServerProxy__request(self, methodname: str, params: Any) -> Any:  # noqa: N802
         with self._lock:
-            return xmlrpc.client.ServerProxy._ServerProxy__request(self, methodname, params)
+            # the name-mangled private method typeshed does not list
+            return xmlrpc.client.ServerProxy._ServerProxy__request(  # type: ignore[attr-defined]
+                self, methodname, params)
 
 
 class _TimeoutTransport(xmlrpc.client.Transport):

@@ -8,10 +8,9 @@ import struct
 import traceback
 from typing import Any, List, Optional
 
-from minros.client.topics import AnyMsg, args_kwds_to_message
+from minros.client.msg import AnyMsg, args_kwds_to_message, stamp_header
 from minros.exceptions import DeserializationError, ROSSerializationException
 from minros.msgs.message import reader_for
-from minros.wire import tcpros
 
 __all__ = ["AnyMsg", "args_kwds_to_message", "deserialize_messages", "serialize_message"]
 
@@ -24,7 +23,7 @@ def serialize_message(b: Any, seq: int, msg: Any) -> None:
     message with a Header gets ``seq`` (and frame_id "0" for None), as every rospy send does."""
     start = b.tell()
     b.seek(start + 4)  # the length, once known
-    tcpros.stamp_header(msg, seq)
+    stamp_header(msg, seq)
     try:
         msg.serialize(b)
     except struct.error as exc:

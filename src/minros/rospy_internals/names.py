@@ -38,13 +38,13 @@ from minros.wire.rosapi import (  # noqa: F401
 
 def reload_mappings(argv: Any) -> None:
     """Read the remapping table again from ``argv``."""
-    _node.default_node().argv_mappings = load_mappings(argv)
+    _node.default_node().names.argv_mappings = load_mappings(argv)
 
 
 def initialize_mappings(node_name: str) -> None:
     """Resolve the remappings for node ``node_name``."""
-    me = _node.default_node()
-    me._resolved_mappings = _names.resolve_mappings(me.argv_mappings, node_name)
+    names = _node.default_node().names
+    names.resolved_mappings = _names.resolve_mappings(names.argv_mappings, node_name)
 
 
 def resolve_name_without_node_name(name: str) -> str:
@@ -54,12 +54,12 @@ def resolve_name_without_node_name(name: str) -> str:
 
 def get_mappings() -> Dict[str, str]:
     """The command line's remappings, unresolved."""
-    return _node.default_node().argv_mappings
+    return _node.default_node().names.argv_mappings
 
 
 def get_resolved_mappings() -> Dict[str, str]:
     """The remappings resolved for the node (after init_node)."""
-    return _node.default_node()._resolved_mappings
+    return _node.default_node().names.resolved_mappings
 
 
 def resolve_name(name: str, caller_id: Optional[str] = None) -> str:
@@ -103,7 +103,7 @@ get_caller_id = get_name
 
 def _set_caller_id(caller_id: str) -> None:
     """Name the node (rospy's internal API; init_node does it for a real node)."""
-    _node.default_node().caller_id = caller_id
+    _node.default_node().names.caller_id = caller_id
 
 
 class _NamesModule(types.ModuleType):
@@ -113,7 +113,7 @@ class _NamesModule(types.ModuleType):
 
     @_mappings.setter
     def _mappings(self, value: Dict[str, str]) -> None:
-        _node.default_node().argv_mappings = value
+        _node.default_node().names.argv_mappings = value
 
     @property
     def _resolved_mappings(self) -> Dict[str, str]:
@@ -121,7 +121,7 @@ class _NamesModule(types.ModuleType):
 
     @_resolved_mappings.setter
     def _resolved_mappings(self, value: Dict[str, str]) -> None:
-        _node.default_node()._resolved_mappings = value
+        _node.default_node().names.resolved_mappings = value
 
     @property
     def _caller_id(self) -> str:

@@ -13,13 +13,14 @@ from __future__ import annotations
 import logging
 import threading
 import traceback
-import xmlrpc.client
-from typing import Any, Dict, List, Optional, Tuple
+from functools import partial
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from minros import node as _node
 from minros.client import topics as _topics
 from minros.exceptions import ServiceException
-from minros.wire.xmlrpc import ServerProxy
+from minros.wire.masterapi import MasterClient, RemoteError
+from minros.wire.rosapi import unwrap
 
 #: replaced by callers (rospy's tests stub it); looked up at each use
 is_shutdown = _node.is_shutdown
@@ -109,14 +110,16 @@ class TopicManager:
 
     def acquire_impl(self, reg_type: str, resolved_name: str, data_class: Any) -> Any:
         """The topic's publication or subscription, made if needed (reference counted)."""
-        if reg_type not in (Registration.PUB, Registration.SUB):
-            raise TypeError(f"invalid reg_type: {reg_type}")
-        return _topics._acquire(reg_type, resolved_name, data_class)
+        if reg_type == Registration.PUB:
+            return _topics.acquire_publication(resolved_name, data_class)
+        if reg_type == Registration.SUB:
+            return _topics.acquire_subscription(resolved_name, data_class)
+        raise TypeError(f"invalid reg_type: {reg_type}")
 
     def release_impl(self, reg_type: str, resolved_name: str) -> None:
         impl = self.get_impl(reg_type, resolved_name)
         if impl is not None:
-            _topics._release(reg_type, impl)
+            _topics.release(impl)
 
     def get_impl(self, reg_type: str, resolved_name: str) -> Any:
         impl = self._registry(reg_type).get(resolved_name)
@@ -151,12 +154,12 @@ class TopicManager:
         """Close every publication and subscription (the node's shutdown does it too)."""
         self.closed = True
         me = _node.default_node()
-        for impl in list(me.publications.values()):
-            impl.close()
-            me.remove_publication(impl)
-        for impl in list(me.subscriptions.values()):
-            impl.close()
-            me.remove_subscription(impl)
+        for pub in list(me.publications.values()):
+            pub.close()
+            me.remove_publication(pub)
+        for sub in list(me.subscriptions.values()):
+            sub.close()
+            me.remove_subscription(sub)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -216,11 +219,12 @@ class ServiceManager:
 
     def unregister(self, resolved_service_name: str, service: Any) -> None:
         """Unregister ``service`` (nothing when another service has the name)."""
+        uri = service.uri
         with self.lock:
             if self.map.get(resolved_service_name) is not service:
                 return
             del self.map[resolved_service_name]
-        get_registration_listeners().notify_removed(resolved_service_name, service.uri, Registration.SRV)
+        get_registration_listeners().notify_removed(resolved_service_name, uri, Registration.SRV)
 
     def get_service(self, resolved_service_name: str) -> Any:
         with self.lock:
@@ -234,7 +238,7 @@ class NodeServiceManager(ServiceManager):
     def __init__(self) -> None:
         super().__init__({})
 
-    @property  # type: ignore[override]
+    @property
     def map(self) -> Dict[str, Any]:
         return {name: _service_of(h) for name, h in _node.default_node().services.items()}
 
@@ -243,7 +247,7 @@ class NodeServiceManager(ServiceManager):
         pass  # the node's registry is the map
 
     def get_services(self) -> List[Tuple[str, str]]:
-        return [(name, getattr(service, "uri", None)) for name, service in self.map.items()]
+        return [(name, getattr(service, "uri", None) or "") for name, service in self.map.items()]
 
     def unregister_all(self) -> None:
         for name in list(_node.default_node().services):
@@ -285,17 +289,16 @@ def set_service_manager(sm: Any) -> None:
 # ---------------------------------------------------------------------------------------------
 # the registration manager
 
-def _proxy(uri: Optional[str]) -> Optional[ServerProxy]:
-    try:
-        return ServerProxy(uri) if uri else None
-    except ValueError:
-        return None
+def _master(uri: Optional[str]) -> Optional[MasterClient]:
+    """The master at ``uri`` as this node (None without a URI)."""
+    return MasterClient(uri, _node.get_caller_id) if uri else None
 
 
 class RegManager(RegistrationListener):
     """Keeps the master told of the managers' registrations and connects subscriptions to
-    the publishers the master names (rospy's registration manager; a minros node does this
-    for itself, so this one serves code that drives rospy's machinery directly)."""
+    the publishers the master names (rospy's registration manager; a minros node's own is
+    :class:`minros.node.registration.Registration`, so this one serves code that drives
+    rospy's machinery directly). It calls the master through the one master client."""
 
     def __init__(self, handler: Any) -> None:
         self.logger = logging.getLogger("rospy.registration")
@@ -306,6 +309,14 @@ class RegManager(RegistrationListener):
         self.cond = threading.Condition()
         self.registered = False
 
+    def _refused(self, what: str, name: str, call: Callable[[], Any]) -> Any:
+        """``call()``'s value; None when the master refused it (logged, as rospy logs it)."""
+        try:
+            return call()
+        except RemoteError as exc:
+            self.logger.error("master refused to register %s [%s]: %s", what, name, exc)
+            return None
+
     def start(self, uri: Optional[str], master_uri: Optional[str]) -> None:
         """Register everything with the master at ``master_uri`` (until it answers or the node
         shuts down), then :meth:`run`. Nothing to do without a master, or if it is us."""
@@ -313,20 +324,24 @@ class RegManager(RegistrationListener):
         self.master_uri, self.uri = master_uri, uri
         if not master_uri or master_uri == uri:
             return
-        master = _proxy(master_uri)
-        caller_id = _node.get_caller_id()
+        master = _master(master_uri)
+        assert master is not None
+        node_uri = uri or ""
         first = True
         while not self.registered and not is_shutdown():
             try:
                 tm, sm = get_topic_manager(), get_service_manager()
                 for name, data_type in tm.get_publications():
-                    master.registerPublisher(caller_id, name, data_type, uri)
+                    self._refused("pub", name, partial(master.register_publisher, name,
+                                                       data_type, node_uri))
                 for name, data_type in tm.get_subscriptions():
-                    code, _msg, val = master.registerSubscriber(caller_id, name, data_type, uri)
-                    if code == 1:
-                        self.publisher_update(name, val)
+                    publishers = self._refused("sub", name, partial(
+                        master.register_subscriber, name, data_type, node_uri))
+                    if publishers is not None:
+                        self.publisher_update(name, publishers)
                 for name, service_uri in sm.get_services():
-                    master.registerService(caller_id, name, service_uri, uri)
+                    self._refused("srv", name, partial(master.register_service, name,
+                                                       service_uri, node_uri))
                 self.registered = True
                 get_registration_listeners().add_listener(self)
             except Exception:
@@ -357,10 +372,10 @@ class RegManager(RegistrationListener):
 
     def _connect_topic_thread(self, topic: str, uri: str) -> None:
         try:
-            code, msg, _ = self.handler._connect_topic(topic, uri)
-            if code != 1:
-                self.logger.debug("Unable to connect subscriber to publisher [%s] for topic "
-                                  "[%s]: %s", uri, topic, msg)
+            unwrap(self.handler._connect_topic(topic, uri))  # rospy's slave-side triplet
+        except RemoteError as exc:
+            self.logger.debug("Unable to connect subscriber to publisher [%s] for topic "
+                              "[%s]: %s", uri, topic, exc)
         except Exception:
             if not is_shutdown():
                 self.logger.debug("Unable to connect to publisher [%s] for topic [%s]: %s",
@@ -370,62 +385,73 @@ class RegManager(RegistrationListener):
         """Unregister everything from the master, in one multicall."""
         with self.cond:
             self.cond.notify_all()
-        master = _proxy(self.master_uri)
+        master = _master(self.master_uri)
         if master is None:
             return
-        caller_id = _node.get_caller_id()
+        caller_id = master.caller_id
         get_registration_listeners().clear()
         tm, sm = get_topic_manager(), get_service_manager()
+        calls = [{"methodName": "unregisterSubscriber", "params": [caller_id, name, self.uri]}
+                 for name, _ in tm.get_subscriptions()]
+        calls += [{"methodName": "unregisterPublisher", "params": [caller_id, name, self.uri]}
+                  for name, _ in tm.get_publications()]
+        calls += [{"methodName": "unregisterService", "params": [caller_id, name, service_uri]}
+                  for name, service_uri in sm.get_services()]
+        if not calls:
+            return
         try:
-            multi = xmlrpc.client.MultiCall(master)
-            for name, _ in tm.get_subscriptions():
-                multi.unregisterSubscriber(caller_id, name, self.uri)
-            for name, _ in tm.get_publications():
-                multi.unregisterPublisher(caller_id, name, self.uri)
-            for name, service_uri in sm.get_services():
-                multi.unregisterService(caller_id, name, service_uri)
-            multi()
+            master.multicall(calls)
         except Exception as exc:
             self.logger.warning("cannot unregister with master: %s", exc)
+        finally:
+            master.close()
 
     def reg_removed(self, resolved_name: str, data_type_or_uri: str, reg_type: str) -> None:
-        master = _proxy(self.master_uri)
+        master = _master(self.master_uri)
         if master is None:
             self.logger.error("Registrar: master_uri is not set yet, cannot inform master of "
                               "deregistration")
             return
-        caller_id = _node.get_caller_id()
+        uri = self.uri or ""
         try:
             if reg_type == Registration.PUB:
-                master.unregisterPublisher(caller_id, resolved_name, self.uri)
+                master.unregister_publisher(resolved_name, uri)
             elif reg_type == Registration.SUB:
-                master.unregisterSubscriber(caller_id, resolved_name, self.uri)
+                master.unregister_subscriber(resolved_name, uri)
             elif reg_type == Registration.SRV:
-                master.unregisterService(caller_id, resolved_name, data_type_or_uri)
+                master.unregister_service(resolved_name, data_type_or_uri)
         except Exception:
             self.logger.warning("unable to communicate with ROS Master, registrations are now "
                                 "out of sync")
+        finally:
+            master.close()
 
     def reg_added(self, resolved_name: str, data_type_or_uri: str, reg_type: str) -> None:
-        master = _proxy(self.master_uri)
+        master = _master(self.master_uri)
         if master is None:
             self.logger.error("Registrar: master_uri is not set yet, cannot inform master of "
                               "registration")
             return
-        args = (_node.get_caller_id(), resolved_name, data_type_or_uri, self.uri)
-        while not is_shutdown():
-            try:
-                if reg_type == Registration.PUB:
-                    master.registerPublisher(*args)
-                elif reg_type == Registration.SUB:
-                    code, _msg, val = master.registerSubscriber(*args)
-                    if code == 1:
-                        self.publisher_update(resolved_name, val)
-                elif reg_type == Registration.SRV:
-                    master.registerService(*args)
-                return
-            except Exception:
-                _node.wait_for_shutdown(0.2)
+        uri = self.uri or ""
+        try:
+            while not is_shutdown():
+                try:
+                    if reg_type == Registration.PUB:
+                        self._refused("pub", resolved_name, lambda: master.register_publisher(
+                            resolved_name, data_type_or_uri, uri))
+                    elif reg_type == Registration.SUB:
+                        publishers = self._refused("sub", resolved_name, lambda: master.register_subscriber(
+                            resolved_name, data_type_or_uri, uri))
+                        if publishers is not None:
+                            self.publisher_update(resolved_name, publishers)
+                    elif reg_type == Registration.SRV:
+                        self._refused("srv", resolved_name, lambda: master.register_service(
+                            resolved_name, data_type_or_uri, uri))
+                    return
+                except Exception:  # the master is unreachable: try again
+                    _node.wait_for_shutdown(0.2)
+        finally:
+            master.close()
 
     def publisher_update(self, resolved_name: str, uris: List[str]) -> None:
         """Queue a publisher list for :meth:`run`."""

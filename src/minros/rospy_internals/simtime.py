@@ -7,6 +7,7 @@ from typing import Any
 
 from minros import node as _node
 from minros.client import rostime as _rostime
+from minros.wire.masterapi import RemoteError
 
 _USE_SIM_TIME = "/use_sim_time"
 
@@ -14,10 +15,9 @@ _USE_SIM_TIME = "/use_sim_time"
 def _is_use_simtime() -> bool:
     """Whether the parameter server says /use_sim_time (False when it cannot be asked)."""
     try:
-        code, _msg, value = _node.master_call("getParam", _USE_SIM_TIME)
-    except Exception:
+        return bool(_node.master().get_param(_USE_SIM_TIME))
+    except (RemoteError, OSError):  # not set, or no master to ask
         return False
-    return code == 1 and bool(value)
 
 
 def _set_rostime_clock_wrapper(time_msg: Any) -> None:

@@ -72,11 +72,8 @@ class TCPServer:
         self.addr: Optional[str] = None
         self.is_shutdown = False
         self.inbound_handler = inbound_handler
-        try:
-            self.server_sock = self._create_server_sock()
-        except Exception:
-            self.server_sock = None
-            raise
+        self.server_sock: Optional[socket.socket] = None
+        self.server_sock = self._create_server_sock()
 
     def _create_server_sock(self) -> socket.socket:
         ipv6 = rosenv.use_ipv6()
@@ -93,6 +90,8 @@ class TCPServer:
     def run(self) -> None:
         while not self.is_shutdown:
             try:
+                if self.server_sock is None:
+                    break
                 client, addr = self.server_sock.accept()
             except OSError:
                 if self.is_shutdown:
@@ -200,14 +199,15 @@ class TCPROSTransport(Transport):
         super().__init__(protocol.direction, name=name)
         if not name:
             raise TransportInitError("Unable to initialize transport: name is not set")
-        self.protocol: Optional[TCPROSTransportProtocol] = protocol
+        # rospy's name for its protocol object (the seam's protocol name is transport_type)
+        self.protocol: Optional[TCPROSTransportProtocol] = protocol  # type: ignore[assignment]
         self.socket: Optional[socket.socket] = None
         self.endpoint_id = "unknown"
         self.callerid_pub = "unknown"
         self.dest_address: Optional[Tuple[str, int]] = None  # for reconnection
         self.read_buff: Optional[io.BytesIO] = io.BytesIO()
         self.write_buff: Optional[io.BytesIO] = io.BytesIO()
-        self.header = header
+        self.header = header  # type: ignore[assignment]  # rospy's: None until one is read
         self.is_latched = False
         self.latch: Any = None
         self._fileno: Optional[int] = None
@@ -327,6 +327,8 @@ class TCPROSTransport(Transport):
         if sock is None:
             raise TransportException("connection not initialized")
         b, protocol = self.read_buff, self.protocol
+        if b is None or protocol is None:
+            raise TransportTerminated("connection closed")
         msg_queue: List[Any] = []
         try:
             sock.setblocking(True)

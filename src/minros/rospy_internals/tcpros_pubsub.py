@@ -1,6 +1,8 @@
 """rospy.impl.tcpros_pubsub: the TCPROS protocol of topics (header fields of each side) and
-rospy's TCPROS handler: inbound subscriber connections are checked and handed to the node's
-publication, outbound ones are made by the node's subscription."""
+rospy's TCPROS handler over the node's (:mod:`minros.transport.tcpros_pubsub`): what a publisher
+answers is the node's answer (``Node.answer_protocol``), an inbound subscriber connection
+checked here becomes a rospy TCPROSTransport among the publication's transports, and outbound
+connections are made by the node's subscription."""
 
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ from minros import node as _node
 from minros.names import TOPIC_ANYTYPE
 
 from . import registration
-from .tcpros_base import (
+from .tcpros_base import (  # noqa: F401 - rospy.impl.tcpros_pubsub's namespace has them
     DEFAULT_BUFF_SIZE,
     TCPROS,
     TCPROSTransport,
@@ -99,8 +101,10 @@ class TCPROSHandler(ProtocolHandler):
         """The TCPROS parameters subscribers connect with: ``[TCPROS, host, port]``."""
         if protocol[0] != TCPROS:
             return 0, f"Internal error: protocol does not match TCPROS: {protocol}", []
-        addr, port = get_tcpros_server_address()
-        return 1, f"ready on {addr}:{port}", [TCPROS, addr, port]
+        answer = _node.default_node().answer_protocol(resolved_name, protocol)
+        if answer is None:
+            return 0, f"Internal error: the node does not speak {TCPROS}", []
+        return 1, f"ready on {answer[1]}:{answer[2]}", answer
 
     def topic_connection_handler(self, sock: socket.socket, client_addr: Any,
                                  header: Dict[str, str]) -> Optional[str]:
@@ -137,5 +141,14 @@ class TCPROSHandler(ProtocolHandler):
         transport.set_socket(sock, header["callerid"])
         transport.remote_endpoint = client_addr
         transport.write_header()
+        # rospy's rule: a subscriber's new connection replaces its old one, and a transport
+        # that closes leaves the publication
+        for old in [c for c in topic.connections if c.endpoint_id == transport.endpoint_id]:
+            topic.remove_connection(old)
+            try:
+                old.close()
+            except Exception:  # a connection leaving must not stop the new one
+                pass
+        transport.set_cleanup_callback(topic.remove_connection)
         topic.add_connection(transport)
         return None

@@ -9,7 +9,7 @@ import threading
 from typing import Any, Iterator, List
 
 from minros import node as _node
-from minros.client.topics import DEFAULT_BUFF_SIZE  # noqa: F401
+from minros.wire.tcpros import DEFAULT_BUFF_SIZE  # noqa: F401
 
 from .registration import TopicManager as _TopicManager  # noqa: F401
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Tuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 #: Occupancy at or above which the simulator treats a cell as a wall: map_saver's default
 #: ``--occ`` threshold, i.e. the cells map_saver would write black.
@@ -51,7 +52,7 @@ class GridMap:
 
     # -- coordinates: "cell units" are metres / resolution from the origin, along the grid axes
 
-    def to_cells(self, x, y):
+    def to_cells(self, x: ArrayLike, y: ArrayLike) -> Tuple[np.ndarray, np.ndarray]:
         """World (map frame) metres -> continuous cell coordinates (col, row); arrays allowed."""
         dx = np.asarray(x, dtype=float) - self.origin[0]
         dy = np.asarray(y, dtype=float) - self.origin[1]
@@ -59,14 +60,14 @@ class GridMap:
         gy = (-self._sin * dx + self._cos * dy) / self.resolution
         return gx, gy
 
-    def to_world(self, gx, gy):
+    def to_world(self, gx: ArrayLike, gy: ArrayLike) -> Tuple[np.ndarray, np.ndarray]:
         """Continuous cell coordinates -> world metres (a cell's centre is ``col + 0.5``)."""
         lx = np.asarray(gx, dtype=float) * self.resolution
         ly = np.asarray(gy, dtype=float) * self.resolution
         return (self.origin[0] + self._cos * lx - self._sin * ly,
                 self.origin[1] + self._sin * lx + self._cos * ly)
 
-    def yaw_to_grid(self, yaw):
+    def yaw_to_grid(self, yaw: ArrayLike) -> np.ndarray:
         """A heading in the map frame -> the same heading measured on the grid's axes."""
         return np.asarray(yaw, dtype=float) - self.origin[2]
 

@@ -147,7 +147,7 @@ def read_image(path: str) -> np.ndarray:
     return pixels
 
 
-def _quiet_imread(cv2, path: str):
+def _quiet_imread(cv2: Any, path: str) -> Any:
     """cv2.imread without OpenCV's own log lines on stderr (the MapError says it once)."""
     logging = getattr(getattr(cv2, "utils", None), "logging", None)
     if logging is None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from minros.sim.grid import GridMap
 
@@ -49,7 +50,7 @@ class RayCaster:
         # flat, so one take() per step indexes it
         self._dist = np.ascontiguousarray(dist, dtype=np.float64).ravel()
 
-    def cast(self, x, y, angles, max_range: float, max_steps: int = 100000) -> np.ndarray:
+    def cast(self, x: ArrayLike, y: ArrayLike, angles: ArrayLike, max_range: float, max_steps: int = 100000) -> np.ndarray:
         """Ranges (metres) of rays from (x[i], y[i]) at headings angles[i] (map frame),
         ``inf`` where no wall lies within ``max_range`` or the ray leaves the grid."""
         grid = self.grid
@@ -103,7 +104,7 @@ class RayCaster:
         return result
 
 
-def cast_discs(x, y, angles, centres: np.ndarray, radii: np.ndarray,
+def cast_discs(x: ArrayLike, y: ArrayLike, angles: ArrayLike, centres: np.ndarray, radii: np.ndarray,
                skip: np.ndarray | None = None) -> np.ndarray:
     """Distance along each ray (x[i], y[i], angles[i]) to the nearest of the discs
     ``centres[k]`` with ``radii[k]`` (``inf`` if none); ``skip[i]`` names a disc ray i ignores

@@ -12,6 +12,7 @@ import math
 from typing import Dict, Sequence, Tuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from minros.sim.world import World
 
@@ -44,7 +45,7 @@ class Renderer:
                          interpolation=cv2.INTER_NEAREST)
         self.background = cv2.cvtColor(big, cv2.COLOR_GRAY2BGR)
 
-    def pixel(self, x, y):
+    def pixel(self, x: ArrayLike, y: ArrayLike) -> Tuple[np.ndarray, np.ndarray]:
         """World metres -> picture pixel coordinates (floats; arrays allowed)."""
         gx, gy = self.world.grid.to_cells(x, y)
         return gx * self.scale, (self.world.grid.height - gy) * self.scale

@@ -43,7 +43,8 @@ def _fmt(values: Tuple[float, ...]) -> str:
 
 def urdf(name: str = "turtlebot3_burger_minros") -> str:
     """The URDF text (what ``/robot_description`` holds)."""
-    def visual(geometry: str, xyz=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0), material: str = "dark") -> str:
+    def visual(geometry: str, xyz: Tuple[float, float, float] = (0.0, 0.0, 0.0),
+               rpy: Tuple[float, float, float] = (0.0, 0.0, 0.0), material: str = "dark") -> str:
         origin = f'<origin xyz="{_fmt(xyz)}" rpy="{_fmt(rpy)}"/>'
         return (f"    <visual>{origin}<geometry>{geometry}</geometry>"
                 f'<material name="{material}"/></visual>\n'

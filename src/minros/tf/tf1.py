@@ -126,13 +126,13 @@ class Transformer:
             source_time, strip_leading_slash(fixed_frame)))
 
     def lookupTwist(self, tracking_frame: str, observation_frame: str, time: Any,  # noqa: N802
-                    averaging_interval: Any):
+                    averaging_interval: Any) -> Tuple[Any, Any]:
         return self.lookupTwistFull(tracking_frame, observation_frame, observation_frame,
                                     (0, 0, 0), tracking_frame, time, averaging_interval)
 
     def lookupTwistFull(self, tracking_frame: str, observation_frame: str, reference_frame: str,  # noqa: N802
                         ref_point: Any, reference_point_frame: str, time: Any,
-                        averaging_interval: Any):
+                        averaging_interval: Any) -> Tuple[Any, Any]:
         """(linear, angular) velocity of ``tracking_frame`` seen from ``observation_frame``,
         averaged over ``averaging_interval`` around ``time``, in ``reference_frame`` at the
         point ``ref_point`` of ``reference_point_frame``."""

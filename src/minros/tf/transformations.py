@@ -121,7 +121,8 @@ def translation_from_matrix(matrix: Any) -> numpy.ndarray:
     return numpy.array(matrix, dtype=numpy.float64)[:3, 3].copy()
 
 
-def vector_norm(data: Any, axis: Optional[int] = None, out: Optional[numpy.ndarray] = None):
+def vector_norm(data: Any, axis: Optional[int] = None,
+                out: Optional[numpy.ndarray] = None) -> Any:
     """Euclidean length of ``data`` (along ``axis``), into ``out`` when given."""
     data = numpy.array(data, dtype=numpy.float64)
     if out is None:
@@ -133,7 +134,8 @@ def vector_norm(data: Any, axis: Optional[int] = None, out: Optional[numpy.ndarr
     return None
 
 
-def unit_vector(data: Any, axis: Optional[int] = None, out: Optional[numpy.ndarray] = None):
+def unit_vector(data: Any, axis: Optional[int] = None,
+                out: Optional[numpy.ndarray] = None) -> Any:
     """``data`` divided by its length (along ``axis``); into ``out`` when given."""
     if out is None:
         data = numpy.array(data, dtype=numpy.float64)
@@ -321,7 +323,7 @@ def projection_matrix(point: Sequence[float], normal: Sequence[float],
     return m
 
 
-def projection_from_matrix(matrix: Any, pseudo: bool = False):
+def projection_from_matrix(matrix: Any, pseudo: bool = False) -> Tuple[Any, ...]:
     """(point, normal, direction, perspective, pseudo) for ``projection_matrix``."""
     m = numpy.array(matrix, dtype=numpy.float64)
     m33 = m[:3, :3]
@@ -392,7 +394,7 @@ def shear_matrix(angle: float, direction: Sequence[float], point: Sequence[float
     return m
 
 
-def shear_from_matrix(matrix: Any):
+def shear_from_matrix(matrix: Any) -> Tuple[Any, ...]:
     """(angle, direction, point, normal) of a shear matrix."""
     m = numpy.array(matrix, dtype=numpy.float64)
     # m33 - I = tan(angle) d n^T has rank one
@@ -411,7 +413,7 @@ def shear_from_matrix(matrix: Any):
 
 # ----------------------------------------------------------------------------- decomposition
 
-def decompose_matrix(matrix: Any):
+def decompose_matrix(matrix: Any) -> Tuple[Any, ...]:
     """(scale, shear, angles, translate, perspective) with
     matrix = perspective . translate . rotate('sxyz' angles) . shear . scale.
 
@@ -756,7 +758,7 @@ def arcball_constrain_to_axis(point: Sequence[float], axis: Sequence[float]) -> 
     return unit_vector([-a[1], a[0], 0.0])
 
 
-def arcball_nearest_axis(point: Sequence[float], axes: Sequence[Sequence[float]]):
+def arcball_nearest_axis(point: Sequence[float], axes: Sequence[Sequence[float]]) -> Any:
     """The axis whose constraint circle passes nearest ``point``."""
     p = numpy.array(point, dtype=numpy.float64)
     nearest, best = None, -1.0

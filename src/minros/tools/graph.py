@@ -24,6 +24,7 @@ import time
 from typing import Dict, Iterator, List, Optional, Set, Tuple
 
 from minros.tools.master import Master, MasterException, call_node
+from minros.wire.rosapi import RemoteError, unwrap
 
 logger = logging.getLogger("rosgraph.graph")
 
@@ -226,15 +227,16 @@ class Graph:
     def _node_refresh_businfo(self, node: str, uri: str, bad_node: bool = False) -> bool:
         """Ask ``node`` for its connections and update topics and edges."""
         try:
-            code, msg, bus_info = call_node(uri, "getBusInfo", _ROS_NAME,
-                                            timeout=0.2 if bad_node else 1.0)
+            answer = call_node(uri, "getBusInfo", _ROS_NAME, timeout=0.2 if bad_node else 1.0)
         except Exception as exc:  # noqa: BLE001 - any failure puts the node on the bad list
             self._mark_bad_node(node, str(exc))
             return False
         if bad_node:
             self._unmark_bad_node(node)
-        if code != 1:
-            logger.error("cannot get stats info from node [%s]: %s", node, msg)
+        try:
+            bus_info = unwrap(answer)
+        except RemoteError as exc:
+            logger.error("cannot get stats info from node [%s]: %s", node, exc)
             return False
         updated = False
         for info in bus_info:
@@ -267,7 +269,7 @@ class Graph:
 
     def _node_refresh(self, node: str, bad_node: bool = False) -> bool:
         uri = self._node_uri_refresh(node)
-        return bool(uri) and self._node_refresh_businfo(node, uri, bad_node)
+        return uri is not None and bool(uri) and self._node_refresh_businfo(node, uri, bad_node)
 
     def _due(self, node: str) -> bool:
         return time.time() > self.last_node_refresh.get(node, 0.0) + self.node_stale

@@ -1,8 +1,10 @@
-"""A master client for command-line tools (rosgraph.Master semantics, bounded timeouts).
+"""rosgraph.Master for the command-line tools: the one master client with rosgraph's face.
 
 ``Master(caller_id).getParam('/x')`` returns the value of a SUCCESS triplet, raises
 :class:`MasterError` for code -1, :class:`MasterFailure` for code 0, and
-:class:`MasterIOError` (an ``OSError``) when the master cannot be reached at all.
+:class:`MasterIOError` (an ``OSError``) when the master cannot be reached at all: it is
+:class:`minros.wire.masterapi.MasterClient` (typed methods, one error path) with rosgraph's
+camelCase calls and a bounded timeout, so no tool hangs on a dead master.
 """
 
 from __future__ import annotations
@@ -12,7 +14,20 @@ import xmlrpc.client
 from typing import Any, Dict, List, Tuple
 
 from minros import names, rosenv
+from minros.wire.masterapi import (
+    MasterClient,
+    MasterError,
+    MasterException,
+    MasterFailure,
+    MasterIOError,
+)
 from minros.wire.xmlrpc import ServerProxy
+
+__all__ = [
+    "Error", "Failure", "Master", "MasterError", "MasterException", "MasterFailure",
+    "MasterIOError", "QUIET_NAMES", "ROSMasterException", "call_node", "get_master_uri",
+    "is_online", "is_quiet",
+]
 
 DEFAULT_MASTER_URI = rosenv.DEFAULT_MASTER_URI
 #: seconds to wait for any single XML-RPC answer; a tool never hangs on a dead peer
@@ -27,22 +42,6 @@ QUIET_NAMES = ("/diag_agg", "/runtime_logger", "/pr2_dashboard", "/rviz", "/roso
 
 def is_quiet(name: str) -> bool:
     return any(q in name for q in QUIET_NAMES)
-
-
-class MasterException(Exception):
-    """Base of master call errors."""
-
-
-class MasterError(MasterException):
-    """The master answered code -1 (caller error: unknown name, unset parameter...)."""
-
-
-class MasterFailure(MasterException):
-    """The master answered code 0 (it tried and failed)."""
-
-
-class MasterIOError(OSError):
-    """The master could not be reached."""
 
 
 def get_master_uri(argv: List[str] | None = None) -> str:
@@ -70,20 +69,18 @@ Error = MasterError
 Failure = MasterFailure
 
 
-class Master:
-    """Calls master methods with ``caller_id`` prepended; results unwrapped as rosgraph does.
+class Master(MasterClient):
+    """rosgraph.Master: ``Master('/rostopic').getParam('/x')``, master methods with
+    ``caller_id`` prepended and the answer unwrapped. A relative caller id is put in the ROS
+    namespace; every call is bounded by ``timeout`` seconds."""
 
-    This is rosgraph.Master: ``Master('/rostopic').getParam('/x')``; a relative caller id is
-    put in the ROS namespace. Every call is bounded by ``timeout`` seconds.
-    """
+    _handle: Any = None
 
     def __init__(self, caller_id: str, master_uri: str | None = None,
                  timeout: float = TOOL_TIMEOUT) -> None:
         caller_id = names.make_caller_id(caller_id)
-        self.caller_id = caller_id[:-1] if caller_id.endswith("/") else caller_id
-        self.uri = master_uri or get_master_uri()
-        self.timeout = timeout
-        self._proxy: ServerProxy | None = None
+        super().__init__(master_uri or get_master_uri(),
+                         caller_id[:-1] if caller_id.endswith("/") else caller_id, timeout)
 
     @property
     def master_uri(self) -> str:
@@ -92,75 +89,46 @@ class Master:
     @property
     def handle(self) -> ServerProxy:
         """The XML-RPC proxy of the master (rosgraph's name; tests replace it by a mock)."""
-        return self._get_proxy()
+        return self._proxy()
 
     @handle.setter
     def handle(self, proxy: Any) -> None:
-        self._proxy = proxy
+        self._handle = proxy
 
     def is_online(self) -> bool:
         """Whether the master answers ``getPid``."""
         try:
-            self.getPid()
+            self.get_pid()
             return True
         except Exception:  # noqa: BLE001 - any failure means "not online", as in rosgraph
             return False
 
-    def _get_proxy(self) -> ServerProxy:
-        if self._proxy is None:
-            try:
-                self._proxy = ServerProxy(self.uri, timeout=self.timeout)
-            except ValueError:
-                raise MasterIOError(f"invalid ROS_MASTER_URI [{self.uri}]") from None
-        return self._proxy
-
-    def raw(self, method: str, *args: Any) -> list:
-        """The raw ``[code, msg, value]`` triplet."""
-        try:
-            return getattr(self._get_proxy(), method)(self.caller_id, *args)
-        except xmlrpc.client.Fault as exc:
-            raise MasterFailure(f"{method}: {exc.faultString}") from None
-        except (xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError) as exc:
-            raise MasterIOError(str(exc)) from exc  # a CallError's line is what tools print
-        except OSError as exc:
-            raise MasterIOError(str(exc)) from None
-
-    def call(self, method: str, *args: Any) -> Any:
-        result = self.raw(method, *args)
-        if not isinstance(result, (list, tuple)) or len(result) != 3:
-            raise MasterFailure(f"malformed result of {method}: {result!r}")
-        code, msg, value = result
-        if code == 1:
-            return value
-        if code == -1:
-            raise MasterError(str(msg))
-        raise MasterFailure(str(msg))
+    def _proxy(self) -> ServerProxy:
+        # a proxy set through ``handle`` (rosgraph's tests set a mock) answers every call
+        return self._handle if self._handle is not None else super()._proxy()
 
     def __getattr__(self, name: str) -> Any:
-        if name.startswith("_") or name in ("uri", "timeout", "caller_id"):
+        # rosgraph's API: any master method by its XML-RPC name
+        if name.startswith("_") or not name[:1].islower():
             raise AttributeError(name)
         return lambda *args: self.call(name, *args)
 
-    def close(self) -> None:
-        if self._proxy is not None:
-            self._proxy.close()
-            self._proxy = None
-
     # -- helpers used by several tools --------------------------------------------------------
     def system_state(self) -> Tuple[list, list, list]:
-        pubs, subs, srvs = self.call("getSystemState")
+        pubs, subs, srvs = self.get_system_state()
         return pubs, subs, srvs
 
-    def topic_types(self) -> List[List[str]]:
+    def topic_types(self) -> List[Tuple[str, str]]:
+        """getTopicTypes, or getPublishedTopics from a master without it."""
         try:
-            return self.call("getTopicTypes")
+            return self.get_topic_types()
         except MasterFailure:
-            return self.call("getPublishedTopics", "/")
+            return self.get_published_topics("/")
 
     def lookup_node_cached(self, cache: Dict[str, str | None], node: str) -> str | None:
         if node not in cache:
             try:
-                cache[node] = self.call("lookupNode", node)
+                cache[node] = self.lookup_node(node)
             except MasterException:
                 cache[node] = None
         return cache[node]

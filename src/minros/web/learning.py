@@ -26,15 +26,20 @@ and stops it. :class:`LearnSession` (one per page) adds the view's ops to the pa
 
 What a page can make the server run is bounded as the command line bounds it, and less: a
 page names an exercise by its number (and a variant the exercise has), nothing else, so only
-the exercises' own programs run (``python -m minros core`` and ``python -m
-minros.learn.actors ROLE`` with the catalog's arguments), in the folder the server chose
+the exercises' own programs run (``python -m minros core``, ``python -m
+minros.learn.actors ROLE`` and, for exercise 11 through Zenoh, ``python -m minros zenoh`` on
+loopback endpoints, all with the catalog's arguments), in the folder the server chose
 (``$MINROS_LEARN_DIR``, else ``$ROS_HOME/learn``). One exercise runs at a time per server; it
 stops when its page asks, when its page has been gone for :data:`OWNER_GRACE` seconds (a
-reload or a reconnection within that time keeps it), after ``minros learn``'s own limit
-(:data:`~minros.learn.session.RUN_LIMIT`), and when the server stops. Starting, stopping and
-checking are for pages of this machine only (:meth:`minros.web.origin.OriginPolicy.local_page`:
-no page let in only by ``--allow-origin`` starts programs here), besides the server's Host,
-Origin and token checks every request passes.
+reload or a reconnection within that time keeps it), after ``minros learn``'s own limits
+(:data:`~minros.learn.session.RUN_LIMIT`, and its traces' size,
+:data:`~minros.learn.session.TRACE_LIMIT`), and when the server stops. A page starts an
+exercise's default variant unless it names another (exercise 11's is Zenoh when the
+eclipse-zenoh package is installed, else the relay; the list says why a variant cannot
+start). Starting, stopping and checking are for pages of this machine only
+(:meth:`minros.web.origin.OriginPolicy.local_page`: no page let in only by
+``--allow-origin`` starts programs here), besides the server's Host, Origin and token checks
+every request passes.
 """
 
 from __future__ import annotations
@@ -47,7 +52,15 @@ from typing import Any, Callable, Dict, Hashable, List, Optional, Sequence
 
 import minros
 from minros import learn
-from minros.learn.session import RUN_LIMIT, STATE, LearnError, Runner, default_base, folder_for
+from minros.learn.session import (
+    RUN_LIMIT,
+    SIZE_EVERY,
+    STATE,
+    LearnError,
+    Runner,
+    default_base,
+    folder_for,
+)
 from minros.web.rosbridge import OpError, _check
 from minros.web.wiretrace import WireFeed, WireWatch
 
@@ -114,8 +127,10 @@ def exercise_json(ex: learn.Exercise, base: Path) -> Dict[str, Any]:
     preview = ex.task_text({"number": ex.number, "dir": str(folder),
                             "me": str(folder / "me.jsonl"), "python": "python3"})
     return {"number": ex.number, "slug": ex.slug, "title": ex.title, "minutes": ex.minutes,
-            "covers": ex.covers, "answer_form": ex.answer_form,
-            "variants": [v for v in ex.variants if v], "planned": dict(ex.planned),
+            "covers": ex.covers, "answer_form": ex.form(),
+            "variants": [v for v in ex.variants if v],
+            "planned": {v: f"{v}: {why}" for v, why in ex.unavailable().items()},
+            "variant": ex.default_variant,
             "processes": [p.name for p in ex.processes()], "folder": str(folder),
             "preview": preview}
 
@@ -124,16 +139,20 @@ class LearnHub:
     """The server's started exercise and the pages watching it (see the module doc).
 
     ``runner`` makes a :class:`~minros.learn.session.Runner` (tests give a fake), ``feed``
-    a :class:`~minros.web.wiretrace.WireFeed` for a folder."""
+    a :class:`~minros.web.wiretrace.WireFeed` for a folder; a run stops after ``limit``
+    seconds, or when its traces grow past the runner's bound (looked at every ``size_every``
+    seconds)."""
 
     def __init__(self, base: Optional[Path] = None, runner: Callable[..., Any] = Runner,
                  feed: Callable[[Sequence[str]], Any] = WireFeed, grace: float = OWNER_GRACE,
-                 limit: float = RUN_LIMIT, clock: Callable[[], float] = time.monotonic) -> None:
+                 limit: float = RUN_LIMIT, clock: Callable[[], float] = time.monotonic,
+                 size_every: float = SIZE_EVERY) -> None:
         self.base = Path(base) if base is not None else default_base()
         self.make_runner = runner
         self.make_feed = feed
         self.grace = grace
         self.limit = limit
+        self.size_every = size_every
         self.clock = clock
         self.run: Optional[LearnRun] = None
         self.lock = threading.Lock()
@@ -320,11 +339,17 @@ class LearnHub:
 
     def _watch(self, run: LearnRun) -> str:
         """Until the run must stop: why."""
+        sized = self.clock()
         while not run.stop.wait(TICK):
             now = self.clock()
             if now >= run.deadline:
                 return (f"stopped after {self.limit / 60:g} minutes (an exercise takes five; "
                         "start it again)")
+            if now - sized >= self.size_every:
+                sized = now
+                too_big = run.runner.too_big()
+                if too_big:
+                    return too_big
             with self.lock:
                 orphaned = run.orphaned
             if orphaned is not None and now - orphaned >= self.grace:

@@ -9,8 +9,10 @@ server 2,017 threads and 238 MB (a thread and a 64 KB receive buffer per connect
 waits on every publisher connection with a selector and hands each message's bytes to the
 topic's listener; a few workers (``minros-web-connect``) do what blocks, asking the publisher
 for the topic (``requestTopic``), connecting and exchanging connection headers, then pass the
-socket to that thread. The protocol is a subscriber's, from :mod:`minros.wire.tcpros` (header
-codec, handshake checks, framing); each subscription is a :class:`minros.node.Subscription` in
+socket to that thread. The protocol is a subscriber's TCPROS, from the transport layer's parts
+(:func:`minros.transport.tcpros_base.connect` and ``negotiate`` running a subscriber's
+:class:`minros.wire.handshake.Handshake`) and :mod:`minros.wire.tcpros`'s framing; each
+subscription is a :class:`minros.node.Subscription` in
 the node's registry, so the master's ``publisherUpdate`` and ``getBusStats``/``getBusInfo``
 reach it as they reach a Subscriber. A connection that fails or ends is tried again after
 0.5 s, doubling to 8 s, while the master still lists its publisher, as Subscriber does; a
@@ -34,7 +36,10 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import minros
-from minros.wire import sockets, tcpros, trace
+from minros.transport import tcpros_base
+from minros.wire import sockets, tcpros
+from minros.wire.handshake import Handshake, Rejected, Role
+from minros.wire.rosapi import RemoteError, unwrap
 from minros.wire.xmlrpc import ServerProxy
 
 #: the receive buffer of a connection: messages larger than this get a buffer of their own
@@ -88,30 +93,26 @@ class _Connection:
         sub = self.sub
         proxy = ServerProxy(self.pub_uri, timeout=REQUEST_TIMEOUT)
         try:
-            code, msg, params = proxy.requestTopic(sub.node.caller_id, sub.resolved_name,
-                                                   [[tcpros.TCPROS]])
+            params = unwrap(proxy.requestTopic(sub.node.caller_id, sub.resolved_name,
+                                               [[tcpros.TCPROS]]))
+        except RemoteError as exc:
+            raise _GiveUp(f"requestTopic: {exc}") from None
         finally:
             proxy.close()
-        if code != 1:
-            raise _GiveUp(f"requestTopic: {msg}")
         if (not isinstance(params, list) or len(params) != 3 or params[0] != tcpros.TCPROS
                 or not isinstance(params[1], str) or not isinstance(params[2], int)):
             raise _GiveUp(f"publisher returned invalid protocol choice: {params}")
-        sock = trace.watch(socket.create_connection((params[1], params[2]),
-                                                    timeout=CONNECT_TIMEOUT), "connect")
+        sock = tcpros_base.connect(params[1], params[2], timeout=CONNECT_TIMEOUT, nodelay=True)
         try:
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             cls = sub.data_class
-            sock.sendall(tcpros.encode_header({
+            handshake = Handshake(Role.SUBSCRIBER, {
                 "topic": sub.resolved_name, "message_definition": cls._full_text,
                 "tcp_nodelay": "1", "md5sum": cls._md5sum, "type": cls._type,
-                "callerid": sub.node.caller_id}))
-            header = sockets.read_header(sock)  # exactly the header: the messages follow
-            error = tcpros.subscriber_header_error(header, sub.resolved_name, cls._md5sum,
-                                                   cls._type)
-            if error is not None:
-                raise _GiveUp(error)
-            self.header = header
+                "callerid": sub.node.caller_id})
+            try:  # reads exactly the header: the messages follow
+                self.header = tcpros_base.negotiate(sock, handshake)
+            except Rejected as exc:  # refused, or not the topic we asked for
+                raise _GiveUp(str(exc)) from None
             self.local, self.remote = sock.getsockname(), sock.getpeername()
             self.fileno = sock.fileno()
             sock.setblocking(False)
@@ -136,7 +137,7 @@ class RawSubscription:
     """One topic the web node subscribes to: a :class:`minros.node.Subscription` whose
     connections the :class:`Receiver` serves; each message's bytes go to ``deliver``."""
 
-    def __init__(self, receiver: Receiver, resolved_name: str, data_class: type,
+    def __init__(self, receiver: Receiver, resolved_name: str, data_class: Any,
                  deliver: Deliver) -> None:
         self.receiver = receiver
         self.node = receiver.node
@@ -225,7 +226,7 @@ class Receiver:
 
     # -- the API -------------------------------------------------------------------------------
 
-    def subscribe(self, resolved_name: str, data_class: type, deliver: Deliver) -> RawSubscription:
+    def subscribe(self, resolved_name: str, data_class: Any, deliver: Deliver) -> RawSubscription:
         """Subscribe the node to ``resolved_name`` (registered with the master now);
         ValueError when the node has a subscription there already (a Subscriber of its own,
         such as /clock on simulated time: the caller uses one too, sharing it)."""

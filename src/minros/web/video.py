@@ -116,7 +116,7 @@ def _bgr(image: np.ndarray) -> np.ndarray:
 
 def image_to_bgr8(msg: Any) -> np.ndarray:
     """A displayable BGR8 image of a sensor_msgs/Image in any cv_bridge encoding."""
-    from cv_bridge import CvBridge, CvBridgeError
+    from minros.cv_bridge import CvBridge, CvBridgeError
 
     bridge = CvBridge()
     encoding = msg.encoding

@@ -27,7 +27,7 @@ import itertools
 import threading
 import time
 from dataclasses import dataclass
-from typing import Any, Callable, Dict, List, Optional, Sequence
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from minros import rosenv
 
@@ -259,7 +259,7 @@ class Admission:
         return ticket.key
 
     @staticmethod
-    def _oldest(tickets: Any, states: tuple) -> _Ticket | None:
+    def _oldest(tickets: Any, states: Tuple[Any, ...]) -> _Ticket | None:
         best: _Ticket | None = None
         for t in tickets:
             if not t.evicted and t.state in states and (best is None or t.since < best.since):

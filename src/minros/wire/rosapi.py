@@ -5,7 +5,8 @@ Every method of both XML-RPC APIs takes the caller's ``caller_id`` first and ans
 own failure, -1 (ERROR) is the caller's mistake. ``value`` is there even on error, because
 XML-RPC cannot carry None.
 
-This module holds the convention once: the codes, :func:`unwrap` for callers, and for servers
+This module holds the convention once: the codes, :func:`unwrap` for callers (the one place a
+code is checked: :class:`CallerError` for -1, :class:`CalleeFailure` for 0), and for servers
 the :func:`api` decorator with its argument validators, which give the exact triplets rosmaster
 and rospy answer to bad calls (both use the same decorator, ``apivalidate``). Pure: no sockets.
 """
@@ -19,7 +20,7 @@ from minros.names import ANYTYPE, SEP, resolve_name
 
 __all__ = [
     "ERROR", "FAILURE", "ROSRPC", "SUCCESS",
-    "ParameterInvalid", "RemoteError", "Validator",
+    "CalleeFailure", "CallerError", "ParameterInvalid", "RemoteError", "Validator",
     "api", "empty_or_valid_name", "global_name", "is_api", "is_service", "is_topic", "non_empty",
     "non_empty_str", "not_none", "parse_rosrpc_uri", "triplet", "unwrap", "valid_name",
     "valid_name_validator_resolved", "valid_name_validator_unresolved", "valid_type_name",
@@ -41,7 +42,7 @@ def triplet(code: int, msg: str, value: Any) -> List[Any]:
 
 
 class RemoteError(Exception):
-    """A ROS API call answered with a code other than SUCCESS."""
+    """A ROS API call answered with a code other than SUCCESS (rosgraph's ROSMasterException)."""
 
     def __init__(self, code: int, msg: str, value: Any = None) -> None:
         super().__init__(msg)
@@ -50,14 +51,25 @@ class RemoteError(Exception):
         self.value = value
 
 
+class CallerError(RemoteError):
+    """Code -1 (ERROR): the callee says the call was wrong (unknown name, unset parameter...)."""
+
+
+class CalleeFailure(RemoteError):
+    """Code 0 (FAILURE), or an answer that is no triplet: the callee tried and failed."""
+
+
 def unwrap(result: Any) -> Any:
-    """Value of a SUCCESS triplet; raises :class:`RemoteError` otherwise (or on a malformed result)."""
+    """Value of a SUCCESS triplet; :class:`CallerError` for code -1, :class:`CalleeFailure` for
+    code 0, another code or a malformed result."""
     if not isinstance(result, (list, tuple)) or len(result) != 3:
-        raise RemoteError(FAILURE, f"malformed ROS API result: {result!r}")
+        raise CalleeFailure(FAILURE, f"malformed ROS API result: {result!r}")
     code, msg, value = result
-    if code != SUCCESS:
-        raise RemoteError(code, str(msg), value)
-    return value
+    if code == SUCCESS:
+        return value
+    if code == ERROR:
+        raise CallerError(code, str(msg), value)
+    raise CalleeFailure(code, str(msg), value)
 
 
 # ---------------------------------------------------------------------------- validators
@@ -198,7 +210,8 @@ def valid_type_name(name: str) -> Validator:
 # ---------------------------------------------------------------------------- the decorator
 
 
-def api(error_value: Any, validators: Sequence[Validator | None] = ()) -> Callable:
+def api(error_value: Any, validators: Sequence[Validator | None] = ()
+        ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Decorate a master or slave API method: arity and caller_id checks, validators, and the
     exact error triplets of rosmaster/rospy.
 

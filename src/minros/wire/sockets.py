@@ -13,7 +13,7 @@ import collections
 import socket
 import struct
 import time
-from typing import Any, Callable, Dict, Optional
+from typing import Any, Callable, Deque, Dict, Optional
 
 from minros.exceptions import TransportTerminated
 from minros.wire import tcpros
@@ -141,7 +141,7 @@ class FrameSource:
         self.reader = reader
         self.stop = stop
         self.guard = guard
-        self.pending: collections.deque = collections.deque()
+        self.pending: Deque[Any] = collections.deque()
         self._poll = sock.gettimeout()  # paces the checks of stop()
         self._started: float | None = None  # when the frame in progress began to arrive
 

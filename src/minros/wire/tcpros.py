@@ -1,7 +1,8 @@
 """TCPROS as pure functions: connection headers, length-prefixed framing, service responses.
 
-No sockets here (sans-IO, like h11): the socket layer in ``minros.node`` / ``minros.client.topics`` /
-``minros.client.services`` only moves bytes in and out of these objects.
+No sockets here (sans-IO, like h11): the transports (``minros.transport``), the node's TCPROS
+server and ``minros.client.services`` only move bytes in and out of these objects; the order of
+the header exchange is :mod:`minros.wire.handshake`.
 
 Wire format (all integers little-endian ``uint32``):
 
@@ -34,7 +35,6 @@ __all__ = [
     "encode_service_error",
     "encode_service_response",
     "frame_prefix",
-    "stamp_header",
     "publisher_header_error",
     "read_header_block",
     "service_header_error",
@@ -209,16 +209,6 @@ def service_header_error(header: Mapping[str, str], service: str, md5sum: str) -
 # framing
 
 
-def stamp_header(msg: Any, seq: int) -> None:
-    """What rospy does to every message it sends (topic, request or response): a message with
-    a std_msgs/Header gets the sender's sequence number, and a None frame_id becomes "0"."""
-    if getattr(msg, "_has_header", False):
-        header = msg.header
-        header.seq = seq
-        if header.frame_id is None:
-            header.frame_id = "0"
-
-
 def frame_prefix(size: int) -> bytes:
     """The 4-byte length prefix of a frame of ``size`` bytes."""
     return _U32.pack(size)
@@ -283,7 +273,7 @@ class FrameReader:
         self._big_ok = 1
         self.max_frame = max_frame
         self.ok_byte = ok_byte
-        self._ready: List = []
+        self._ready: List[Any] = []
         self.bytes_received = 0
         self._error: FrameError | None = None
         # reuse_big=True: the consumer is done with a big frame before it asks for more data
@@ -318,7 +308,7 @@ class FrameReader:
         pops the completed frames."""
         self._ready = self.received_frames(n)
 
-    def received_frames(self, n: int) -> list:
+    def received_frames(self, n: int) -> List[Any]:
         """``received(n)`` and ``frames()`` in one call (the subscriber's hot path): the frames
         completed so far. An error in the data is raised by the next call, once the good
         frames before it are out."""
@@ -342,7 +332,7 @@ class FrameReader:
             self._ready = []
         return ready
 
-    def frames(self) -> list:
+    def frames(self) -> List[Any]:
         """Pop the complete frames parsed so far (``bytes``/``bytearray``, or (ok, payload)).
 
         Raises FrameError once every good frame before a bad one has been handed out.
@@ -367,7 +357,7 @@ class FrameReader:
         prefix = 5 if self.ok_byte else 4
         if self._end - self._start < prefix:
             return None
-        return _U32.unpack_from(self._buf, self._start + prefix - 4)[0]
+        return int(_U32.unpack_from(self._buf, self._start + prefix - 4)[0])
 
     def eof(self) -> None:
         """The peer closed the stream: an error if it stopped in the middle of a frame."""
@@ -377,7 +367,7 @@ class FrameReader:
         if pending:
             raise FrameError(f"connection closed in the middle of a frame ({pending} bytes pending)")
 
-    def feed(self, data: BytesLike) -> list:
+    def feed(self, data: BytesLike) -> List[Any]:
         """Convenience for tests and non-socket users: push ``data`` and return new frames."""
         view = memoryview(data).cast("B")
         while len(view) and self._error is None:

@@ -343,7 +343,7 @@ def xmlrpc_called(uri: str, method: str, args: Any, n: int, addresses: Optional[
     """The client side of one XML-RPC call (``request``/``response``: the HTTP bytes)."""
     if _writer is None:
         return
-    fields = {"uri": uri}
+    fields: Dict[str, Any] = {"uri": uri}
     if addresses is not None:
         fields["local"], fields["remote"] = addresses
         fields["n"] = n
@@ -359,7 +359,10 @@ def xmlrpc_served(addresses: Tuple[str, str], n: int, t0: float, request: bytes,
     server pays for it only when tracing)."""
     if _writer is None:
         return
-    method, args, result, error = "?", [], None, None
+    method: Optional[str] = "?"
+    args: Any = []
+    result: Any = None
+    error: Optional[BaseException] = None
     try:
         args, method = xmlrpc.client.loads(body, use_builtin_types=False)
         (result,), _ = xmlrpc.client.loads(reply, use_builtin_types=False)
@@ -423,7 +426,8 @@ class _Connection:
         """A function decoding this direction's frames, from the headers (None: cannot)."""
         found = self.decoders.get(direction, False)
         if found is not False:
-            return found
+            known: Optional[Callable[[bytes], Any]] = found
+            return known
         decode = None
         try:
             server = self.header_in if self.side == "connect" else self.header_out

@@ -43,7 +43,7 @@ MAX_HEADER_LINES = 100
 MAX_REPLY_DEPTH = 200
 
 
-def _check_markup(body: bytes) -> None:
+def _check_markup(body: bytes | bytearray) -> None:
     """Refuse DTDs: XML-RPC never needs them and they are the door to entity-expansion bombs."""
     if b"<!" in body:
         upper = body.upper()
@@ -80,7 +80,7 @@ class Dispatcher:
         return sorted(names)
 
     def _lookup(self, method: Any) -> Callable[..., Any] | None:
-        func = self._cache.get(method)
+        func: Callable[..., Any] | None = self._cache.get(method)
         if func is not None:
             return func
         if not isinstance(method, str) or not method or method.startswith("_") or "." in method:
@@ -89,7 +89,7 @@ class Dispatcher:
         if func is None or not callable(func):
             return None
         self._cache[method] = func
-        return func
+        return func  # type: ignore[no-any-return]  # what getattr found, checked callable
 
     def dispatch(self, method: Any, params: Sequence[Any]) -> Any:
         """Call ``method``; exceptions propagate (the caller turns them into faults)."""
@@ -117,7 +117,7 @@ class Dispatcher:
                 results.append({"faultCode": 1, "faultString": _fault_string(exc)})
         return results
 
-    def handle_request_body(self, body: bytes) -> bytes:
+    def handle_request_body(self, body: bytes | bytearray) -> bytes:
         """Decode a methodCall, dispatch it, encode the methodResponse (or fault)."""
         try:
             _check_markup(body)
@@ -248,7 +248,7 @@ class RequestReader:
         buf = self._buf
         if self._head is not None:
             return True
-        if buf[:1] in (b"\r", b"\n"):
+        if bytes(buf[:1]) in (b"\r", b"\n"):
             del buf[:len(buf) - len(buf.lstrip(b"\r\n"))]
             self._scanned = 0
         return bool(buf)

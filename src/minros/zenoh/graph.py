@@ -24,6 +24,7 @@ from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Tuple
 from minros.tools.master import Master, call_node
 from minros.tools.services import probe_service
 from minros.wire import sockets, tcpros
+from minros.wire.rosapi import RemoteError, unwrap
 from minros.zenoh.keys import KeyMappingError, Resource, data_key
 
 __all__ = ["LocalGraph", "PublisherInfo", "Snapshot", "probe_publisher"]
@@ -58,10 +59,13 @@ def probe_publisher(node_uri: str, topic: str, caller_id: str,
                     timeout: float = PROBE_TIMEOUT) -> Dict[str, str]:
     """The connection header the publisher of ``topic`` at ``node_uri`` answers with.
     OSError or tcpros.HeaderError when it cannot be asked or refuses."""
-    code, msg, params = call_node(node_uri, "requestTopic", caller_id, topic, [["TCPROS"]],
-                                  timeout=timeout)
-    if code != 1 or not isinstance(params, list) or len(params) != 3 or params[0] != "TCPROS":
-        raise OSError(f"requestTopic of {topic} at {node_uri}: {msg or params}")
+    try:
+        params = unwrap(call_node(node_uri, "requestTopic", caller_id, topic, [["TCPROS"]],
+                                  timeout=timeout))
+    except RemoteError as exc:
+        raise OSError(f"requestTopic of {topic} at {node_uri}: {exc}") from None
+    if not isinstance(params, list) or len(params) != 3 or params[0] != "TCPROS":
+        raise OSError(f"requestTopic of {topic} at {node_uri}: {params}")
     sock = socket.create_connection((params[1], int(params[2])), timeout=timeout)
     try:
         sock.sendall(tcpros.encode_header({"topic": topic, "md5sum": "*", "type": "*",

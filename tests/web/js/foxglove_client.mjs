@@ -84,7 +84,8 @@ if (mode === "echo" || mode === "bench") {
   if (mode === "echo") {
     let n = 0;
     client.on("message", (event) => {
-      if (event.subscriptionId !== subId) return;
+      // finish() closes asynchronously: messages already in the socket still arrive, not counted
+      if (event.subscriptionId !== subId || n >= Number(countOrSeconds)) return;
       const msg = reader.readMessage(new Uint8Array(event.data.buffer, event.data.byteOffset, event.data.byteLength));
       out({ message: msg, receiveTime: event.timestamp.toString(), size: event.data.byteLength });
       if (++n >= Number(countOrSeconds)) finish();

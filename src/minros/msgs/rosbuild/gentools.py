@@ -34,7 +34,7 @@ def _add_msgs_depends(rospack: Any, spec: Any, deps: List[str], package_context:
     """Append the types ``spec`` embeds to ``deps``, depth first, loading unregistered ones."""
     valid: Optional[List[str]] = None
     for type_ in spec.types:
-        base = _msgs.base_msg_type(type_)
+        base = _msgs.base_msg_type(type_) or type_
         if _msgs.is_builtin(base):
             continue
         if base == _msgs.HEADER:
@@ -93,6 +93,7 @@ def get_file_dependencies(f: str, stdout: Any = sys.stdout, stderr: Any = sys.st
     import rospkg
 
     package = rospkg.get_package_name(f)
+    spec: Any
     if f.endswith(_msgs.EXT):
         _, spec = _msgs.load_from_file(f)
     elif f.endswith(_srvs.EXT):
@@ -111,7 +112,7 @@ def compute_md5_text(get_deps_dict: Dict[str, Any], spec: Any, rospack: Any = No
     for c in spec.constants:
         buff.write(f"{c.type} {c.name}={c.val_text}\n")
     for type_, name in zip(spec.types, spec.names):
-        base = _msgs.base_msg_type(type_)
+        base = _msgs.base_msg_type(type_) or type_
         if _msgs.is_builtin(base):
             buff.write(f"{type_} {name}\n")
             continue

@@ -181,7 +181,7 @@ def _strify_spec(spec: MsgSpec, buff: Optional[StringIO] = None, indent: str = "
         buff.write(f"{indent}{c.type} {c.name}={c.val_text}\n")
     for type_, name in zip(spec.types, spec.names):
         buff.write(f"{indent}{type_} {name}\n")
-        base = base_msg_type(type_)
+        base = base_msg_type(type_) or type_
         if base not in BUILTIN_TYPES:
             _strify_spec(get_registered(base), buff, indent + "  ")
     return buff.getvalue()
@@ -312,7 +312,9 @@ def load_package_dependencies(package: str, load_recursive: bool = False) -> Non
     if load_recursive:
         depends = _packages.rospack().get_depends(package, implicit=True)
     else:
-        manifest = _packages.parse_manifest_file(_packages.manifest_file(package, True))
+        path = _packages.manifest_file(package, True)
+        assert path is not None  # required: a package without one raised
+        manifest = _packages.parse_manifest_file(path)
         depends = [d.package for d in manifest.depends]
     loaded = []
     for dep in depends:

@@ -31,7 +31,7 @@ import os
 import sys
 import threading
 import time
-from typing import Any, Dict, List, Tuple
+from typing import Any, Dict, Iterator, List, Tuple
 
 from minros.sim import kinematics, mapfile
 from minros.sim import robot as model
@@ -64,7 +64,7 @@ def robot_names(count: int) -> List[str]:
     return [""] if count == 1 else [f"tb3_{i}" for i in range(count)]
 
 
-def row_candidates(limit: int = 200):
+def row_candidates(limit: int = 200) -> Iterator[Tuple[float, float]]:
     """Start places in a row along y through (0, 0): 0, +0.5, -0.5, +1.0, ... metres."""
     yield 0.0, 0.0
     for k in range(1, limit):
@@ -300,7 +300,7 @@ class SimNode:
     def wants_view(self) -> bool:
         return self.view_pub.get_num_connections() > 0
 
-    def render(self):
+    def render(self) -> Any:
         from minros.sim.render import Renderer
 
         with self.lock:

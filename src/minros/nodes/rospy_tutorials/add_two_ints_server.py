@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import rospy
-from rospy_tutorials.srv import AddTwoInts, AddTwoIntsResponse
+from rospy_tutorials.srv import AddTwoInts, AddTwoIntsRequest, AddTwoIntsResponse
 
 
-def handle_add_two_ints(req) -> AddTwoIntsResponse:
+def handle_add_two_ints(req: AddTwoIntsRequest) -> AddTwoIntsResponse:
     total = req.a + req.b
     print(f"Returning [{req.a} + {req.b} = {total}]", flush=True)
     return AddTwoIntsResponse(total)

@@ -10,7 +10,7 @@ import tf
 import turtlesim.msg
 
 
-def handle_turtle_pose(msg, turtlename):
+def handle_turtle_pose(msg: turtlesim.msg.Pose, turtlename: str) -> None:
     br = tf.TransformBroadcaster()
     br.sendTransform((msg.x, msg.y, 0),
                      tf.transformations.quaternion_from_euler(0, 0, msg.theta),

@@ -262,7 +262,7 @@ class TurtlesimNode:
             if iface is not None:
                 iface.publish(update)
 
-    def render(self):
+    def render(self) -> Any:
         with self.lock:
             self.dirty = False
             return self.world.render()
@@ -290,7 +290,7 @@ class _TkDisplay:
     def _close(self) -> None:
         self.closed = True
 
-    def show(self, frame) -> None:
+    def show(self, frame: Any) -> None:
         header = b"P6 %d %d 255\n" % (frame.shape[1], frame.shape[0])
         self.photo = self.tk.PhotoImage(data=header + frame.tobytes(), format="PPM")
         self.label.configure(image=self.photo)
@@ -321,7 +321,7 @@ def _open_display(headless: bool, title: str) -> Tuple[_TkDisplay | None, str]:
         return None, f"cannot open a window ({(str(exc).splitlines() or [type(exc).__name__])[0]})"
 
 
-def write_snapshot(path: str, frame_rgb) -> None:
+def write_snapshot(path: str, frame_rgb: Any) -> None:
     """Write an RGB frame as an image file atomically (readers never see half a PNG)."""
     import cv2
 

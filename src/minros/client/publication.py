@@ -1,0 +1,181 @@
+"""A publication: every Publisher handle of one topic in this process, and its subscribers'
+connections (rospy's _PublisherImpl).
+
+Publishing serializes a message once (Header stamped first) and hands the same frame to every
+connection's ``send``; the connections are transports of any protocol (``minros.transport``),
+added by the protocol handler that accepted the subscriber. The publication keeps what ROS
+keeps per topic: the latched message (sent first to every new subscriber), the sequence number,
+the SubscribeListeners, the user's extra header fields.
+
+Code written against rospy's ``_PublisherImpl`` finds its names here too (``add_connection``,
+``publish(msg, connection_override)``, ``acquire``/``release``, ``has_connection``): rospy's
+own transports (:mod:`minros.rospy_internals.transport`) are transports of this seam.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+import threading
+import traceback
+from typing import TYPE_CHECKING, Any, Dict, List
+
+from minros.client.msg import args_kwds_to_message, frame_len, serialize_frame, stamp_header
+from minros.exceptions import ROSException
+from minros.transport.base import Transport
+
+if TYPE_CHECKING:
+    from minros.node import Node
+
+__all__ = ["Publication"]
+
+_logger = logging.getLogger("minros.client.topics")
+
+
+class Publication:
+    """Shared state of all Publisher handles for one topic in this process."""
+
+    def __init__(self, node: Node, name: str, resolved_name: str, data_class: Any) -> None:
+        self.node = node
+        self.name = name
+        self.resolved_name = resolved_name
+        self.data_class = data_class
+        self.type: str = data_class._type
+        self.md5sum: str = data_class._md5sum
+        self.connections: List[Transport] = []
+        self.lock = threading.RLock()
+        self.listeners: List[Any] = []
+        self.headers: Dict[str, str] = {}
+        self.is_latch = False
+        self.latch: Any = None
+        self.queue_size: int | None = None
+        self.tcp_nodelay = False
+        self.seq = 0
+        self.message_data_sent = 0
+        self.ref_count = 0
+        self.closed = False
+
+    # -- connections -------------------------------------------------------------------------
+
+    def header_fields(self) -> Dict[str, str]:
+        """What the publisher says in its connection header (the user's headers last)."""
+        fields = {
+            "topic": self.resolved_name,
+            "type": self.type,
+            "latching": "1" if self.is_latch else "0",
+            "message_definition": self.data_class._full_text,
+            "md5sum": self.md5sum,
+            "callerid": self.node.caller_id,
+        }
+        fields.update(self.headers)
+        return fields
+
+    def add_connection(self, transport: Transport) -> bool:
+        """A subscriber's negotiated connection: the latched message goes first, then the
+        listeners hear of it. False (and the transport closed) when the publication is."""
+        with self.lock:
+            if self.closed:
+                transport.close()
+                return False
+            self.connections = self.connections + [transport]
+            if self.is_latch and self.latch is not None:
+                transport.send(self._serialize(self.latch))
+        for listener in list(self.listeners):
+            def publish_single(*args: Any, _conn: Transport = transport, **kwds: Any) -> None:
+                msg = args_kwds_to_message(self.data_class, args, kwds)
+                with self.lock:
+                    _conn.send(self._serialize(msg))
+            try:
+                listener.peer_subscribe(self.resolved_name, self._publish_any, publish_single)
+            except Exception:
+                _logger.error("peer_subscribe failed: %s", traceback.format_exc())
+        return True
+
+    def remove_connection(self, transport: Transport) -> None:
+        """A connection ended (the subscriber left or failed)."""
+        with self.lock:
+            if transport not in self.connections:
+                return
+            self.connections = [c for c in self.connections if c is not transport]
+            remaining = len(self.connections)
+        for listener in list(self.listeners):
+            try:
+                listener.peer_unsubscribe(self.resolved_name, remaining)
+            except Exception:
+                _logger.error("peer_unsubscribe failed: %s", traceback.format_exc())
+
+    def _publish_any(self, *args: Any, **kwds: Any) -> None:
+        self.publish(args_kwds_to_message(self.data_class, args, kwds))
+
+    # -- publishing --------------------------------------------------------------------------
+
+    def _serialize(self, msg: Any) -> Any:
+        """Called with the lock held: Header.seq auto-fill, then one serialization."""
+        self.seq += 1
+        stamp_header(msg, self.seq)
+        frame = serialize_frame(msg)
+        self.message_data_sent += frame_len(frame) - 4
+        return frame
+
+    def publish(self, msg: Any, connection_override: Transport | None = None) -> None:
+        """Send ``msg`` to every connection, or to ``connection_override`` only (rospy's way
+        of sending to one subscriber); a latching publication keeps it for newcomers."""
+        with self.lock:
+            if self.closed:
+                if self.node.is_shutdown():
+                    return
+                raise ROSException("publish() to a closed topic")
+            if self.is_latch:
+                self.latch = msg
+            conns = self.connections if connection_override is None else [connection_override]
+            if not conns:
+                return
+            # Header auto-fill, then one serialization for every connection
+            self.seq += 1
+            if getattr(msg, "_has_header", False):
+                stamp_header(msg, self.seq)
+            frame = serialize_frame(msg)
+            self.message_data_sent += (len(frame) if frame.__class__ is bytes else frame_len(frame)) - 4
+            for conn in conns:
+                conn.send(frame)
+
+    # -- bookkeeping -------------------------------------------------------------------------
+
+    def get_stats(self) -> list:
+        return [self.resolved_name, self.message_data_sent,
+                [[c.id, c.stat_bytes, c.stat_msgs, not c.done] for c in self.connections]]
+
+    def has_connection(self, endpoint_id: str) -> bool:
+        """rospy's query: is the subscriber node ``endpoint_id`` (its caller id) connected?"""
+        return any(c.endpoint_id == endpoint_id and not c.done for c in self.connections)
+
+    def has_connections(self) -> bool:
+        return any(not c.done for c in self.connections)
+
+    def get_num_connections(self) -> int:
+        return sum(1 for c in self.connections if not c.done)
+
+    def get_stats_info(self) -> list:
+        return [[c.id, c.endpoint_id, "o", c.transport_type, self.resolved_name, True,
+                 c.info()] for c in self.connections]
+
+    # rospy's _PublisherImpl names, for code written against them
+
+    @property
+    def buff(self) -> io.BytesIO:
+        """rospy's serialization buffer, empty between publishes: one here serializes into a
+        frame of its own each time, so this one is always empty."""
+        return io.BytesIO()
+
+    def acquire(self) -> None:
+        self.lock.acquire()
+
+    def release(self) -> None:
+        self.lock.release()
+
+    def close(self) -> None:
+        with self.lock:
+            self.closed = True
+            conns, self.connections = self.connections, []
+        for conn in conns:
+            conn.close()

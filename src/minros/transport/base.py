@@ -1,0 +1,149 @@
+"""The transport seam: one interface for a topic connection, one for a protocol (rospy's
+impl/transport.py).
+
+A :class:`Transport` is one end of one topic connection, whatever carries it: it negotiates
+(its side of the connection-header exchange), sends frames (the publisher's end), receives
+frames (the subscriber's end) and closes. A frame is what ``serialize_frame`` makes: a
+serialized message with its 4-byte length prefix, as ``bytes`` or, for a big message, a tuple
+of buffers whose first is the prefix.
+
+A :class:`ProtocolHandler` is one protocol a node speaks: what a subscriber offers in
+``requestTopic`` and how it connects to what the publisher chose; what a publisher answers to
+an offer; and which inbound connections it takes. A node keeps an ordered list of them
+(:attr:`minros.node.Node.protocols`: a subscriber offers them in that order, TCPROS last), so
+another transport joins by adding its handler there; the topic API (``minros.client``) only
+ever sees ``Transport``.
+"""
+
+from __future__ import annotations
+
+import abc
+import itertools
+import threading
+from typing import Any, Dict, List, Protocol, Tuple, Union
+
+from minros.exceptions import TransportException
+from minros.wire.handshake import Handshake
+
+__all__ = ["Frame", "ProtocolHandler", "PublicationSide", "Transport", "next_connection_id"]
+
+#: a length-prefixed message: bytes, or a tuple of buffers (prefix first) sent without a join
+Frame = Union[bytes, Tuple[Any, ...]]
+
+_ids = itertools.count(1)
+_ids_lock = threading.Lock()
+
+
+def next_connection_id() -> int:
+    """A process-wide connection number (getBusInfo/getBusStats identify connections by it)."""
+    with _ids_lock:
+        return next(_ids)
+
+
+class Transport(abc.ABC):
+    """One end of one topic connection.
+
+    Attributes every transport keeps (getBusInfo and getBusStats read them): ``id``;
+    ``header``, the peer's connection header once negotiated; ``stat_bytes`` and ``stat_msgs``;
+    ``done``, true once closed.
+    """
+
+    #: the protocol name, as in requestTopic (``"TCPROS"``)
+    protocol = ""
+
+    id: int
+    header: Dict[str, str]
+    stat_msgs: int
+    done: bool
+
+    @property
+    @abc.abstractmethod
+    def stat_bytes(self) -> int:
+        """Bytes sent (the publisher's end) or received (the subscriber's end)."""
+
+    @abc.abstractmethod
+    def negotiate(self, handshake: Handshake, opening: Dict[str, str] | None = None) -> None:
+        """Run this end's side of the connection-header exchange (``opening``: the peer's
+        header, when the acceptor has read it already); raises ``Rejected`` or
+        TransportException."""
+
+    def send(self, frame: Frame) -> None:
+        """Send one frame to the peer (the publisher's end). Never blocks a queued
+        publisher; drops the oldest queued frame when the queue is full."""
+        raise TransportException(f"this end of a {self.protocol} connection does not send")
+
+    def receive(self) -> List[Any] | None:
+        """Block until the peer sends more; the frames it completed (perhaps none yet), or
+        None at a clean end of the stream (the subscriber's end). Frames are ``bytes`` or,
+        when large, a ``bytearray`` of their own that message fields may keep views of."""
+        raise TransportException(f"this end of a {self.protocol} connection does not receive")
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """End the connection (idempotent); a thread blocked in send or receive wakes up."""
+
+    @abc.abstractmethod
+    def info(self) -> str:
+        """One line for getBusInfo, as rospy writes it."""
+
+    # rospy's names (rospy.impl.transport.Transport, whose classes are transports here too)
+
+    @property
+    def endpoint_id(self) -> str:
+        """Who is at the other end: the peer's caller id, from its header."""
+        return self.header.get("callerid", "")
+
+    @property
+    def transport_type(self) -> str:
+        """The protocol's name, as getBusInfo lists it."""
+        return self.protocol
+
+
+class PublicationSide(Protocol):
+    """What a protocol handler needs of a publication to connect a subscriber to it."""
+
+    resolved_name: str
+    type: str
+    md5sum: str
+    queue_size: int | None
+    tcp_nodelay: bool
+    closed: bool
+
+    def header_fields(self) -> Dict[str, str]: ...
+    def add_connection(self, transport: Transport) -> bool: ...
+    def remove_connection(self, transport: Transport) -> None: ...
+
+
+class ProtocolHandler(abc.ABC):
+    """A protocol a node speaks (rospy's ProtocolHandler)."""
+
+    #: the protocol name in requestTopic
+    protocol = ""
+
+    def offer(self) -> List[Any]:
+        """The subscriber's entry in requestTopic's protocol list (``[name, params...]``)."""
+        return [self.protocol]
+
+    @abc.abstractmethod
+    def answer(self, topic: str, offer: List[Any]) -> List[Any] | None:
+        """The publisher's answer to a subscriber's ``offer`` of this protocol
+        (``[name, params...]``), or None to decline it."""
+
+    @abc.abstractmethod
+    def connect(self, answer: List[Any], topic: str, buff_size: int, reuse_big: bool,
+                tcp_nodelay: bool) -> Transport:
+        """The subscriber's end of a connection to the publisher that gave ``answer``,
+        connected but not negotiated yet (the caller may close it meanwhile). ValueError for
+        an answer this handler cannot use; OSError when the publisher cannot be reached.
+        ``reuse_big``: the subscriber is done with a big frame before it receives again."""
+
+    def claims(self, header: Dict[str, str]) -> bool:
+        """Whether an inbound TCP connection opening with ``header`` is this protocol's: the
+        node's TCPROS server gives it to the first handler that claims it (TCPROS, last in
+        the node's list, claims every topic connection)."""
+        return False
+
+    def accept(self, stream: Any, header: Dict[str, str], publication: PublicationSide) -> None:
+        """Take an inbound connection this handler claimed, for ``publication``: negotiate
+        and add the publisher's end to it; raises ``Rejected`` after refusing."""
+        raise TransportException(f"{self.protocol} takes no inbound TCP connections")
