@@ -234,6 +234,11 @@ def test_every_display_draws_and_bad_ones_say_why(page):
     assert "nowhere" in status.inner_text()
     # drawn: the light blue CUBE marker, the map's unknown corner (Rviz's grey green)
     page.look((0.5, -0.5, 0), (4.5, -6.5, 5))
+    # a point projected in the same task as the camera moved (no frame drawn between) is where
+    # the next frame draws it
+    moved = page.js(f"{V}.scene3d.resetCamera() || {V}.scene3d.lookAt([0.5, -0.5, 0], [4.5, -6.5, 5]) "
+                    f"|| {V}.scene3d.project(4.0, -2.4, 0.5)")
+    assert moved["inside"] and (moved["x"], moved["y"]) == pytest.approx(page.project(4.0, -2.4, 0.5)), moved
     # marker "shapes"/1, a CUBE of (0.2, 0.7, 1.0); map cells [150:, 150:] are unknown (-1)
     page.wait_pixel((4.0, -2.4, 0.5), "b > 180 && g > 110 && r < 110")
     page.wait_pixel((3.5, 3.5, 0.0), "g > r + 10 && Math.abs(g - b) < 25 && g > 90 && g < 190")
