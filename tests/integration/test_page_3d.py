@@ -494,6 +494,12 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
         page.js(f"{V}.scene3d.controls.autoRotate = false; {V}.scene3d.continuous = false")
         stats = page.js(f"{V}.scene3d.stats")
         count = page.js(f"{V}.displays.find((d) => d.source === '/cloud').count")
+        # an option changed on a colored cloud keeps its points' own colors (the flat color
+        # used to multiply them: a rainbow turned red and black)
+        cloud_display = f"{V}.displays.find((d) => d.source === '/cloud')"
+        page.js(f"{cloud_display}.setOption('size', 0.03)")
+        colors = page.js(f"[{cloud_display}.material.vertexColors, "
+                         f"{cloud_display}.material.color.getHex()]")
         report = {"points": count, "camera_still": still, "camera_turning": turning,
                   "canvas": f"{stats['width']}x{stats['height']}", "renderer": stats["renderer"],
                   "cpus": os.cpu_count(), "load_average": round(os.getloadavg()[0], 1)}
@@ -502,6 +508,7 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
         page.shot("view3d_cloud")
     finally:
         cloud.stop()
+    assert colors == [True, 0xFFFFFF], colors
     assert count == page.js(f"{V}.displays.find((d) => d.source === '/cloud').request.max_points") or count == 100_000
     # the view keeps drawing and keeps taking clouds, whatever else the machine runs (the
     # server drops what the page cannot take): floors a broken pipeline misses, not a benchmark

@@ -441,7 +441,10 @@ export class PointsDisplay extends Display {
 
   applyOptions() {
     this.material.size = Number(this.options.size) || 0.02;
-    this.material.color.setRGB(...hexColor(this.options.color).slice(0, 3));
+    // a colored cloud's colors are its points' own (white multiplies them): the flat color is
+    // for clouds without colors, also when another option (max points, size) changes
+    this.material.color.setRGB(...(this.material.vertexColors
+      ? [1, 1, 1] : hexColor(this.options.color).slice(0, 3)));
     const alpha = Number(this.options.alpha);
     this.material.transparent = alpha < 1;
     this.material.opacity = alpha;
