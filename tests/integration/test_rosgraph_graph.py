@@ -85,9 +85,11 @@ def test_rosgraph_command_prints_peers_and_services(minros_core: int, ros_home: 
         def connected() -> bool:
             nonlocal text
             text = printed()
-            return "  /listener :\n    Inbound:\n      /talker\n" in text
+            # the talker registers its service on its own schedule: wait for both
+            return ("  /listener :\n    Inbound:\n      /talker\n" in text
+                    and "  /talker/ping\n" in text)
 
-        wait_until(connected, 20, what="the listener's inbound peer")
+        wait_until(connected, 20, what="the listener's inbound peer and /talker/ping")
         assert text.startswith("\n\nNodes:\n")
         assert "  /talker :\n    Inbound:\n    Outbound:\n      /listener\n" in text
         assert "Services:\n" in text and "  /talker/ping\n" in text

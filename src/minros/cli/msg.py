@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import io
-import os
 import sys
 from typing import Any, Callable, Iterator, List, Tuple
 
@@ -319,20 +318,34 @@ def list_srvs(package: str, rospack: object = None) -> List[str]:
 
 
 def iterate_packages(rospack: object, mode: str) -> Iterator[Tuple[str, str]]:
-    """``(package, its msg or srv folder)`` of every package that has one: the packages
-    ``rospack`` knows (a ``rospkg.RosPack``, as ROS's rosmsg takes), or without one minros's
-    package lookup (ROS_PACKAGE_PATH, then the packages minros bundles)."""
+    """``(package, its msg or srv folder)`` of every package that has one: those ``rospack``
+    knows (a ``rospkg.RosPack``, as ROS's rosmsg takes), and when it looks where the
+    environment says (no ``ros_paths`` of its own) also the packages minros bundles, which
+    PyPI's rospkg cannot see and a real install's rospack would list (std_msgs, ...).
+    Without ``rospack``: minros's package lookup (ROS_PACKAGE_PATH, then the bundled ones)."""
+    import os
+
     from minros.msgs.registry import packages_with
 
     kind = _kind(mode)
+    seen = set()
     if rospack is not None and hasattr(rospack, "list") and hasattr(rospack, "get_path"):
         for package in rospack.list():
             folder = os.path.join(rospack.get_path(package), kind)
             if os.path.isdir(folder):
+                seen.add(package)
                 yield package, folder
-        return
+        try:
+            import rospkg
+
+            explicit = list(getattr(rospack, "ros_paths", [])) != list(rospkg.get_ros_paths())
+        except ImportError:
+            explicit = False
+        if explicit:
+            return
     for package, folder in packages_with(kind).items():
-        yield package, str(folder)
+        if package not in seen:
+            yield package, str(folder)
 
 
 def rosmsg_search(rospack: object, mode: str, base_type: str) -> Iterator[str]:
