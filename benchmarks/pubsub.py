@@ -53,6 +53,7 @@ import argparse
 import hashlib
 import json
 import os
+import platform
 import shutil
 import socket
 import statistics
@@ -1066,6 +1067,28 @@ def _own_ratios(med: dict, contenders: list) -> list:
     return cells
 
 
+def _load() -> str:
+    """The 1-minute load average (other users of a shared machine show here)."""
+    try:
+        return f"{os.getloadavg()[0]:.2f}"
+    except OSError:
+        return "?"
+
+
+def machine() -> str:
+    """The CPU model (from /proc/cpuinfo) and the kernel: per-call costs depend on both."""
+    model = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.partition(":")[2].strip()
+                    break
+    except OSError:
+        pass
+    return f"CPU: {model} x {os.cpu_count()}; kernel: {platform.system()} {platform.release()}"
+
+
 def _python_version(python: str) -> str:
     out = subprocess.run([python, "-c", "import sys; print(sys.version.split()[0])"],
                          capture_output=True, text=True)
@@ -1104,6 +1127,7 @@ def main(argv=None) -> int:
     byte_compile_minros()
     if args.baseline:  # its checkout, when the interpreter is that checkout's .venv
         byte_compile_minros(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(args.baseline)))))
+    load = (_load(),)
     runner = Runner(args)
     try:
         contenders = runner.contenders()
@@ -1166,6 +1190,7 @@ def main(argv=None) -> int:
         print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
         for row in rows:
             print("| " + " | ".join(str(c).ljust(w) for c, w in zip(row, widths)) + " |")
+        print(machine() + f"; load average before/after: {load[0]} / {_load()}")
         if failures:
             print("\nruns without a figure (the medians above are of the other rounds):")
             for line in failures:
