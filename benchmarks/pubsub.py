@@ -24,7 +24,9 @@ Scenarios
   publisher has queue_size=10, so a loop publishing faster than the wire drops frames and its
   spinning competes for the CPUs with the thread that sends (on every implementation); the
   1920x1080 flood is also run with queue_size=None (publish() sends before it returns, as the
-  raw floor's sendall does), which measures the receive path at wire speed;
+  raw floor's sendall does), which measures the receive path at wire speed; each flood also
+  shows the CPU both processes spent per message received (publishing loop and sending
+  thread included), steadier than the rate on a shared machine;
 * idle node memory: RSS of a node that did nothing but init_node;
 * service calls of std_srvs/SetBool, persistent and with a new connection (and master
   lookup) per call, median round trip;
@@ -188,13 +190,15 @@ def role_flood_pub(args) -> None:
     _wait_connections(pub, args.subs)
     time.sleep(0.3)
     sent = 0
+    cpu = time.process_time()
     end = time.monotonic() + args.seconds
     while time.monotonic() < end:
         for _ in range(10):
             pub.publish(msg)
         sent += 10
-    print(json.dumps({"sent": sent}), flush=True)
-    time.sleep(1.0)
+    time.sleep(0.5)  # what is queued still goes out: the writer's CPU counts too
+    print(json.dumps({"sent": sent, "pub_cpu_s": time.process_time() - cpu}), flush=True)
+    time.sleep(0.5)
     rospy.signal_shutdown("done")
 
 
@@ -204,7 +208,11 @@ def role_flood_sub(args) -> None:
     cls, _ = _make(args.kind)
     stamps: list = []
 
+    cpu = [0.0]
+
     def on_msg(_msg) -> None:
+        if not stamps:
+            cpu[0] = time.process_time()
         stamps.append(time.perf_counter())
 
     rospy.init_node("bench_flood_sub", anonymous=True)
@@ -219,7 +227,8 @@ def role_flood_sub(args) -> None:
         last = len(stamps)
     n = len(stamps)
     rate = (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0
-    print(json.dumps({"received": n, "rate": rate}), flush=True)
+    print(json.dumps({"received": n, "rate": rate, "sub_cpu_s": time.process_time() - cpu[0]}),
+          flush=True)
     rospy.signal_shutdown("done")
 
 
@@ -482,17 +491,20 @@ def role_raw_flood_sub(args) -> None:
     head = bytearray(4)
     body = bytearray(8 << 20)
     stamps = []
+    cpu = 0.0
     try:
         while True:
             _recv_exact(conn, memoryview(head))
             (size,) = struct.unpack("<I", head)
             _recv_exact(conn, memoryview(body)[:size])
+            if not stamps:
+                cpu = time.process_time()
             stamps.append(time.perf_counter())
     except (ConnectionError, OSError):
         pass
     n = len(stamps)
-    print(json.dumps({"received": n, "rate": (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0}),
-          flush=True)
+    print(json.dumps({"received": n, "rate": (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0,
+                      "sub_cpu_s": time.process_time() - cpu}), flush=True)
 
 
 def role_raw_flood_pub(args) -> None:
@@ -503,13 +515,14 @@ def role_raw_flood_pub(args) -> None:
         height, width = KINDS[args.kind]
         frame = struct.pack("<I", height * width * 3) + bytes(height * width * 3)
     sent = 0
+    cpu = time.process_time()
     end = time.monotonic() + args.seconds
     while time.monotonic() < end:
         for _ in range(10):
             sock.sendall(frame)
         sent += 10
     sock.close()
-    print(json.dumps({"sent": sent}), flush=True)
+    print(json.dumps({"sent": sent, "pub_cpu_s": time.process_time() - cpu}), flush=True)
 
 
 ROLES = {
@@ -854,6 +867,10 @@ class Runner:
                           self.command(who, "flood-pub", ["--kind", kind, "--queue", queue,
                                                           "--seconds", seconds]),
                           first_measures=True)
+        if r.get("received") and "pub_cpu_s" in r and "sub_cpu_s" in r:
+            key = f"{kind}{queue}"
+            per = (r["pub_cpu_s"] + r["sub_cpu_s"]) / r["received"] * 1e6
+            self.cpu[(key, who)] = self.cpu.get((key, who), []) + [per]
         return r.get("rate")
 
     def service(self, who: str, persistent: bool, placement: str = ""):
@@ -1160,6 +1177,10 @@ def main(argv=None) -> int:
         cpu_rows = {"lat10": ("10", "CPU per round trip, ping side, q=10 (µs)"),
                     "lat10same": ("10same", "CPU per round trip, one CPU (µs)"),
                     "lat10split": ("10split", "CPU per round trip, different CPUs (µs)"),
+                    "flood": ("small10", "CPU per message received, both processes (µs)"),
+                    "vga": ("vga10", "CPU per frame received, both processes (µs)"),
+                    "hd": ("hd10", "CPU per frame received, both processes (µs)"),
+                    "hdsync": ("hdnone", "CPU per frame received, both processes (µs)"),
                     "srv": ("srv", "CPU per persistent call, client side (µs)"),
                     "srvsame": ("srvsame", "CPU per persistent call, one CPU (µs)"),
                     "srvsplit": ("srvsplit", "CPU per persistent call, different CPUs (µs)"),

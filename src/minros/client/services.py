@@ -264,7 +264,9 @@ class Service:
         """What answers ``request`` (bytes or buffers for ``_send_all``): ok + response, or
         not-ok + error text."""
         try:
-            response = _convert_return_to_response(self.handler(request), self.response_class)
+            response = self.handler(request)
+            if response.__class__ is not self.response_class:
+                response = _convert_return_to_response(response, self.response_class)
             seq = next(self._seqs)  # atomic: connections are served in threads of their own
             self.seq = seq
             stamp_header(response, seq)
@@ -362,6 +364,10 @@ class _Buffer:
 
 # --------------------------------------------------------------------------- client
 
+#: argument types that are a request's field value, never a message
+_PLAIN = frozenset((bool, int, float, str, bytes, list, tuple))
+
+
 def _args_kwds_to_request(request_class: Any, args: tuple, kwds: dict) -> Any:
     """A request from call arguments: one request instance, positional fields or keywords."""
     if args and kwds:
@@ -370,6 +376,8 @@ def _args_kwds_to_request(request_class: Any, args: tuple, kwds: dict) -> Any:
         return request_class(**kwds)
     if len(args) == 1:
         arg = args[0]
+        if arg.__class__ is request_class or arg.__class__ in _PLAIN:
+            return arg if arg.__class__ is request_class else request_class(arg)
         if getattr(arg, "_md5sum", None) == request_class._md5sum:
             return arg
         if hasattr(arg, "_type") and hasattr(arg, "_slot_types"):  # some other message

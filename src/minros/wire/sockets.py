@@ -197,7 +197,8 @@ class FrameSource:
         while not pending:
             target = reader.recv_buffer()
             while True:
-                if guard is not None:
+                if guard is not None and (wait_until is not None or self._started is not None
+                                          or self._timeout != self._poll):
                     self._pace(wait_until)
                 try:
                     n = recv_into(target)

@@ -320,10 +320,17 @@ class FrameReader:
         else:
             self._end += n
             try:
-                if self.ok_byte:
+                if not self.ok_byte:
+                    self._parse_frames()
+                elif not self._start and self._end >= 5 and not self._ready:
+                    # a service response, usually whole in one recv: one unpack, one slice
+                    ok, size = _OK_LEN.unpack_from(self._buf, 0)
+                    if ok <= 1 and size <= self.max_frame and self._end == 5 + size:
+                        self._end = 0
+                        return [(bool(ok), bytes(self._view[5:5 + size]))]
                     self._parse()
                 else:
-                    self._parse_frames()
+                    self._parse()
             except FrameError as exc:
                 # the frames before the bad one are still good: they are handed out first
                 self._error = exc
