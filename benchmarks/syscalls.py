@@ -32,6 +32,61 @@ from types import SimpleNamespace
 import pubsub  # benchmarks/ is the script's directory: on sys.path
 from _bytecode import byte_compile_minros
 
+#: run a worker with every threading lock counting its acquisitions (written to argv[1] at
+#: exit, and every 50 ms in case the process is killed)
+_COUNT_LOCKS = r"""
+import _thread, atexit, os, runpy, sys, threading, time
+count = [0]
+out = sys.argv.pop(1)
+allocate, make_rlock = _thread.allocate_lock, threading._CRLock or threading._PyRLock
+
+class Lock:
+    __slots__ = ("_l",)
+    def __init__(self):
+        self._l = allocate()
+    def acquire(self, blocking=True, timeout=-1):
+        count[0] += 1
+        return self._l.acquire(blocking, timeout)
+    __enter__ = acquire
+    def release(self):
+        self._l.release()
+    def __exit__(self, *exc):
+        self._l.release()
+    def locked(self):
+        return self._l.locked()
+    def _at_fork_reinit(self):
+        self._l._at_fork_reinit()
+
+class RLock(Lock):
+    __slots__ = ()
+    def __init__(self, *args, **kwargs):
+        self._l = make_rlock()
+    def _is_owned(self):
+        return self._l._is_owned()
+    def _release_save(self):
+        return self._l._release_save()
+    def _acquire_restore(self, state):
+        count[0] += 1
+        self._l._acquire_restore(state)
+
+def dump():
+    with open(out, "w") as f:
+        f.write(str(count[0]))
+
+def dumping():
+    while True:
+        time.sleep(0.05)
+        dump()
+
+threading.Lock = Lock
+threading.RLock = RLock
+atexit.register(dump)
+threading.Thread(target=dumping, daemon=True).start()
+sys.argv = sys.argv[1:]
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # as when run as a script
+runpy.run_path(sys.argv[0], run_name="__main__")
+"""
+
 
 def _parse(path: str) -> collections.Counter:
     counts: collections.Counter = collections.Counter()
@@ -43,8 +98,19 @@ def _parse(path: str) -> collections.Counter:
     return counts
 
 
-def _traced(command: tuple, out: str) -> tuple:
+def _traced(command: tuple, out: str, locks: bool) -> tuple:
+    if locks:
+        python, *rest = command[0]
+        return ([python, "-c", _COUNT_LOCKS, out, *rest], command[1])
     return (["strace", "-f", "-qq", "-c", "-o", out, *command[0]], command[1])
+
+
+def _read_locks(path: str) -> collections.Counter:
+    try:
+        with open(path) as f:
+            return collections.Counter({"locks": int(f.read() or 0)})
+    except OSError:  # a process that takes no lock before it is stopped
+        return collections.Counter({"locks": 0})
 
 
 def _stop_tracee(strace: subprocess.Popen) -> None:
@@ -70,7 +136,8 @@ def _stop_tracee(strace: subprocess.Popen) -> None:
         strace.wait(10)
 
 
-def _run(runner: pubsub.Runner, who: str, exchange: str, calls: int, work: str) -> tuple:
+def _run(runner: pubsub.Runner, who: str, exchange: str, calls: int, work: str,
+         locks: bool = False) -> tuple:
     """(server side's counts, client side's counts) for ``calls`` calls."""
     port = str(pubsub._free_port())
     if exchange == "topic":
@@ -88,7 +155,10 @@ def _run(runner: pubsub.Runner, who: str, exchange: str, calls: int, work: str) 
             first = runner.command(who, "srv-server", [])
             second = runner.command(who, "srv-client", ["--persistent", "--count", str(calls)])
     out1, out2 = os.path.join(work, "server.txt"), os.path.join(work, "client.txt")
-    first, second = _traced(first, out1), _traced(second, out2)
+    for path in (out1, out2):
+        if os.path.exists(path):
+            os.remove(path)
+    first, second = _traced(first, out1, locks), _traced(second, out2, locks)
     p1 = subprocess.Popen(first[0], env=first[1], stdout=subprocess.PIPE,
                           stderr=subprocess.DEVNULL, text=True)
     try:
@@ -98,7 +168,17 @@ def _run(runner: pubsub.Runner, who: str, exchange: str, calls: int, work: str) 
         if '"median_us"' not in p2.stdout:
             raise RuntimeError(f"{who}: the {exchange} client failed: {p2.stdout[-300:]}")
     finally:
-        _stop_tracee(p1)
+        if locks:
+            p1.send_signal(signal.SIGINT)  # a node shuts down: its counts are written at exit
+            try:
+                p1.wait(10)
+            except subprocess.TimeoutExpired:
+                p1.kill()
+                p1.wait()
+        else:
+            _stop_tracee(p1)
+    if locks:
+        return _read_locks(out1), _read_locks(out2)
     return _parse(out1), _parse(out2)
 
 
@@ -112,23 +192,32 @@ def main(argv=None) -> int:
                         help="calls of the long run (the short run makes a quarter of them)")
     parser.add_argument("--only", default="minros,rospy,raw", help="comma-separated contenders")
     parser.add_argument("--exchanges", default="topic,service", help="topic, service or both")
+    parser.add_argument("--baseline", default="", metavar="PY",
+                        help="add 'baseline': minros run by this interpreter (another "
+                             "checkout's venv), as in pubsub.py")
+    parser.add_argument("--locks", action="store_true",
+                        help="count the acquisitions of Python's threading locks instead "
+                             "(no strace: every Lock and RLock counts what takes it)")
     args = parser.parse_args(argv)
-    if not shutil.which("strace"):
+    if not args.locks and not shutil.which("strace"):
         print("strace is not installed (apt-get install strace)", file=sys.stderr)
         return 1
     byte_compile_minros()
-    runner = pubsub.Runner(SimpleNamespace(trace=False, baseline="", only="", count=args.calls,
+    runner = pubsub.Runner(SimpleNamespace(trace=False, baseline=args.baseline, only="",
+                                           count=args.calls,
                                            minros_python=pubsub.VENV_PYTHON, seconds=2.0))
     work = tempfile.mkdtemp(prefix="minros-syscalls-")
     contenders = [c for c in args.only.split(",") if c != "rospy" or runner.reference]
+    if args.baseline and "baseline" not in contenders:
+        contenders.insert(1, "baseline")
     low_calls = max(args.calls // 4, 1)
     rows = []
     try:
         for exchange in args.exchanges.split(","):
             for who in contenders:
                 t = time.monotonic()
-                low = _run(runner, who, exchange, low_calls, work)
-                high = _run(runner, who, exchange, args.calls, work)
+                low = _run(runner, who, exchange, low_calls, work, args.locks)
+                high = _run(runner, who, exchange, args.calls, work, args.locks)
                 sides = [_per_call(low[i], high[i], args.calls - low_calls) for i in (0, 1)]
                 rows.append((exchange, who, sides))
                 print(f"{exchange} {who}: {time.monotonic() - t:.0f} s", file=sys.stderr, flush=True)
@@ -136,8 +225,8 @@ def main(argv=None) -> int:
         runner.close()
         shutil.rmtree(work, ignore_errors=True)
     side_names = {"topic": ("echo", "ping"), "service": ("server", "client")}
-    print(f"system calls per call (strace -f -c, {args.calls} - {low_calls} calls); "
-          f"{pubsub.machine()}")
+    what = "threading lock acquisitions" if args.locks else "system calls (strace -f -c)"
+    print(f"{what} per call ({args.calls} - {low_calls} calls); {pubsub.machine()}")
     print("| exchange | contender | side | total | calls |")
     print("|---|---|---|---|---|")
     for exchange, who, sides in rows:
