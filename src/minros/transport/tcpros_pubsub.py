@@ -94,6 +94,7 @@ class TCPROSSender(TCPROSTransport):
         self.lock = threading.Lock()  # C-level `with` on the hot path; cond shares it
         self.cond = threading.Condition(self.lock)  # the writer waits here for frames
         self.space = threading.Condition(self.lock)  # a publisher, for room in a full queue
+        self.room_wanted = 0  # publishers waiting on space
         self.busy = False
         self.on_close = on_close
         self.thread: threading.Thread | None = None
@@ -165,7 +166,9 @@ class TCPROSSender(TCPROSTransport):
                 # writer a big frame's send time to take one first (nothing for a small one).
                 wait = (len(frame) if frame.__class__ is bytes else sum(map(len, frame))) / BACKOFF_RATE
                 if wait >= BACKOFF_MIN:
+                    self.room_wanted += 1
                     self.space.wait(min(wait, BACKOFF_MAX))
+                    self.room_wanted -= 1
                     if self.done:
                         return
             if self.queue_size and len(queue) >= self.queue_size:
@@ -176,7 +179,8 @@ class TCPROSSender(TCPROSTransport):
                 else:
                     queue.popleft()
             queue.append(frame)
-            self.cond.notify()
+            if not self.busy:  # a busy writer takes it without being told (and a notify
+                self.cond.notify()  # costs a microsecond even with no one waiting)
         # The writer thread is behind: let it have the GIL now rather than after the
         # interpreter's switch interval (5 ms), or a publishing loop starves it.
         _yield_gil()
@@ -262,7 +266,8 @@ class TCPROSSender(TCPROSTransport):
                 else:  # a big frame: one at a time, so that the queue keeps the newest
                     batch = [queue.popleft()]
                 self.busy = True
-                self.space.notify()
+                if self.room_wanted:  # (a notify costs a microsecond even with no one waiting)
+                    self.space.notify()
             try:
                 if len(batch) > 1 and all(type(f) is bytes for f in batch):
                     # many small frames: one system call for the lot
