@@ -33,6 +33,14 @@ Scenarios
 * fan-out: one publisher flooding 8 subscriber processes (small messages, 640x480 images),
   messages per second delivered in all;
 * a subscriber's CPU (% of one core) while it receives a 1920x1080 bgr8 topic at 30 Hz;
+* shared memory (minros's MINROSSHM between two minros processes; every other minros row
+  runs with MINROS_SHM=0, i.e. over TCPROS): the 1920x1080 and 3840x2160 bgr8 floods, a
+  20 MB sensor_msgs/PointCloud2 flood, the small-message flood and round trip (small
+  messages go inline on its Unix socket), the 30 Hz subscriber's CPU; the "raw" column of
+  these rows is the raw TCP floor measured again in the same round, so minros/raw says how
+  far shared memory goes past the socket;
+* intra-process: one minros process publishing 1920x1080 images with intraprocess=True to
+  its own subscriber (the object handed over, no serialization);
 * bring-up: 100 nodes, each publishing 10 topics and subscribing to the next node's 10, started
   at once: seconds until every connection is made (minros and rospy);
 * `rostopic hz` and `rostopic echo` (minros's and Debian's) on a 10 kHz std_msgs/String topic
@@ -72,7 +80,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 VENV_PYTHON = os.path.join(REPO, ".venv", "bin", "python")
 REFERENCE_PYTHON = "/usr/bin/python3"
-KINDS = {"small": None, "vga": (480, 640), "hd": (1080, 1920)}
+KINDS = {"small": None, "vga": (480, 640), "hd": (1080, 1920), "4k": (2160, 3840)}
+#: the PointCloud2 flood: 20 MB of points (16 bytes each: x, y, z, intensity as float32)
+CLOUD_POINTS = 20_000_000 // 16
 
 # --------------------------------------------------------------------------------- workers
 
@@ -82,6 +92,18 @@ def _make(kind: str):
         from std_msgs.msg import String
 
         return String, String("x" * 20)
+    if kind == "cloud":
+        from sensor_msgs.msg import PointCloud2, PointField
+
+        cloud = PointCloud2()
+        cloud.header.frame_id = "lidar"
+        cloud.height, cloud.width = 1, CLOUD_POINTS
+        cloud.fields = [PointField(name, 4 * i, PointField.FLOAT32, 1)
+                        for i, name in enumerate(("x", "y", "z", "intensity"))]
+        cloud.point_step, cloud.row_step = 16, 16 * CLOUD_POINTS
+        cloud.data = bytes(16 * CLOUD_POINTS)
+        cloud.is_dense = True
+        return PointCloud2, cloud
     from sensor_msgs.msg import Image
 
     height, width = KINDS[kind]
@@ -229,6 +251,33 @@ def role_flood_sub(args) -> None:
     rate = (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0
     print(json.dumps({"received": n, "rate": rate, "sub_cpu_s": time.process_time() - cpu[0]}),
           flush=True)
+    rospy.signal_shutdown("done")
+
+
+def role_intra_flood(args) -> None:
+    """One process publishing to its own subscriber with intraprocess=True: messages per
+    second the callback receives (the object itself, handed over)."""
+    import warnings
+
+    import rospy
+
+    warnings.simplefilter("ignore", SyntaxWarning)
+    cls, msg = _make(args.kind)
+    stamps: list = []
+    rospy.init_node("bench_intra", anonymous=True)
+    rospy.Subscriber("/bench_intra", cls, lambda _m: stamps.append(time.perf_counter()),
+                     queue_size=None)
+    pub = rospy.Publisher("/bench_intra", cls, queue_size=_queue(args.queue), intraprocess=True)
+    _wait_connections(pub)
+    time.sleep(0.3)
+    end = time.monotonic() + args.seconds
+    while time.monotonic() < end:
+        for _ in range(10):
+            pub.publish(msg)
+    time.sleep(0.5)
+    n = len(stamps)
+    rate = (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0
+    print(json.dumps({"received": n, "rate": rate}), flush=True)
     rospy.signal_shutdown("done")
 
 
@@ -485,11 +534,18 @@ def role_raw_pubsub_ping(args) -> None:
     clock.report()
 
 
+def _frame_size(kind: str) -> int:
+    if kind == "cloud":
+        return 16 * CLOUD_POINTS
+    height, width = KINDS[kind]
+    return height * width * 3
+
+
 def role_raw_flood_sub(args) -> None:
     server = _raw_listen(args.port, 1)
     conn, _ = server.accept()
     head = bytearray(4)
-    body = bytearray(8 << 20)
+    body = bytearray(32 << 20)
     stamps = []
     cpu = 0.0
     try:
@@ -512,8 +568,8 @@ def role_raw_flood_pub(args) -> None:
     if args.kind == "small":
         frame = struct.pack("<I", 24) + struct.pack("<I", 20) + b"x" * 20
     else:
-        height, width = KINDS[args.kind]
-        frame = struct.pack("<I", height * width * 3) + bytes(height * width * 3)
+        size = _frame_size(args.kind)
+        frame = struct.pack("<I", size) + bytes(size)
     sent = 0
     cpu = time.process_time()
     end = time.monotonic() + args.seconds
@@ -531,15 +587,17 @@ ROLES = {
     "raw-flood-sub": role_raw_flood_sub, "raw-pubsub-echo": role_raw_pubsub_echo,
     "raw-pubsub-ping": role_raw_pubsub_ping, "srv-server": role_srv_server,
     "srv-client": role_srv_client, "rate-pub": role_rate_pub, "cpu-sub": role_cpu_sub,
-    "ring-node": role_ring_node,
+    "ring-node": role_ring_node, "intra-flood": role_intra_flood,
 }
 
 # --------------------------------------------------------------------------------- roscpp
 
 ROSCPP_SOURCE = r'''
 #include <ros/ros.h>
+#define CLOUD_POINTS 1250000
 #include <std_msgs/String.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/SetBool.h>
 #include <ctime>
 #include <chrono>
@@ -570,6 +628,8 @@ static bool onSetBool(std_srvs::SetBool::Request& req, std_srvs::SetBool::Respon
   res.success = req.data; res.message = "ok"; return true;
 }
 static double cpuSeconds() { return (double)std::clock() / CLOCKS_PER_SEC; }
+static int heightOf(const std::string& kind) { return kind == "vga" ? 480 : kind == "4k" ? 2160 : 1080; }
+static int widthOf(const std::string& kind) { return kind == "vga" ? 640 : kind == "4k" ? 3840 : 1920; }
 static double cpu0 = 0, cpu1 = 0;
 static Clock::time_point first, last;
 static long received = 0;
@@ -608,6 +668,7 @@ int main(int argc, char** argv) {
   } else if (role == "flood-sub") {
     ros::Subscriber s;
     if (kind == "small") s = nh.subscribe<std_msgs::String>("/bench_flood", 100000, onFlood<std_msgs::String>);
+    else if (kind == "cloud") s = nh.subscribe<sensor_msgs::PointCloud2>("/bench_flood", 100, onFlood<sensor_msgs::PointCloud2>);
     else s = nh.subscribe<sensor_msgs::Image>("/bench_flood", 100, onFlood<sensor_msgs::Image>);
     printf("{\"ready\": true}\n"); fflush(stdout);
     size_t last = (size_t)-1;
@@ -651,7 +712,7 @@ int main(int argc, char** argv) {
     double span = std::chrono::duration<double>(last - first).count();
     printf("{\"received\": %ld, \"cpu_percent\": %f}\n", received, span > 0 ? 100.0 * (cpu1 - cpu0) / span : 0.0);
   } else if (role == "rate-pub") {
-    sensor_msgs::Image img; int h = kind == "vga" ? 480 : 1080, w = kind == "vga" ? 640 : 1920;
+    sensor_msgs::Image img; int h = heightOf(kind), w = widthOf(kind);
     img.height = h; img.width = w; img.encoding = "bgr8"; img.step = w * 3; img.data.assign(h * w * 3, 0);
     pub = nh.advertise<sensor_msgs::Image>("/bench_rate", queue);
     while (pub.getNumSubscribers() == 0) ros::Duration(0.005).sleep();
@@ -666,18 +727,30 @@ int main(int argc, char** argv) {
   } else {  // flood-pub
     std_msgs::String small; small.data = std::string(20, 'x');
     sensor_msgs::Image img;
-    if (kind != "small") {
-      int h = kind == "vga" ? 480 : 1080, w = kind == "vga" ? 640 : 1920;
+    sensor_msgs::PointCloud2 cloud;
+    if (kind == "cloud") {
+      const char* names[4] = {"x", "y", "z", "intensity"};
+      for (int i = 0; i < 4; ++i) {
+        sensor_msgs::PointField f; f.name = names[i]; f.offset = 4 * i; f.datatype = f.FLOAT32; f.count = 1;
+        cloud.fields.push_back(f);
+      }
+      cloud.height = 1; cloud.width = CLOUD_POINTS; cloud.point_step = 16; cloud.row_step = 16 * CLOUD_POINTS;
+      cloud.data.assign(16 * (size_t)CLOUD_POINTS, 0); cloud.is_dense = true;
+    } else if (kind != "small") {
+      int h = heightOf(kind), w = widthOf(kind);
       img.height = h; img.width = w; img.encoding = "bgr8"; img.step = w * 3; img.data.assign(h * w * 3, 0);
     }
     if (kind == "small") pub = nh.advertise<std_msgs::String>("/bench_flood", queue);
+    else if (kind == "cloud") pub = nh.advertise<sensor_msgs::PointCloud2>("/bench_flood", queue);
     else pub = nh.advertise<sensor_msgs::Image>("/bench_flood", queue);
     while ((int)pub.getNumSubscribers() < std::max(count, 1)) ros::Duration(0.005).sleep();
     ros::Duration(0.3).sleep();
     long sent = 0;
     Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
     while (Clock::now() < end) {
-      for (int i = 0; i < 10; ++i) { if (kind == "small") pub.publish(small); else pub.publish(img); }
+      for (int i = 0; i < 10; ++i) {
+        if (kind == "small") pub.publish(small); else if (kind == "cloud") pub.publish(cloud); else pub.publish(img);
+      }
       sent += 10;
       ros::spinOnce();
     }
@@ -739,6 +812,7 @@ class Runner:
     def __init__(self, args) -> None:
         self.args = args
         self.cpu: dict = {}  # (queue, contender) -> CPU µs per round trip of the ping process
+        self.shm = False  # minros workers may use shared memory (else MINROS_SHM=0: TCPROS)
         self.home = tempfile.mkdtemp(prefix="minros-bench-")
         self.port = _free_port()
         self.reference = os.path.exists(REFERENCE_PYTHON) and subprocess.run(
@@ -779,6 +853,8 @@ class Runner:
         python = {"rospy": REFERENCE_PYTHON, "baseline": self.args.baseline}.get(
             who, self.args.minros_python)
         env = self.env(who == "rospy")
+        if who != "rospy":
+            env["MINROS_SHM"] = "1" if self.shm else "0"
         if who == "minros+trace":
             # both processes append to one fresh trace, every frame of it
             path = os.path.join(self.home, "bench-trace.jsonl")
@@ -956,6 +1032,29 @@ class Runner:
             second = self.command(who, "rate-pub", ["--kind", "hd", "--hz", "30", "--seconds", seconds])
         return self.pair(who, first, second, first_measures=True).get("cpu_percent")
 
+    def shared(self, who: str, measure):
+        """``measure()`` with minros on shared memory; the raw TCP floor beside it, nothing
+        for contenders without shared memory."""
+        if who in ("rospy", "roscpp", "py-min", "raw-1"):
+            return None
+        self.shm = who != "raw"
+        try:
+            return measure()
+        finally:
+            self.shm = False
+
+    def intra(self, who: str, kind: str):
+        """Frames/s one minros process delivers to itself with intraprocess=True."""
+        if who != "minros":
+            return None
+        command, env = self.command(who, "intra-flood", ["--kind", kind, "--queue", "10",
+                                                        "--seconds", str(self.args.seconds)])
+        out = subprocess.run(command, env=env, capture_output=True, text=True, timeout=120).stdout
+        for raw in out.splitlines():
+            if raw.startswith("{"):
+                return json.loads(raw).get("rate")
+        return None
+
     def bringup(self, who: str, nodes: int = 100, topics: int = 10):
         """Seconds from starting ``nodes`` nodes (``topics`` publishers and subscribers each, in a
         ring) until every one of their connections is made."""
@@ -1049,8 +1148,21 @@ SCENARIOS = [
     ("small-message flood (msg/s received)", "flood", lambda r, w: r.flood(w, "small"), "high"),
     ("640x480 bgr8 images (frames/s)", "vga", lambda r, w: r.flood(w, "vga"), "high"),
     ("1920x1080 bgr8 images (frames/s)", "hd", lambda r, w: r.flood(w, "hd"), "high"),
+    ("1920x1080 bgr8, shared memory (frames/s)", "hdshm",
+     lambda r, w: r.shared(w, lambda: r.flood(w, "hd")), "high"),
     ("1920x1080, publisher queue_size=None (frames/s)", "hdsync",
      lambda r, w: r.flood(w, "hd", "none"), "high"),
+    ("3840x2160 bgr8 images (frames/s)", "4k", lambda r, w: r.flood(w, "4k"), "high"),
+    ("3840x2160 bgr8, shared memory (frames/s)", "4kshm",
+     lambda r, w: r.shared(w, lambda: r.flood(w, "4k")), "high"),
+    ("20 MB PointCloud2 (clouds/s)", "cloud", lambda r, w: r.flood(w, "cloud"), "high"),
+    ("20 MB PointCloud2, shared memory (clouds/s)", "cloudshm",
+     lambda r, w: r.shared(w, lambda: r.flood(w, "cloud")), "high"),
+    ("small-message flood, shared memory (msg/s received)", "floodshm",
+     lambda r, w: r.shared(w, lambda: r.flood(w, "small")), "high"),
+    ("round trip, q=10, shared memory (µs)", "lat10shm",
+     lambda r, w: r.shared(w, lambda: r.latency(w, "10")), "low"),
+    ("1920x1080 bgr8, intra-process (frames/s)", "hdintra", lambda r, w: r.intra(w, "hd"), "high"),
     ("idle node memory (MB RSS)", "mem", lambda r, w: r.idle_memory(w), "low"),
     ("service call, persistent (µs)", "srv", lambda r, w: r.service(w, True), "low"),
     ("service call, persistent, one CPU (µs)", "srvsame", lambda r, w: r.service(w, True, "same"), "low"),
@@ -1061,6 +1173,8 @@ SCENARIOS = [
     ("1 publisher -> 8 subscribers, 640x480 (frames/s delivered)", "fanvga",
      lambda r, w: r.fanout(w, "vga"), "high"),
     ("subscriber CPU, 1920x1080 at 30 Hz (% of a core)", "subcpu", lambda r, w: r.subscriber_cpu(w), "low"),
+    ("subscriber CPU, 1920x1080 at 30 Hz, shared memory (% of a core)", "subcpushm",
+     lambda r, w: r.shared(w, lambda: r.subscriber_cpu(w)), "low"),
     ("100 nodes x 10 topics: all connected (s)", "bringup", lambda r, w: r.bringup(w), "low"),
     ("rostopic hz, 10 kHz topic (% of a core)", "hz", lambda r, w: r.tool_cpu(w, "hz"), "low"),
     ("rostopic echo, 10 kHz topic (% of a core)", "echo", lambda r, w: r.tool_cpu(w, "echo"), "low"),

@@ -2,6 +2,7 @@
 """``minros zenoh`` beside TCPROS, in one run: round trip, 1080p frames/s, discovery, loss.
 
     .venv/bin/python benchmarks/zenoh.py [--rounds 3] [--seconds 3] [--count 2000]
+        [--only rtt,hd,discovery,loss] [--baseline OTHER_CHECKOUT/.venv/bin/python]
 
 Two minros masters on loopback, each with its bridge (a listens on a loopback port, b
 connects; no multicast). Contenders, interleaved round by round (the machine is shared: the
@@ -10,14 +11,21 @@ table shows medians of the rounds):
 * round trip of a 20-byte std_msgs/String, each side answering from its receive callback:
   "TCPROS" with both nodes on master a; "2 bridges" with the pinger on a and the echo on b
   (ping: ROS -> bridge a -> Zenoh -> bridge b -> ROS, and the pong back the same way);
-  "Zenoh floor" is two plain zenoh-python sessions echoing the bytes, the least any bridge
-  on eclipse-zenoh can do;
+  "Zenoh floor" is two plain zenoh-python sessions, configured and called as the bridge's,
+  echoing the bytes: the least any bridge on eclipse-zenoh can do;
 * 1920x1080 rgb8 sensor_msgs/Image flood (publisher queue_size=10), frames/s received:
-  TCPROS on one master, and through the two bridges;
+  TCPROS on one master, through the two bridges, and between two plain zenoh-python
+  sessions (the subscriber takes each sample's bytes, as the bridge must);
 * discovery: seconds from a new publisher's Publisher() on a until master b lists the topic
   (bridge b advertised it);
 * loss: seconds from SIGKILL of bridge a until master b no longer lists a topic bridge b was
   publishing for it (its beacons stopped; bridge a is started again for the next round).
+
+Wall-clock figures move with the load of a shared machine; the CPU that each process (the
+publisher, the subscriber, both bridges) spends per round trip or per frame moves much less,
+and it is printed below the table: it shows where the time goes. ``--baseline PY`` adds two
+more bridges run by another checkout's interpreter (their own masters and Zenoh link), so
+two versions of the bridge meet in one run.
 
 This file is also the worker: ``--role ...`` runs one side and prints one JSON line.
 """
@@ -43,6 +51,38 @@ PYTHON = sys.executable
 sys.path[:] = [p for p in sys.path if os.path.abspath(p or os.curdir) != HERE]
 
 # ------------------------------------------------------------------------------------ workers
+
+_TICK = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+
+
+def _cpu_seconds(pid: int) -> float:
+    """User + system CPU of every thread of process ``pid`` so far (Linux /proc), or nan."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rpartition(")")[2].split()
+        return (int(fields[11]) + int(fields[12])) / _TICK
+    except (OSError, IndexError, ValueError):
+        return float("nan")
+
+
+class _Watch:
+    """CPU seconds of the processes named in ``--watch`` (label=pid,...) and this one, between
+    ``start()`` and ``stop()``: what each process spends per message, whatever the load."""
+
+    def __init__(self, spec: str, me: str) -> None:
+        self.pids = {me: os.getpid()}
+        for item in filter(None, spec.split(",")):
+            label, _, pid = item.partition("=")
+            self.pids[label] = int(pid)
+        self.before: dict = {}
+
+    def start(self) -> None:
+        self.before = {label: _cpu_seconds(pid) for label, pid in self.pids.items()}
+
+    def per(self, count: int) -> dict:
+        """Milliseconds of CPU per one of ``count`` messages, by process."""
+        return {label: (_cpu_seconds(pid) - self.before[label]) * 1e3 / max(count, 1)
+                for label, pid in self.pids.items()}
 
 
 def _init(name: str):
@@ -80,8 +120,11 @@ def role_ping(args) -> None:
         pub.publish(msg)
         got.wait(0.05)
     time.sleep(0.3)
+    watch = _Watch(args.watch, "ping")
     times = []
     for i in range(args.count + 200):
+        if i == 200:
+            watch.start()
         got.clear()
         t = time.perf_counter()
         pub.publish(msg)
@@ -89,9 +132,11 @@ def role_ping(args) -> None:
             continue
         if i >= 200:
             times.append(time.perf_counter() - t)
+    cpu = watch.per(args.count)
     times.sort()
     print(json.dumps({"median_us": statistics.median(times) * 1e6,
-                      "p95_us": times[int(len(times) * 0.95)] * 1e6, "n": len(times)}), flush=True)
+                      "p95_us": times[int(len(times) * 0.95)] * 1e6, "n": len(times),
+                      "cpu_ms": cpu}), flush=True)
     rospy.signal_shutdown("done")
 
 
@@ -113,8 +158,13 @@ def role_flood_pub(args) -> None:
         time.sleep(0.01)
     print(json.dumps({"ready": True}), flush=True)
     end = time.monotonic() + args.seconds + 30
+    period = 1.0 / args.pace if args.pace else 0.0
+    due = time.monotonic()
     while time.monotonic() < end and not rospy.is_shutdown():
         pub.publish(msg)
+        if period:  # paced: what a frame costs each process, below saturation
+            due += period
+            time.sleep(max(0.0, due - time.monotonic()))
 
 
 def role_flood_sub(args) -> None:
@@ -128,11 +178,14 @@ def role_flood_sub(args) -> None:
         if time.monotonic() > deadline:
             raise SystemExit("no frames")
         time.sleep(0.01)
+    watch = _Watch(args.watch, "sub")
     start = len(stamps)
+    watch.start()
     time.sleep(args.seconds)
     end = len(stamps)
+    cpu = watch.per(end - start)
     rate = (end - start - 1) / (stamps[end - 1] - stamps[start]) if end - start > 1 else 0.0
-    print(json.dumps({"rate": rate}), flush=True)
+    print(json.dumps({"rate": rate, "cpu_ms": cpu}), flush=True)
     rospy.signal_shutdown("done")
 
 
@@ -149,15 +202,63 @@ def role_advertise(args) -> None:
 
 
 def _zenoh_session(listen=None, connect=None):
+    """A plain session configured as the bridge's (its transport settings), no ROS."""
     import zenoh
 
-    config = zenoh.Config()
-    config.insert_json5("scouting/multicast/enabled", "false")
-    if listen:
-        config.insert_json5("listen/endpoints", json.dumps([listen]))
-    if connect:
-        config.insert_json5("connect/endpoints", json.dumps([connect]))
-    return zenoh.open(config)
+    from minros.zenoh.bridge import Options, zenoh_config
+
+    options = Options(listen=[listen] if listen else [], connect=[connect] if connect else [],
+                      multicast_scouting=False)
+    return zenoh.open(zenoh_config(options))
+
+
+def role_zflood_sub(args) -> None:
+    """The Zenoh floor of the 1080p flood: every sample's bytes taken into Python, as any
+    Python consumer (and the bridge) must."""
+    session = _zenoh_session(connect=args.endpoint)
+    stamps: list = []
+
+    def on_sample(sample) -> None:
+        sample.payload.to_bytes()
+        stamps.append(time.perf_counter())
+
+    session.declare_subscriber("zb/image", on_sample)
+    print(json.dumps({"ready": True}), flush=True)
+    deadline = time.monotonic() + 40
+    while len(stamps) < 20:
+        if time.monotonic() > deadline:
+            raise SystemExit("no zenoh frames")
+        time.sleep(0.01)
+    watch = _Watch(args.watch, "sub")
+    start = len(stamps)
+    watch.start()
+    time.sleep(args.seconds)
+    end = len(stamps)
+    cpu = watch.per(end - start)
+    rate = (end - start - 1) / (stamps[end - 1] - stamps[start]) if end - start > 1 else 0.0
+    print(json.dumps({"rate": rate, "cpu_ms": cpu}), flush=True)
+    session.close()
+
+
+def role_zflood_pub(args) -> None:
+    import zenoh
+
+    session = _zenoh_session(listen=args.endpoint)
+    pub = session.declare_publisher("zb/image", congestion_control=zenoh.CongestionControl.BLOCK,
+                                    reliability=zenoh.Reliability.RELIABLE)
+    data = _image()[1].data
+    payload = b"\0" * 29 + data  # an Image's header fields, then its pixels
+    end = time.monotonic() + args.seconds + 30
+    period = 1.0 / args.pace if args.pace else 0.0
+    due = time.monotonic()
+    try:
+        while time.monotonic() < end:
+            pub.put(payload)
+            if period:
+                due += period
+                time.sleep(max(0.0, due - time.monotonic()))
+    except KeyboardInterrupt:  # the runner's stop
+        pass
 
 
 def role_zpong(args) -> None:
@@ -186,21 +287,26 @@ def role_zping(args) -> None:
             raise SystemExit("no zenoh pong")
         pub.put(payload)
         got.wait(0.05)
+    watch = _Watch(args.watch, "ping")
     times = []
     for i in range(args.count + 200):
+        if i == 200:
+            watch.start()
         got.clear()
         t = time.perf_counter()
         pub.put(payload)
         if got.wait(2.0) and i >= 200:
             times.append(time.perf_counter() - t)
+    cpu = watch.per(args.count)
     times.sort()
     print(json.dumps({"median_us": statistics.median(times) * 1e6,
-                      "p95_us": times[int(len(times) * 0.95)] * 1e6, "n": len(times)}), flush=True)
+                      "p95_us": times[int(len(times) * 0.95)] * 1e6, "n": len(times),
+                      "cpu_ms": cpu}), flush=True)
 
 
 ROLES = {"echo": role_echo, "ping": role_ping, "flood_pub": role_flood_pub,
          "flood_sub": role_flood_sub, "advertise": role_advertise, "zpong": role_zpong,
-         "zping": role_zping}
+         "zping": role_zping, "zflood_pub": role_zflood_pub, "zflood_sub": role_zflood_sub}
 
 # ------------------------------------------------------------------------------------- runner
 
@@ -214,8 +320,11 @@ def _free_port() -> int:
 
 
 class Site:
-    def __init__(self, name: str, home: str) -> None:
+    """A master, and the bridge its ``python`` runs (another checkout's for the baseline)."""
+
+    def __init__(self, name: str, home: str, python: str = PYTHON) -> None:
         self.port = _free_port()
+        self.python = python
         self.home = os.path.join(home, name)
         os.makedirs(os.path.join(self.home, "log"))
         self.env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
@@ -243,7 +352,8 @@ class Site:
 
     def start_bridge(self, *args: str) -> None:
         self.bridge_args = args
-        self.bridge = self.spawn([PYTHON, "-m", "minros", "zenoh", "--no-multicast-scouting", *args])
+        self.bridge = self.spawn([self.python, "-m", "minros", "zenoh", "--no-multicast-scouting",
+                                  *args])
         line = self.bridge.stdout.readline()
         if "bridging the master" not in line:
             raise SystemExit(f"bridge did not start: {line}")
@@ -253,6 +363,30 @@ class Site:
     def published(self, topic: str, by: str = "") -> bool:
         pubs = xmlrpc.client.ServerProxy(self.env["ROS_MASTER_URI"]).getSystemState("/b")[2][0]
         return any(t == topic and (not by or by in nodes) for t, nodes in pubs)
+
+
+class Pair:
+    """Two sites joined by their bridges (a listens, b connects), or one site for TCPROS."""
+
+    def __init__(self, a: Site, b: Site | None) -> None:
+        self.a, self.b = a, b or a
+
+    def start(self) -> None:
+        if self.b is not self.a:
+            endpoint = f"tcp/127.0.0.1:{_free_port()}"
+            self.a.start_bridge("--listen", endpoint)
+            self.b.start_bridge("--connect", endpoint)
+
+    def watch(self, **pids: int) -> str:
+        """``--watch`` of the bridges and the given workers."""
+        if self.b is not self.a:
+            pids.update(bridge_a=self.a.bridge.pid, bridge_b=self.b.bridge.pid)
+        return ",".join(f"{label}={pid}" for label, pid in pids.items())
+
+    def stop(self) -> None:
+        for site in {id(s): s for s in (self.b, self.a)}.values():
+            _stop(site.bridge)
+            _stop(site.master)
 
 
 def _stop(proc) -> None:
@@ -275,18 +409,18 @@ def _result(proc, timeout: float = 120) -> dict:
     return json.loads(lines[-1])
 
 
-def rtt(a: Site, b: Site, where: str, count: int, n: int) -> float:
+def rtt(pair: Pair, count: int, n: int) -> dict:
     ping, pong = f"/zb_ping_{n}", f"/zb_pong_{n}"
-    echo_site = a if where == "TCPROS" else b
-    echo = echo_site.role("echo", "--ping", ping, "--pong", pong)
+    echo = pair.b.role("echo", "--ping", ping, "--pong", pong)
     try:
         echo.stdout.readline()
-        return _result(a.role("ping", "--ping", ping, "--pong", pong, "--count", str(count)))["median_us"]
+        return _result(pair.a.role("ping", "--ping", ping, "--pong", pong, "--count", str(count),
+                                   "--watch", pair.watch(echo=echo.pid)))
     finally:
         _stop(echo)
 
 
-def zenoh_floor(count: int) -> float:
+def zenoh_floor(count: int) -> dict:
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
     env = dict(os.environ)
     pong = subprocess.Popen([PYTHON, __file__, "--role", "zpong", "--endpoint", endpoint],
@@ -294,19 +428,38 @@ def zenoh_floor(count: int) -> float:
     try:
         pong.stdout.readline()
         ping = subprocess.run([PYTHON, __file__, "--role", "zping", "--endpoint", endpoint,
-                               "--count", str(count)], capture_output=True, text=True, timeout=120)
-        return json.loads(ping.stdout.strip().splitlines()[-1])["median_us"]
+                               "--count", str(count), "--watch", f"echo={pong.pid}"],
+                              capture_output=True, text=True, timeout=120)
+        return json.loads(ping.stdout.strip().splitlines()[-1])
     finally:
         pong.stdin.close()
         pong.wait(10)
 
 
-def flood(a: Site, b: Site, where: str, seconds: float, n: int) -> float:
+def flood(pair: Pair, seconds: float, n: int, pace: float) -> dict:
     topic = f"/zb_image_{n}"
-    sub = (a if where == "TCPROS" else b).role("flood_sub", "--topic", topic, "--seconds", str(seconds))
-    pub = a.role("flood_pub", "--topic", topic, "--seconds", str(seconds))
+    pub = pair.a.role("flood_pub", "--topic", topic, "--seconds", str(seconds), "--pace", str(pace))
+    sub = pair.b.role("flood_sub", "--topic", topic, "--seconds", str(seconds),
+                      "--watch", pair.watch(pub=pub.pid))
     try:
-        return _result(sub)["rate"]
+        return _result(sub)
+    finally:
+        _stop(pub)
+        _stop(sub)
+
+
+def zenoh_flood_floor(seconds: float, pace: float) -> dict:
+    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    # the publisher listens and puts from the start (to no one at first), so that the
+    # subscriber, connecting, knows the pid to watch
+    pub = subprocess.Popen([PYTHON, __file__, "--role", "zflood_pub", "--endpoint", endpoint,
+                            "--seconds", str(seconds), "--pace", str(pace)], stdout=subprocess.DEVNULL,
+                           start_new_session=True)
+    sub = subprocess.Popen([PYTHON, __file__, "--role", "zflood_sub", "--endpoint", endpoint,
+                            "--seconds", str(seconds), "--watch", f"pub={pub.pid}"],
+                           stdout=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        return _result(sub)
     finally:
         _stop(pub)
         _stop(sub)
@@ -361,6 +514,9 @@ def loss(a: Site, b: Site, n: int) -> float:
         a.start_bridge(*a.bridge_args)
 
 
+MEASURES = ("rtt", "hd", "discovery", "loss")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--role", choices=sorted(ROLES))
@@ -368,49 +524,100 @@ def main(argv=None) -> int:
     parser.add_argument("--pong", default="/zb_pong")
     parser.add_argument("--topic", default="/zb_image")
     parser.add_argument("--endpoint", default="")
-    parser.add_argument("--count", type=int, default=2000)
-    parser.add_argument("--seconds", type=float, default=3.0)
+    parser.add_argument("--watch", default="", help=argparse.SUPPRESS)
+    parser.add_argument("--count", type=int, default=2000,
+                        help="round trips per round (default 2000)")
+    parser.add_argument("--seconds", type=float, default=3.0,
+                        help="seconds of 1080p frames per round (default 3)")
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--pace", type=float, default=0.0, metavar="FPS",
+                        help="publish the 1080p frames at this rate instead of flooding: the CPU "
+                             "per frame below saturation, for comparing versions on a busy machine")
+    parser.add_argument("--only", default=",".join(MEASURES),
+                        help=f"measures to run, of {','.join(MEASURES)} (default all)")
+    parser.add_argument("--baseline", default="", metavar="PY",
+                        help="add 'baseline': two more bridges run by this interpreter (another "
+                             "checkout's venv), so two versions of the bridge meet in one run")
     args = parser.parse_args(argv)
     if args.role:
         ROLES[args.role](args)
         return 0
+    only = set(args.only.split(","))
+    if only - set(MEASURES):
+        parser.error(f"--only: unknown {','.join(sorted(only - set(MEASURES)))}")
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))  # stopped: the finally below cleans up
     home = tempfile.mkdtemp(prefix="zenoh-bench-")
-    a, b = Site("a", home), Site("b", home)
-    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    pairs: dict = {}
     results: dict = {}
     try:
-        a.start_bridge("--listen", endpoint)
-        b.start_bridge("--connect", endpoint)
+        a, b = Site("a", home), Site("b", home)
+        pairs["TCPROS"] = Pair(a, None)
+        pairs["2 bridges"] = Pair(a, b)
+        if args.baseline:
+            pairs["baseline"] = Pair(Site("a0", home, args.baseline), Site("b0", home, args.baseline))
+        for pair in pairs.values():
+            pair.start()
+        bridged = [w for w in pairs if w != "TCPROS"]
         for r in range(args.rounds):
-            for where in ("TCPROS", "2 bridges"):
-                results.setdefault(("rtt", where), []).append(rtt(a, b, where, args.count, r))
-            results.setdefault(("rtt", "Zenoh floor"), []).append(zenoh_floor(args.count))
-            for where in ("TCPROS", "2 bridges"):
-                results.setdefault(("hd", where), []).append(flood(a, b, where, args.seconds, r))
-            results.setdefault(("discovery", "2 bridges"), []).append(discovery(a, b, r))
-            results.setdefault(("loss", "2 bridges"), []).append(loss(a, b, r))
+            if "rtt" in only:
+                for where, pair in pairs.items():
+                    results.setdefault(("rtt", where), []).append(rtt(pair, args.count, r))
+                results.setdefault(("rtt", "Zenoh floor"), []).append(zenoh_floor(args.count))
+            if "hd" in only:
+                for where, pair in pairs.items():
+                    results.setdefault(("hd", where), []).append(flood(pair, args.seconds, r, args.pace))
+                results.setdefault(("hd", "Zenoh floor"), []).append(zenoh_flood_floor(args.seconds, args.pace))
+            for where in bridged:
+                pair = pairs[where]
+                if "discovery" in only:
+                    results.setdefault(("discovery", where), []).append(
+                        {"value": discovery(pair.a, pair.b, r)})
+                if "loss" in only:
+                    results.setdefault(("loss", where), []).append(
+                        {"value": loss(pair.a, pair.b, r)})
             print(f"round {r + 1}/{args.rounds} done", file=sys.stderr, flush=True)
     finally:
-        for site in (b, a):
-            _stop(site.bridge)
-            _stop(site.master)
-    rows = [("small-message round trip (us)", "rtt", "<= 300"),
-            ("1920x1080 rgb8 frames/s received", "hd", ">= 300"),
-            ("new remote topic listed after (s)", "discovery", "<= 1.5"),
-            ("remote loss noticed after (s)", "loss", "<= 3.5")]
+        for pair in pairs.values():
+            pair.stop()
+    report(args, results, list(pairs) + ["Zenoh floor"])
+    return 0
+
+
+def report(args, results: dict, columns: list) -> None:
+    rows = [("small-message round trip (us)", "rtt", "median_us", "<= 300"),
+            ("1920x1080 rgb8 frames/s received", "hd", "rate", ">= 300"),
+            ("new remote topic listed after (s)", "discovery", "value", "<= 1.5"),
+            ("remote loss noticed after (s)", "loss", "value", "<= 3.5")]
     load = os.getloadavg()[0]
     print(f"\nminros zenoh vs TCPROS, median of {args.rounds} interleaved rounds "
           f"(python {sys.version.split()[0]}, {os.cpu_count()} CPUs, load average {load:.1f})\n")
-    print(f"{'measure':36} {'TCPROS':>10} {'2 bridges':>10} {'Zenoh floor':>12} {'target':>8}")
-    for title, kind, target in rows:
+    print(f"{'measure':36}" + "".join(f"{c:>13}" for c in columns) + f"{'target':>8}")
+    for title, kind, field, target in rows:
+        if not any((kind, c) in results for c in columns):
+            continue
         cells = []
-        for where in ("TCPROS", "2 bridges", "Zenoh floor"):
-            values = results.get((kind, where))
+        for where in columns:
+            values = [r[field] for r in results.get((kind, where), [])]
             cells.append(f"{statistics.median(values):.3g}" if values else "-")
-        print(f"{title:36} {cells[0]:>10} {cells[1]:>10} {cells[2]:>12} {target:>8}")
-    return 0
+        print(f"{title:36}" + "".join(f"{c:>13}" for c in cells) + f"{target:>8}")
+    # CPU per message: what each process spends, which the load does not change much
+    for kind, unit in (("rtt", "round trip (us)"), ("hd", "frame (ms)")):
+        labels: list = []
+        for where in columns:
+            for r in results.get((kind, where), []):
+                labels += [k for k in r.get("cpu_ms", {}) if k not in labels]
+        if not labels:
+            continue
+        print(f"\nCPU per {unit}, by process")
+        for label in labels + ["total"]:
+            cells = []
+            for where in columns:
+                values = [sum(r["cpu_ms"].values()) if label == "total" else r["cpu_ms"][label]
+                          for r in results.get((kind, where), []) if label in r.get("cpu_ms", {})
+                          or (label == "total" and r.get("cpu_ms"))]
+                scale = 1e3 if kind == "rtt" else 1.0
+                cells.append(f"{statistics.median(values) * scale:.3g}" if values else "-")
+            print(f"{'  ' + label:36}" + "".join(f"{c:>13}" for c in cells))
 
 
 if __name__ == "__main__":

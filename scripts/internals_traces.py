@@ -98,7 +98,10 @@ class Session:
                     if not k.startswith(("ROS_", "MINROS_")) and k != "PYTHONPATH"}
         self.env.update(ROS_MASTER_URI=f"http://localhost:{self.port}", ROS_HOSTNAME="localhost",
                         ROS_HOME=str(home), ROS_LOG_DIR=str(home / "log"),
-                        PYTHONUNBUFFERED="1", MINROS_HEADLESS="1")
+                        PYTHONUNBUFFERED="1", MINROS_HEADLESS="1",
+                        # the page teaches TCPROS: two minros nodes of one host would take
+                        # shared memory (MINROSSHM, README "Shared memory")
+                        MINROS_SHM="0")
         self.procs: Dict[str, subprocess.Popen] = {}
 
     def path(self, name: str) -> Path:

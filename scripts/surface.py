@@ -54,6 +54,8 @@ EXCLUSIONS: Dict[str, str] = {
     "rosboost_cfg.*": "rosbuild's Boost flags for C++ builds",
     "gencpp.*": "the C++ message generator, run by catkin at build time",
     "genlisp.*": "the Lisp message generator, run by catkin at build time",
+    "genmsg.template_tools": "the empy-template code writer of the C++/Lisp/EusLisp message "
+                             "generators, run by catkin at build time",
     "nodelet_topic_tools.*": "parameter configs of C++ nodelets (throttle), no Python API",
     "dynamic_reconfigure.cfg.TestConfig": "config of dynamic_reconfigure's own C++ test node",
     "joint_state_publisher_gui": "a Qt window of sliders (GUI only); the joint_state_publisher "

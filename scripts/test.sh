@@ -69,7 +69,19 @@ for entry in "${others[@]}"; do
   pids+=("$v:$!")
 done
 status=0
-.venv/bin/python -m pytest "$@" || status=$?
+# The main run in parallel workers (pytest-xdist; WORKERS=1 runs it in one process): a test
+# spends most of its time waiting on the processes it starts, so three workers on two CPUs
+# finish far sooner than one. Every test picks free ports and its own ROS_HOME, so workers do
+# not meet. The tests marked `timing` run afterwards on their own, with no workers beside them.
+workers=${WORKERS:-3}
+if [ "$workers" -gt 1 ]; then
+  .venv/bin/python -m pytest -n "$workers" -m "not timing" "$@" || status=$?
+  code=0
+  .venv/bin/python -m pytest -m timing "$@" || code=$?
+  [ "$code" -eq 0 ] || [ "$code" -eq 5 ] || status=$code  # 5: the arguments chose no timing test
+else
+  .venv/bin/python -m pytest "$@" || status=$?
+fi
 for entry in "${pids[@]}"; do
   v=${entry%%:*}
   if wait "${entry#*:}"; then

@@ -7,6 +7,7 @@ between bit depths, a scaled ``convertTo`` the way cv_bridge's C++ core scales t
 
 from __future__ import annotations
 
+import mmap
 import re
 import sys
 from typing import Any, Dict, Tuple
@@ -89,7 +90,8 @@ class CvBridge:
 
     # -- conversions --
     def imgmsg_to_cv2(self, img_msg: Any, desired_encoding: str = "passthrough") -> np.ndarray:
-        """A numpy image of ``img_msg``; with ``passthrough`` a view onto the message data."""
+        """A numpy image of ``img_msg``; with ``passthrough`` a view onto the message data
+        (a copy when that data is a shared-memory slot, valid only during a callback)."""
         dtype_name, channels = self.encoding_to_dtype_with_channels(img_msg.encoding)
         dtype = np.dtype(dtype_name).newbyteorder(">" if img_msg.is_bigendian else "<")
         height, width = int(img_msg.height), int(img_msg.width)
@@ -107,6 +109,10 @@ class CvBridge:
         strides = (step, channels * dtype.itemsize) if channels == 1 else (
             step, channels * dtype.itemsize, dtype.itemsize)
         image = np.ndarray(shape=shape, dtype=dtype, buffer=data, strides=strides)
+        if isinstance(data, memoryview) and isinstance(data.obj, mmap.mmap):
+            # a shared-memory slot (MINROSSHM), the publisher's again once the callback returns:
+            # the image, often kept, gets pixels of its own
+            image = image.copy()
         if dtype.byteorder not in ("=", "|") and (dtype.byteorder == ">") == (sys.byteorder == "little"):
             image = image.byteswap().view(dtype.newbyteorder("="))
         if desired_encoding == "passthrough" or desired_encoding == img_msg.encoding:

@@ -20,3 +20,5 @@ from minros.dynamic_reconfigure.generator import (  # noqa: F401
     int_t,
     str_t,
 )
+
+LINEDEBUG = "//#line"

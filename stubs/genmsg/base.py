@@ -31,3 +31,6 @@ def log(*args: object) -> None:
 def plog(msg: str, obj: object) -> None:
     if _verbose:
         print(f"{msg}: {obj}")
+
+
+verbose = False

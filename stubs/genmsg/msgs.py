@@ -1,5 +1,7 @@
 """genmsg.msgs: specs, fields, constants and type-name rules (minros.msgs.loader)."""
 
+from genmsg.base import log  # noqa: E402, F401
+from genmsg.names import resource_name  # noqa: E402, F401
 from minros.msgs.loader import (  # noqa: F401
     BUILTIN_TYPES,
     DURATION,
@@ -27,3 +29,7 @@ from minros.names import (  # noqa: F401
     is_legal_resource_name,
     package_resource_name,
 )
+
+EXT_MSG = ".msg"
+MSG_DIR = "msg"
+SEP = "/"

@@ -1,5 +1,6 @@
 """genpy.generator: Python message modules as genpy writes them (minros.msgs.pygen)."""
 
+from genmsg.base import log  # noqa: E402, F401
 from minros.msgs.loader import (  # noqa: F401 - genpy.generator's namespace has them
     InvalidMsgSpec,
     MsgContext,

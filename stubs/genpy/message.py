@@ -41,3 +41,5 @@ def get_message_class(message_type: str, reload_on_error: bool = False) -> Any:
 def get_service_class(service_type: str, reload_on_error: bool = False) -> Any:
     """The class of service ``pkg/Type``, or None when there is none (genpy's contract)."""
     return import_class(service_type, "srv")
+
+from genpy.base import is_simple  # noqa: E402, F401

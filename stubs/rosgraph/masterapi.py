@@ -11,3 +11,5 @@ from minros.tools.master import (  # noqa: F401
     ROSMasterException,
     is_online,
 )
+from rosgraph.names import make_caller_id  # noqa: E402, F401
+from rosgraph.rosenv import get_master_uri  # noqa: E402, F401

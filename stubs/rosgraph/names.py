@@ -25,3 +25,6 @@ from minros.names import (  # noqa: F401
 
 MSG_EXT = ".msg"
 SRV_EXT = ".srv"
+
+
+ROS_NAMESPACE = "ROS_NAMESPACE"

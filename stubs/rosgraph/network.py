@@ -47,3 +47,11 @@ def write_ros_handshake_header(sock, header: dict) -> int:  # noqa: ANN001
     data = encode_ros_handshake_header(header)
     sock.sendall(data)
     return len(data)
+
+
+ROS_HOSTNAME = "ROS_HOSTNAME"
+ROS_IP = "ROS_IP"
+ROS_IPV6 = "ROS_IPV6"
+SIOCGIFADDR = 35093
+SIOCGIFCONF = 35090
+python3 = 1

@@ -8,3 +8,5 @@ from minros.roslogging import (  # noqa: F401
     makedirs_with_parent_perms,
     renew_latest_logdir,
 )
+
+ROS_LOG_DIR = "ROS_LOG_DIR"

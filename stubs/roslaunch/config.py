@@ -9,3 +9,6 @@ from minros.launch.rosmodel import (  # noqa: F401
     load_roscore,
     namespaces_of,
 )
+from roslaunch.core import Master, RLException, is_machine_local, local_machine  # noqa: E402, F401
+
+DEFAULT_MASTER_PORT = 11311

@@ -1,5 +1,7 @@
 """roslaunch.core: roslaunch's data model (minros.launch.rosmodel, minros.launch.api)."""
 
+from rospkg.environment import get_ros_package_path, get_ros_root  # noqa: E402, F401
+
 from minros.launch.api import Node  # noqa: F401
 from minros.launch.rosmodel import (  # noqa: F401
     PHASE_RUN,

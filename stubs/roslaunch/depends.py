@@ -12,3 +12,7 @@ from minros.launch.rostools import (  # noqa: F401
 )
 
 NAME = "roslaunch-deps"
+
+from rosgraph.names import load_mappings  # noqa: E402, F401
+from roslaunch.loader import convert_value  # noqa: E402, F401
+from roslaunch.substitution_args import resolve_args  # noqa: E402, F401

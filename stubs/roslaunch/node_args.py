@@ -11,3 +11,6 @@ from minros.launch.rostools import (  # noqa: F401
     print_node_filename,
     print_node_list,
 )
+from rosgraph.names import script_resolve_name  # noqa: E402, F401
+from roslaunch.config import load_config_default  # noqa: E402, F401
+from roslaunch.core import RLException, local_machine, setup_env  # noqa: E402, F401

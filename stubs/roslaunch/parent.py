@@ -8,5 +8,6 @@ from minros.launch.rosserver import (  # noqa: F401
     DEFAULT_TIMEOUT_SIGTERM,
     ROSLaunchParent,
 )
+from roslaunch.core import RLException, printerrlog, printlog_bold  # noqa: E402, F401
 
 from . import config, launch, pmon, server  # noqa: F401 - roslaunch.parent imports them

@@ -6,6 +6,8 @@ from minros.launch.rosserver import (  # noqa: F401
     DEFAULT_TIMEOUT_SIGINT,
     DEFAULT_TIMEOUT_SIGTERM,
     ROSRemoteRunner,
+    SSHChildROSLaunchProcess,
 )
+from roslaunch.core import RLException, is_machine_local, printerrlog, printlog  # noqa: E402, F401
 
 from . import launch  # noqa: F401 - roslaunch.remote imports it

@@ -14,3 +14,6 @@ def resolve_launch_arguments(args: List[str]) -> List[str]:
     from minros.cli.launch import resolve_launch_arguments as resolve
 
     return resolve(list(args))[0]
+
+
+DEFAULT_MASTER_PORT = 11311

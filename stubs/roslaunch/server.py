@@ -16,5 +16,13 @@ from minros.launch.rosserver import (  # noqa: F401
     ROSLaunchParentNode,
     _ProcessListenerForwarder,
 )
+from roslaunch.core import (  # noqa: E402, F401
+    RLException,
+    add_printerrlog_handler,
+    add_printlog_handler,
+    printerrlog,
+    printlog,
+    printlog_bold,
+)
 
 from . import config, launch, pmon, xmlloader  # noqa: F401 - roslaunch.server imports them

@@ -12,3 +12,4 @@ from minros.launch.rosmodel import (  # noqa: F401
     _optenv,
     resolve_args,
 )
+from roslaunch.loader import convert_value  # noqa: E402, F401

@@ -8,6 +8,7 @@ from rospkg.manifest import InvalidManifest as ManifestException  # noqa: F401
 from rospkg.manifest import Manifest  # noqa: F401
 
 from minros.packages import MANIFEST_FILE, manifest_file, parse_manifest_file, parse_manifest_text
+from minros.workspace.rosbuild import Depend, Export, ROSDep, VersionControl  # noqa: F401
 
 
 def load_manifest(package: str) -> Any:
@@ -23,5 +24,5 @@ def parse(string: str, filename: str = "string") -> Any:
     return parse_manifest_text(string, filename)
 
 
-__all__ = ["MANIFEST_FILE", "Manifest", "ManifestException", "load_manifest", "manifest_file",
+__all__ = ["MANIFEST_FILE", "Depend", "Export", "ROSDep", "VersionControl", "Manifest", "ManifestException", "load_manifest", "manifest_file",
            "parse", "parse_file"]

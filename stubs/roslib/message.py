@@ -11,3 +11,4 @@ from genpy.message import (  # noqa: F401
     get_service_class,
     strify_message,
 )
+from genpy.rostime import Duration, Time, TVal  # noqa: E402, F401

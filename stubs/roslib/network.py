@@ -7,3 +7,9 @@ from rosgraph.network import (  # noqa: F401
     read_ros_handshake_header,
     write_ros_handshake_header,
 )
+
+ROS_HOSTNAME = "ROS_HOSTNAME"
+ROS_IP = "ROS_IP"
+SIOCGIFADDR = 35093
+SIOCGIFCONF = 35090
+python3 = 1

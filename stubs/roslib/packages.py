@@ -59,3 +59,6 @@ def find_resource(pkg: str, resource_name: str, filter_fn: Callable[[str], bool]
                   rospack: Any = None) -> List[str]:
     """Files named ``resource_name`` in package ``pkg``."""
     return packages.find_resource(pkg, resource_name, filter_fn)
+
+
+PIPE = -1

@@ -57,3 +57,7 @@ def get_log_dir(env: Mapping[str, str] | None = None) -> str:
 
 def get_test_results_dir(env: Mapping[str, str] | None = None) -> str:
     return str(rosenv.test_results_dir(env))
+
+
+ROS_BINDEPS_PATH = "ROS_BINDEPS_PATH"
+ROS_BOOST_ROOT = "ROS_BOOST_ROOT"

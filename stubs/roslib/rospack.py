@@ -59,3 +59,6 @@ def rosstack_depends(s: str) -> List[str]:
 
 def rosstack_depends_1(s: str) -> List[str]:
     return _rosstack(s, reverse=False, direct=True)
+
+
+python3 = True

@@ -13,3 +13,6 @@ def rosmaster_main(argv: Sequence[str] = sys.argv, stdout: IO[str] = sys.stdout,
                    env: Mapping[str, str] = os.environ) -> None:
     """Run a master until it is shut down: ``rosmaster --core [-p PORT] [-w N] [-t SECS]``."""
     sys.exit(_master.main(list(argv[1:]), prog="rosmaster"))
+
+
+NUM_WORKERS = 3

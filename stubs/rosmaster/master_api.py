@@ -28,3 +28,24 @@ class ROSMasterHandler(MasterHandler):
 
     def _ok(self) -> bool:
         return not self._shutdown_requested.is_set()
+
+from rosgraph.names import resolve_name  # noqa: E402, F401
+from rosgraph.xmlrpc import XmlRpcHandler  # noqa: E402, F401
+from rosmaster.registrations import RegistrationManager  # noqa: E402, F401
+from rosmaster.util import xmlrpcapi  # noqa: E402, F401
+from rosmaster.validators import (  # noqa: E402, F401
+    ParameterInvalid,
+    empty_or_valid_name,
+    is_api,
+    is_service,
+    is_topic,
+    non_empty,
+    non_empty_str,
+    not_none,
+    valid_name,
+    valid_type_name,
+)
+
+MSG = 1
+STATUS = 0
+VAL = 2

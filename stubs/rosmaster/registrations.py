@@ -29,3 +29,5 @@ class RegistrationManager(_master.RegistrationManager):
                                    (old_api, caller_id, "new node registered with same name"))
         super().__init__(on_bump=bump)
         self.thread_pool = thread_pool
+
+from rosmaster.util import remove_server_proxy, xmlrpcapi  # noqa: E402, F401

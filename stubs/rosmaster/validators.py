@@ -19,3 +19,9 @@ from minros.wire.rosapi import (  # noqa: F401
 
 def isstring(s: object) -> bool:
     return isinstance(s, str)
+
+from rosgraph.names import resolve_name  # noqa: E402, F401
+
+ANYTYPE = "*"
+ROSRPC = "rosrpc://"
+TYPE_SEPARATOR = "/"

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import logging
-import sys
 from typing import Any
 
+from minros.launch.rostestparent import printlog, printlogerr  # noqa: F401
 from minros.tools.junitxml import create_xml_runner as createXMLRunner  # noqa: F401, N812
 from minros.tools.junitxml import (  # noqa: F401
     print_runner_summary,
@@ -17,18 +16,6 @@ from minros.tools.junitxml import print_unittest_summary as printSummary  # noqa
 from minros.tools.junitxml import xml_results_file as xmlResultsFile  # noqa: F401, N812
 
 _errors: Any = None
-
-
-def printlog(msg: str, *args: Any) -> None:
-    msg = msg % args if args else msg
-    logging.getLogger("rostest").info(msg)
-    print("[ROSTEST]" + msg)
-
-
-def printlogerr(msg: str, *args: Any) -> None:
-    msg = msg % args if args else msg
-    logging.getLogger("rostest").error(msg)
-    print("[ROSTEST]" + msg, file=sys.stderr)
 
 
 def getErrors() -> Any:  # noqa: N802 - rostest's name

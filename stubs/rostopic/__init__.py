@@ -33,3 +33,5 @@ from minros.cli.topic import get_nested_attribute as _get_nested_attribute  # no
 from minros.cli.topic import get_topic_list_api as get_topic_list  # noqa: F401
 from minros.cli.topic import get_topic_type_now as _get_topic_type  # noqa: F401
 from minros.cli.topic import master_get_topic_types_api as _master_get_topic_types  # noqa: F401
+from minros.cli.topic import str_plot as _str_plot  # noqa: F401
+from minros.cli.topic import str_plot_fields as _str_plot_fields  # noqa: F401

@@ -21,3 +21,5 @@ def unitrun(package: str, test_name: str, test: Any, sysargs: Sequence[str] | No
 
     if not run_suite(package, test_name, test, sysargs).wasSuccessful():
         sys.exit(1)
+
+from rosunit.baretest import print_runner_summary, print_unittest_summary  # noqa: E402, F401

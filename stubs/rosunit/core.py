@@ -9,3 +9,6 @@ from minros.tools.junitxml import (  # noqa: F401
     rostest_name_from_path,
     xml_results_file,
 )
+from rosunit.xmlrunner import XMLTestRunner  # noqa: E402, F401
+
+XML_OUTPUT_FLAG = "--gtest_output=xml:"

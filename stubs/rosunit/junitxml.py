@@ -15,3 +15,5 @@ from minros.tools.junitxml import (  # noqa: F401
     test_failure_junit_xml,
     test_success_junit_xml,
 )
+
+python2 = False

@@ -8,3 +8,4 @@ from minros.cli.wtf import (  # noqa: F401
     ros_master_uri_hostname,
     wtf_check_environment,
 )
+from roswtf.rules import error_rule, warning_rule  # noqa: E402, F401

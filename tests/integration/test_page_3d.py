@@ -11,7 +11,8 @@ read back from WebGL, the statuses in the display list) and saves a screenshot
 
 The performance test publishes a PointCloud2 of 100,000 points at 10 Hz and measures, in the
 page, the frames drawn and the clouds taken per second, with the camera still and then turning,
-for ``MINROS_3D_SECONDS`` (20 by default, half each); it prints them and writes
+for ``MINROS_3D_SECONDS`` (20 by default, half each), with the cloud display's "max points" at
+``MINROS_3D_MAX_POINTS`` if set (0: all; else the page's default); it prints them and writes
 view3d_perf.json beside the screenshots.
 """
 
@@ -42,6 +43,7 @@ from support import (
 
 WEB = Path(__file__).resolve().parent.parent / "web"
 PERF_SECONDS = float(os.environ.get("MINROS_3D_SECONDS", "20"))
+PERF_MAX_POINTS = os.environ.get("MINROS_3D_MAX_POINTS")
 V = "minrosPage.view('3d')"
 
 try:
@@ -232,6 +234,11 @@ def test_every_display_draws_and_bad_ones_say_why(page):
     assert "nowhere" in status.inner_text()
     # drawn: the light blue CUBE marker, the map's unknown corner (Rviz's grey green)
     page.look((0.5, -0.5, 0), (4.5, -6.5, 5))
+    # a point projected in the same task as the camera moved (no frame drawn between) is where
+    # the next frame draws it
+    moved = page.js(f"{V}.scene3d.resetCamera() || {V}.scene3d.lookAt([0.5, -0.5, 0], [4.5, -6.5, 5]) "
+                    f"|| {V}.scene3d.project(4.0, -2.4, 0.5)")
+    assert moved["inside"] and (moved["x"], moved["y"]) == pytest.approx(page.project(4.0, -2.4, 0.5)), moved
     # marker "shapes"/1, a CUBE of (0.2, 0.7, 1.0); map cells [150:, 150:] are unknown (-1)
     page.wait_pixel((4.0, -2.4, 0.5), "b > 180 && g > 110 && r < 110")
     page.wait_pixel((3.5, 3.5, 0.0), "g > r + 10 && Math.abs(g - b) < 25 && g > 90 && g < 190")
@@ -472,7 +479,11 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
                           "--cloud-rate", "10", "__name:=cloud_source"])
     try:
         cloud.read_until("READY", timeout=30)
-        page.wait(f"{V}.summary().some((d) => d.source === '/cloud' && d.count === 100000)", 30_000)
+        page.wait(f"{V}.summary().some((d) => d.source === '/cloud' && d.total === 100000)", 30_000)
+        if PERF_MAX_POINTS is not None:
+            cloud_display = f"{V}.displays.find((d) => d.source === '/cloud')"
+            page.js(f"{cloud_display}.setOption('max_points', {int(PERF_MAX_POINTS)})")
+            page.wait(f"{cloud_display}.count === {int(PERF_MAX_POINTS) or 100_000}", 30_000)
         page.js(f"{V}.scene3d.resetCamera()")
         # the camera still: the view draws when something changes (each cloud, tf)
         still = measure(page, PERF_SECONDS / 2)
@@ -483,6 +494,12 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
         page.js(f"{V}.scene3d.controls.autoRotate = false; {V}.scene3d.continuous = false")
         stats = page.js(f"{V}.scene3d.stats")
         count = page.js(f"{V}.displays.find((d) => d.source === '/cloud').count")
+        # an option changed on a colored cloud keeps its points' own colors (the flat color
+        # used to multiply them: a rainbow turned red and black)
+        cloud_display = f"{V}.displays.find((d) => d.source === '/cloud')"
+        page.js(f"{cloud_display}.setOption('size', 0.03)")
+        colors = page.js(f"[{cloud_display}.material.vertexColors, "
+                         f"{cloud_display}.material.color.getHex()]")
         report = {"points": count, "camera_still": still, "camera_turning": turning,
                   "canvas": f"{stats['width']}x{stats['height']}", "renderer": stats["renderer"],
                   "cpus": os.cpu_count(), "load_average": round(os.getloadavg()[0], 1)}
@@ -491,7 +508,8 @@ def test_a_100k_point_cloud_at_10_hz_frames_per_second(page, system, shots):
         page.shot("view3d_cloud")
     finally:
         cloud.stop()
-    assert count == 100_000
+    assert colors == [True, 0xFFFFFF], colors
+    assert count == page.js(f"{V}.displays.find((d) => d.source === '/cloud').request.max_points") or count == 100_000
     # the view keeps drawing and keeps taking clouds, whatever else the machine runs (the
     # server drops what the page cannot take): floors a broken pipeline misses, not a benchmark
     for phase in (still, turning):

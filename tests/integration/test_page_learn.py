@@ -60,16 +60,18 @@ def _left_in(folder: Path) -> list:
 class Server:
     """A master for the server's own node, and ``minros web`` keeping exercises in ``learn``."""
 
-    def __init__(self, tmp: Path) -> None:
+    def __init__(self, tmp: Path, option: bool = False) -> None:
+        """``option``: the folder named by ``--learn-dir``, which wins over $MINROS_LEARN_DIR."""
         home = tmp / "ros_home"
         (home / "log").mkdir(parents=True)
         self.base = tmp / "learn"
         self.port = free_port()
-        self.env = ros_env(self.port, home, {"MINROS_LEARN_DIR": str(self.base)})
+        self.env = ros_env(self.port, home, {"MINROS_LEARN_DIR": str(tmp / "not_here" if option else self.base)})
         self.procs = [Proc([PYTHON, "-m", "minros", "core", "-p", str(self.port)], self.env)]
         wait_for_master(self.port)
         self.web_port = free_port()
-        self.web = Proc([PYTHON, "-m", "minros", "web", "--port", str(self.web_port)], self.env)
+        self.web = Proc([PYTHON, "-m", "minros", "web", "--port", str(self.web_port)]
+                        + (["--learn-dir", str(self.base)] if option else []), self.env)
         self.procs.append(self.web)
         self.web.read_until("listening on", timeout=30)
 
@@ -296,7 +298,7 @@ def test_a_reload_keeps_the_exercise_and_closing_the_page_stops_it(server, brows
 
 
 def test_the_server_stopping_stops_the_exercise(browser, shots, tmp_path):
-    own = Server(tmp_path)  # a server of its own: this test stops it
+    own = Server(tmp_path, option=True)  # a server of its own (this test stops it), --learn-dir
     try:
         tab = Page(browser, own, shots)
         try:
@@ -305,7 +307,8 @@ def test_the_server_stopping_stops_the_exercise(browser, shots, tmp_path):
             view.locator('.learn-item[data-number="2"]').click()
             view.locator(".learn-start").click()
             _running(tab, 2)
-            facts = own.facts(2)
+            facts = own.facts(2)  # in --learn-dir's folder, not $MINROS_LEARN_DIR's
+            assert Path(facts["dir"]).parent == own.base and not (tmp_path / "not_here").exists()
             pids = list(facts["pids"].values())
             assert all(_alive(pid) for pid in pids)
             out = own.web.stop(timeout=30)  # Ctrl-C: the server stops what the page started

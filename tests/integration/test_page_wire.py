@@ -51,7 +51,8 @@ class Run:
         self.traces = tmp / "traces"
         self.traces.mkdir()
         self.port = free_port()
-        self.env = ros_env(self.port, home)
+        # the Wire view shows TCPROS (a minros pair of one host would take shared memory)
+        self.env = ros_env(self.port, home, {"MINROS_SHM": "0"})
         self.procs: list = []
         self.start(_traced(self.traces / "core.jsonl",
                            [PYTHON, "-m", "minros", "core", "-p", str(self.port)]))

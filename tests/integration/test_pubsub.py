@@ -27,8 +27,8 @@ def scripts(tmp_path: Path):
     return talker, listener
 
 
-def _node(script: Path, args, port: int, home: Path) -> Proc:
-    return Proc([PYTHON, str(script), *map(str, args)], ros_env(port, home))
+def _node(script: Path, args, port: int, home: Path, extra=None) -> Proc:
+    return Proc([PYTHON, str(script), *map(str, args)], ros_env(port, home, extra))
 
 
 def _master(port: int) -> xmlrpc.client.ServerProxy:
@@ -138,9 +138,11 @@ def test_slave_api_answers_and_errors(latched_talker, scripts, minros_master, ro
 
 
 def test_bus_info_string_parses_like_rosnode(latched_talker, scripts, minros_master, ros_home):
+    """A TCPROS connection's line (a listener kept off shared memory: MINROS_SHM=0)."""
     _, uri, _ = latched_talker
     _, listener = scripts
-    sub = _node(listener, ["/latched", "string", 1000], minros_master, ros_home)
+    sub = _node(listener, ["/latched", "string", 1000], minros_master, ros_home,
+                {"MINROS_SHM": "0"})
     try:
         sub.read_until("got msg 0", 20)
         info = xmlrpc.client.ServerProxy(uri).getBusInfo("/t")[2]
@@ -152,6 +154,27 @@ def test_bus_info_string_parses_like_rosnode(latched_talker, scripts, minros_mas
         sub_info = xmlrpc.client.ServerProxy(sub_uri).getBusInfo("/t")[2]
         (inbound,) = [c for c in sub_info if c[4] == "/latched"]
         assert inbound[1] == uri and inbound[2] == "i"
+    finally:
+        sub.stop()
+
+
+def test_two_minros_nodes_of_one_host_take_shared_memory(latched_talker, scripts, minros_master,
+                                                         ros_home):
+    """Between minros nodes of one host the connection is MINROSSHM, on both sides' bus info."""
+    _, uri, _ = latched_talker
+    _, listener = scripts
+    sub = _node(listener, ["/latched", "string", 1000], minros_master, ros_home)
+    try:
+        sub.read_until("got msg 0", 20)
+        info = xmlrpc.client.ServerProxy(uri).getBusInfo("/t")[2]
+        (conn,) = [c for c in info if c[4] == "/latched"]
+        assert conn[2] == "o" and conn[3] == "MINROSSHM" and conn[1].startswith("/listener")
+        assert re.match(r"MINROSSHM connection \(shared memory, .*\) on Unix socket \d+ to "
+                        r"\[pid \d+\]", conn[6]), conn[6]
+        _, sub_uri = _lookup(minros_master, "/listener")
+        (inbound,) = [c for c in xmlrpc.client.ServerProxy(sub_uri).getBusInfo("/t")[2]
+                      if c[4] == "/latched"]
+        assert inbound[1] == uri and inbound[3] == "MINROSSHM"
     finally:
         sub.stop()
 

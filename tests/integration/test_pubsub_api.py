@@ -148,9 +148,10 @@ print("RESULT", type(data).__name__, data.nbytes, int(data[257]),
 
 
 def test_large_frames_reach_numpy_msg_without_copies(tmp_path: Path, minros_master, ros_home):
+    """Over TCPROS (MINROS_SHM=0: shared memory reads in place anyway, test_shm_run.py)."""
     script = tmp_path / "zero_copy.py"
     script.write_text(ZERO_COPY)
-    proc = Proc([PYTHON, str(script)], ros_env(minros_master, ros_home))
+    proc = Proc([PYTHON, str(script)], ros_env(minros_master, ros_home, {"MINROS_SHM": "0"}))
     out = proc.read_until("RESULT", 30)
     proc.stop()
     assert "RESULT ndarray 6220800 1 memoryview bytearray" in out

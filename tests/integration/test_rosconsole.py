@@ -75,3 +75,49 @@ def test_usage_without_command(minros_core: int, ros_home: Path) -> None:
     out = _console(ros_env(minros_core, ros_home))
     assert out.returncode == 64
     assert out.stdout.startswith("rosconsole is a command-line tool")
+
+
+CALLER = '''
+import sys
+import rospy
+from rospy.logger_level_service_caller import LoggerLevelServiceCaller, ROSConsoleException
+rospy.init_node("caller", anonymous=True, disable_rosout=True)
+caller = LoggerLevelServiceCaller()
+print("nodes", "/noisy" in caller.get_node_names())
+print("loggers", "rosout" in caller.get_loggers("noisy"))
+print("change", caller.send_logger_change_message("noisy", "rosout", "warn"))
+print("again", caller.send_logger_change_message("noisy", "rosout", "warn"))
+try:
+    caller.get_loggers("/nobody")
+except ROSConsoleException as exc:
+    print("missing", "doesn't exist" in str(exc))
+'''
+
+
+def test_rospy_logger_level_service_caller_and_rosconsole_main(noisy: dict) -> None:
+    out = subprocess.run([PYTHON, "-c", CALLER], env=noisy, capture_output=True, text=True,
+                         timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split("\n")[:5] == ["nodes True", "loggers True", "change True",
+                                          "again False", "missing True"]
+    # rospy.rosconsole.main is the rosconsole command (program name first)
+    get = subprocess.run([PYTHON, "-c", "from rospy.rosconsole import main; main(['rosconsole', "
+                          "'get', '/noisy', 'rosout'])"], env=noisy, capture_output=True,
+                         text=True, timeout=60)
+    assert get.returncode == 0, get.stderr
+    assert get.stdout.strip() == "warn"
+    bad = subprocess.run([PYTHON, "-c", "from rospy.rosconsole import main; main(['rosconsole', "
+                          "'get', '/noisy', 'nope'])"], env=noisy, capture_output=True,
+                         text=True, timeout=60)
+    assert bad.returncode == 2 and "does not contain logger nope" in bad.stderr
+
+
+def test_roslaunch_logs_names_the_running_cores_log_folder(minros_core: int, ros_home: Path) -> None:
+    env = ros_env(minros_core, ros_home)
+    out = subprocess.run([PYTHON, "-c", "from roslaunch.roslaunch_logs import logs_main; logs_main()"],
+                         env=env, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    run_id = subprocess.run([PYTHON, "-m", "minros", "param", "get", "/run_id"], env=env,
+                            capture_output=True, text=True, timeout=60).stdout.strip()
+    assert run_id and out.stdout.strip().endswith("/" + run_id)
+    assert Path(out.stdout.strip()).is_dir()  # the core logs there

@@ -60,3 +60,51 @@ def test_graph_follows_nodes_topics_and_connections(minros_core: int, ros_home: 
     finally:
         listener.stop()
         talker.stop()
+
+
+def test_rosgraph_command_prints_peers_and_services(minros_core: int, ros_home: Path,
+                                                    tmp_path: Path) -> None:
+    """``rosgraph`` (here ``--once``): each node's inbound and outbound peers, then the services,
+    in ROS's layout."""
+    import subprocess
+
+    env = ros_env(minros_core, ros_home)
+    (tmp_path / "talker.py").write_text(TALKER)
+    (tmp_path / "listener.py").write_text(LISTENER)
+    talker = Proc([PYTHON, str(tmp_path / "talker.py")], env)
+    listener = Proc([PYTHON, str(tmp_path / "listener.py")], env)
+    try:
+        def printed() -> str:
+            out = subprocess.run([PYTHON, "-m", "minros", "links", "--once"], env=env,
+                                 capture_output=True, text=True, timeout=30)
+            assert out.returncode == 0, out.stderr
+            return out.stdout
+
+        text = ""
+
+        def connected() -> bool:
+            nonlocal text
+            text = printed()
+            return "  /listener :\n    Inbound:\n      /talker\n" in text
+
+        wait_until(connected, 20, what="the listener's inbound peer")
+        assert text.startswith("\n\nNodes:\n")
+        assert "  /talker :\n    Inbound:\n    Outbound:\n      /listener\n" in text
+        assert "Services:\n" in text and "  /talker/ping\n" in text
+    finally:
+        listener.stop()
+        talker.stop()
+
+
+def test_rosgraph_command_without_master_and_with_bad_arguments(ros_home: Path) -> None:
+    import subprocess
+
+    from support import free_port
+
+    env = ros_env(free_port(), ros_home)
+    out = subprocess.run([PYTHON, "-m", "minros", "links"], env=env, capture_output=True,
+                         text=True, timeout=30)
+    assert (out.returncode, out.stderr) == (0, "ERROR: Unable to communicate with master!\n")
+    out = subprocess.run([PYTHON, "-m", "minros", "links", "extra"], env=env,
+                         capture_output=True, text=True, timeout=30)
+    assert out.returncode == 255 and out.stdout.startswith("rosgraph is a command-line tool")

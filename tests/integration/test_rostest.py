@@ -96,3 +96,65 @@ def test_a_test_that_writes_no_results_fails(ros_home: Path, tmp_path: Path) -> 
     assert "\033[1;31m * FAILURES: 1\033[0m" in out.stdout
     assert out.stdout.endswith(" * testsilent\n\nrostest log file is in "
                                f"{next((ros_home / 'log').glob('rostest-*.log'))}\n")
+
+
+def test_rostest_runner_api_runs_a_file_as_a_unittest_class(ros_home: Path) -> None:
+    """rostest.runner.createUnitTest: a test<name> method per <test>, run under a
+    ROSTestLaunchParent (a master of its own); a missing test node fails its method."""
+    broken = ros_home / "missing.test"
+    broken.write_text('<launch><test test-name="nope" pkg="rostest_demo" type="nope.py"/>'
+                      "</launch>")
+    code = f'''
+import unittest, rostest.runner as r
+for f in [{str(PKGS / "rostest_demo" / "test" / "counter.test")!r}, {str(broken)!r}]:
+    case = r.createUnitTest("rostest_demo", f)
+    res = unittest.TextTestRunner(verbosity=0).run(unittest.TestLoader().loadTestsFromTestCase(case))
+    print("RUN", case.__module__, case.__name__, res.testsRun, len(res.failures), len(res.errors))
+    for _, tb in res.failures:
+        print("FAIL", tb.strip().splitlines()[-1])
+g = r.getResults()
+print("TOTAL", g.num_tests, g.num_errors, g.num_failures, len(r.getRostestParents()))
+'''
+    env = ros_env(None, ros_home, {"ROS_PACKAGE_PATH": str(PKGS)})
+    env.pop("ROS_MASTER_URI", None)
+    out = subprocess.run([PYTHON, "-c", code], env=env, capture_output=True, text=True,
+                         timeout=90)
+    assert out.returncode == 0, out.stdout + out.stderr
+    lines = [line for line in out.stdout.splitlines() if line.startswith(("RUN", "FAIL", "TOTAL"))]
+    assert lines == [
+        "RUN rostest.runner RosTest 1 0 0",
+        "RUN rostest.runner RosTest 1 1 0",
+        "FAIL AssertionError: Test node [rostest_demo/nope.py] does not exist or is not executable",
+        "TOTAL 3 0 0 2",  # setUp ran for each method, the failing one too
+    ]
+    assert "[ROSTEST]test [test_counter] results summary: 0 errors, 0 failures, 3 tests" in out.stdout
+    node = _suite(ros_home / "test_results" / "rostest_demo" / "rosunit-test_counter.xml")
+    assert node.get("tests") == "3"
+
+
+def test_rosunit_runs_a_test_program_and_writes_junit(ros_home: Path) -> None:
+    """``rosunit FILE``: the program runs with --gtest_output, its results and the wrapper's
+    are written as JUnit, and the status says whether its checks passed."""
+    env = ros_env(None, ros_home, {"ROS_PACKAGE_PATH": str(PKGS)})
+    scripts = PKGS / "rostest_demo" / "scripts"
+    results = ros_home / "test_results" / "rostest_demo"
+    out = subprocess.run([PYTHON, "-m", "minros", "unit", str(scripts / "unit_fails.py")],
+                         env=env, capture_output=True, text=True, timeout=60, cwd=ros_home)
+    assert out.returncode == 2, out.stdout + out.stderr  # the program's check failed
+    assert "[ROSUNIT]test [unit_fails] results summary: 0 errors, 1 failures, 2 tests" in out.stdout
+    assert "\033[1;31m * RESULT: FAIL\033[0m\n * TESTS: 2\n" in out.stdout
+    node = _suite(results / "rosunit-unit_fails.xml")
+    assert (node.get("tests"), node.get("failures")) == ("2", "1")
+    wrapper = _suite(results / "rostest-unit_fails.xml")
+    assert [c.get("name") for c in wrapper.iter("testcase")] == ["runTest"]
+    out = subprocess.run([PYTHON, "-m", "minros", "unit", "--name", "renamed", "--time-limit",
+                          "0.5", str(scripts / "unit_fails.py"), "--sleep"], env=env,
+                         capture_output=True, text=True, timeout=60, cwd=ros_home)
+    assert out.returncode == 1, out.stdout + out.stderr  # the runner's own check: timed out
+    assert "\033[1;31m * ERRORS: 1\033[0m\n" in out.stdout
+    error = next(_suite(results / "rostest-renamed.xml").iter("error"))
+    assert "TestTimeoutException: test max time allotted" in error.text
+    out = subprocess.run([PYTHON, "-m", "minros", "unit", "/nowhere/x.py"], env=env,
+                         capture_output=True, text=True, timeout=60)
+    assert (out.returncode, out.stderr) == (1, "minros unit: error: no such test file: "
+                                               "/nowhere/x.py\n")

@@ -106,7 +106,8 @@ def traced_capture(tmp_path_factory):
     home = tmp / "ros_home"
     (home / "log").mkdir(parents=True)
     port = free_port()
-    env = ros_env(port, home)
+    # the TCPROS wire the dissector reads (two minros nodes would take shared memory)
+    env = ros_env(port, home, {"MINROS_SHM": "0"})
     core = Proc([PYTHON, "-m", "minros", "core", "-p", str(port)], env)
     try:
         wait_for_master(port)
@@ -208,7 +209,7 @@ def test_a_real_capture_with_segmentation(tmp_path):
     home = tmp_path / "ros_home"
     (home / "log").mkdir(parents=True)
     port = free_port()
-    env = ros_env(port, home)
+    env = ros_env(port, home, {"MINROS_SHM": "0"})  # TCPROS on the wire, as above
     script = tmp_path / "scenario.py"
     script.write_text(SCENARIO)
     capture = tmp_path / "live.pcapng"

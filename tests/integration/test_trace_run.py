@@ -53,7 +53,8 @@ def traced_run(tmp_path_factory):
     ros_home = tmp_path / "ros_home"
     (ros_home / "log").mkdir(parents=True)
     port = free_port()
-    env = ros_env(port, ros_home)
+    # the TCPROS wire, as courses teach it (MINROSSHM's trace: test_shm_run.py)
+    env = ros_env(port, ros_home, {"MINROS_SHM": "0"})
     files = {name: tmp_path / f"{name}.jsonl" for name in ("core", "listener", "talker")}
     core = Proc(_traced(files["core"], [PYTHON, "-m", "minros", "core", "-p", str(port)],
                         messages=False), env)

@@ -314,3 +314,39 @@ def test_rosparam_yaml_hooks(capsys) -> None:
     param.print_params({"a": {"b": 1}}, "/ns")
     assert capsys.readouterr().out == "/ns/a/b=1\n"
     assert param.load_str("x: 1", "f.yaml", default_namespace="rel") == [({"x": 1}, "rel")]
+
+
+def test_rostopic_plot_helpers_and_malformed_field_patterns(capsys) -> None:
+    """rostopic's _str_plot_fields/_str_plot (``-p``): a given time wins over the header's
+    stamp; msgevalgen answers None (and says why) for a malformed pattern."""
+    import rostopic
+    from geometry_msgs.msg import PointStamped
+    from minros.msgs import Time
+
+    msg = PointStamped()
+    msg.header.stamp = Time(5, 0)
+    msg.point.x = 1.5
+    assert rostopic._str_plot_fields(msg, "field", None) == (
+        "time,field.header.seq,field.header.stamp,field.header.frame_id,"
+        "field.point.x,field.point.y,field.point.z")
+    assert rostopic._str_plot(msg, current_time=Time(0, 7)) == "7,0,5000000000,,1.5,0.0,0.0"
+    assert rostopic._str_plot(msg) == "5000000000,0,5000000000,,1.5,0.0,0.0"
+    assert rostopic.msgevalgen("/point/x")(msg) == 1.5
+    assert rostopic.msgevalgen("/vals[0") is None
+    assert "missing closing ']' in slice spec 'vals[0'" in capsys.readouterr().err
+
+
+def test_rosmsg_overview_and_iterate_packages_over_a_given_rospack(tmp_path, capsys) -> None:
+    import rospkg
+
+    from minros.cli import msg
+
+    assert msg.main([], prog="rosmsg") == 0
+    assert "Commands:\n\trosmsg show\tShow message description\n" in capsys.readouterr().out
+    pkg = tmp_path / "only_pkg"
+    (pkg / "msg").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>only_pkg</name></package>")
+    (pkg / "msg" / "A.msg").write_text("int32 a\n")
+    pack = rospkg.RosPack(ros_paths=[str(tmp_path)])
+    assert list(msg.iterate_packages(pack, msg.MODE_MSG)) == [("only_pkg", str(pkg / "msg"))]
+    assert list(msg.iterate_packages(pack, msg.MODE_SRV)) == []

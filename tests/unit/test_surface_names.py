@@ -48,3 +48,33 @@ def test_bondpy_durations_and_reexported_messages() -> None:
     assert bondpy.as_float_duration(3) == 3
     assert tf2_ros.TransformStamped is TransformStamped and tf2_ros.Header is Header
     assert bondpy.Status._type == "bond/Status"
+
+
+def test_names_ros_modules_take_from_their_neighbours_are_the_same_objects() -> None:
+    """ROS's modules import classes and helpers from their neighbours (roslaunch.nodeprocess
+    from roslaunch.core, genmsg.msg_loader from genmsg.msgs, rosmaster.master_api from
+    rosmaster.validators): code finds them there, and they are the neighbours' own."""
+    import genmsg.msg_loader
+    import genmsg.msgs
+    import rosgraph.names
+    import roslaunch
+    import roslaunch.core
+    import roslaunch.loader
+    import roslaunch.nodeprocess
+    import roslaunch.pmon
+    import roslaunch.xmlloader
+    import rosmaster.master_api
+    import rosmaster.validators
+    import rosunit.baretest
+    import rosunit.core
+
+    assert roslaunch.nodeprocess.Node is roslaunch.core.Node
+    assert roslaunch.nodeprocess.Process is roslaunch.pmon.Process
+    assert roslaunch.nodeprocess.PHASE_SETUP == roslaunch.loader.PHASE_SETUP == "setup"
+    assert roslaunch.Node is roslaunch.core.Node and roslaunch.NAME == "roslaunch"
+    assert roslaunch.xmlloader.ns_join is rosgraph.names.ns_join
+    assert genmsg.msg_loader.MsgSpec is genmsg.msgs.MsgSpec
+    assert genmsg.msg_loader.HEADER_FULL_NAME == "std_msgs/Header"
+    assert rosmaster.master_api.is_topic is rosmaster.validators.is_topic
+    assert (rosmaster.master_api.STATUS, rosmaster.master_api.MSG, rosmaster.master_api.VAL) == (0, 1, 2)
+    assert rosunit.baretest.xml_results_file is rosunit.core.xml_results_file

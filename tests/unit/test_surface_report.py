@@ -34,6 +34,8 @@ def test_exclusions_cover_subpackages_only_when_asked() -> None:
     assert surface.exclusion("rosmake.engine")
     assert surface.exclusion("catkin.builder")
     assert surface.exclusion("catkin.find_in_workspaces") is None  # roslib uses it at run time
+    assert surface.exclusion("genmsg.template_tools")  # build-time code writer
+    assert surface.exclusion("genmsg.deps") is None  # the rest of genmsg counts
     assert surface.exclusion("rviz")
     assert surface.exclusion("rviz.srv") is None
 

@@ -94,3 +94,19 @@ def test_fetch_asset_response_layout():
     assert ok == struct.pack("<BIBI", 4, 7, 0, 0) + b"abc"
     bad = fp.fetch_asset_response(8, error="Failed to retrieve asset x")
     assert bad == struct.pack("<BIBI", 4, 8, 1, 26) + b"Failed to retrieve asset x"
+
+
+def test_foxglove_bridge_launch_file_sets_the_allow_list_as_an_argument():
+    """roslaunch foxglove_bridge foxglove_bridge.launch: asset_uri_allowlist is an argument, as
+    in foxglove_bridge's launch file; by default minros web's own list."""
+    from pathlib import Path
+
+    import minros.launch
+    from minros.cli.launch import load_all
+
+    launch = (Path(minros.launch.__file__).parent / "share" / "foxglove_bridge" / "launch"
+              / "foxglove_bridge.launch")
+    params = load_all([str(launch)], []).params
+    assert params["/foxglove_bridge/asset_uri_allowlist"] == list(assets.DEFAULT_ALLOWLIST)
+    params = load_all([str(launch)], [r"asset_uri_allowlist:=['^package://robot_pkg/.*\.stl$']"]).params
+    assert params["/foxglove_bridge/asset_uri_allowlist"] == [r"^package://robot_pkg/.*\.stl$"]

@@ -72,7 +72,7 @@ def test_a_cloud_with_rgb_gives_points_and_their_colours():
     xyz, colors, info = scenedata.cloud_arrays(cloud)
     assert xyz.tolist() == [[1, 2, 3], [4, 5, 6]]
     assert colors.tolist() == [[255, 0, 10], [0, 128, 255]]
-    assert info == {"color": "rgb", "dropped": 1}
+    assert info == {"color": "rgb", "dropped": 1, "total": 3}
 
 
 def test_a_cloud_with_intensity_is_coloured_by_it_blue_to_red():
@@ -94,6 +94,33 @@ def test_a_cloud_with_padded_rows_and_big_endian_values():
     xyz, _colors, info = scenedata.cloud_arrays(cloud)
     assert xyz.tolist() == [[1, 2, 3], [4, 5, 6], [7, 8, 9], [10, 11, 12]]
     assert info["color"] == "z"
+
+
+def xyz_cloud(width, height):
+    PointCloud2 = get_message_class("sensor_msgs/PointCloud2")
+    index = np.arange(width * height, dtype=np.float32)
+    points = np.stack([index % width, index // width, index], axis=1).astype(np.float32)
+    return PointCloud2(height=height, width=width, fields=fields(("x", 0, 7), ("y", 4, 7), ("z", 8, 7)),
+                       point_step=12, row_step=12 * width, data=points.tobytes())
+
+
+def test_a_big_cloud_is_thinned_evenly_to_max_points():
+    # unorganized: every (count / max)-th point, from the first to near the last
+    xyz, colors, info = scenedata.cloud_arrays(xyz_cloud(100_000, 1), max_points=25_000)
+    assert len(xyz) == len(colors) == 25_000 and info["total"] == 100_000
+    assert xyz[:3, 0].tolist() == [0, 4, 8] and xyz[-1, 0] == 99_996
+    # organized (an image's pixels): every k-th row and column, still a grid
+    xyz, _colors, info = scenedata.cloud_arrays(xyz_cloud(640, 480), max_points=25_000)
+    assert len(xyz) == 160 * 120 and info["total"] == 640 * 480
+    assert sorted(set(xyz[:, 0].tolist()))[:3] == [0, 4, 8] and sorted(set(xyz[:, 1].tolist()))[:3] == [0, 4, 8]
+    # a grid that would still be too big (2 rows) falls back to every n-th point
+    assert len(scenedata.cloud_arrays(xyz_cloud(50_000, 2), max_points=25_000)[0]) == 25_000
+    # 0, or no more points than the cloud has: all of them
+    assert len(scenedata.cloud_arrays(xyz_cloud(1000, 1), max_points=0)[0]) == 1000
+    assert len(scenedata.cloud_arrays(xyz_cloud(1000, 1), max_points=1000)[0]) == 1000
+    # the colours are those of the points kept (the rainbow over z spans what is shown)
+    xyz, colors, _info = scenedata.cloud_arrays(xyz_cloud(1000, 1), max_points=10)
+    assert colors[0].tolist() == [0, 0, 255] and colors[-1].tolist() == [255, 0, 0]
 
 
 @pytest.mark.parametrize("change, text", [
@@ -289,6 +316,16 @@ def test_display_ops_check_what_the_page_asks():
     assert error.startswith("/turtle1/pose is a turtlesim/Pose: the 3D view shows ")
     page.receive(json.dumps({"op": "display_remove", "id": "b"}))
     assert state.tapped == []
+    # a cloud's max_points: a count of points, 0 for all
+    page.receive(json.dumps({"op": "display_add", "id": "d", "topic": "/cloud_later", "kind": "cloud",
+                             "max_points": 25000}))
+    assert replies(outbox)[0]["kind"] == "cloud" and page.scene.displays["d"].max_points == 25000
+    for bad, text in ((-1, "max_points must be a number of points (0: all), not -1"),
+                      ("all", "Expected field max_points to be one of ('int',)")):
+        page.receive(json.dumps({"op": "display_add", "id": "e", "topic": "/cloud_later", "kind": "cloud",
+                                 "max_points": bad}))
+        assert text in replies(outbox)[0]["msg"]
+    page.receive(json.dumps({"op": "display_remove", "id": "d"}))
     page.receive(json.dumps({"op": "im_feedback", "id": "nope", "marker": "m", "event": 1}))
     assert "no interactive marker display nope" in replies(outbox)[0]["msg"]
     page.close()
@@ -326,6 +363,10 @@ def test_a_display_renders_binary_clouds_placed_by_tf_and_each_status_once():
     assert header["frame"] == "cam" and header["T"][0] == pytest.approx(2.0) and header["fixed"] == "map"
     assert header["count"] == 2 and arrays["position"].tolist() == [1, 2, 3, 4, 5, 6]
     assert display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2"))[0] == frame  # no new status
+    display.max_points = 1  # thinned, and said how many the message had
+    header, arrays = scenedata.unpack(display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2"))[0])
+    assert header["count"] == 1 and header["total"] == 2 and arrays["position"].tolist() == [1, 2, 3]
+    display.max_points = 0
     cloud.data = cloud.data[:-4]
     (bad,) = display.render(FakeIncoming(cloud, "sensor_msgs/PointCloud2"))
     assert json.loads(bad)["level"] == "error" and "data holds 20 bytes" in json.loads(bad)["text"]

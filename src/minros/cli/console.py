@@ -123,6 +123,62 @@ def _cmd_set(argv: List[str]) -> int:
     return 0
 
 
+class ROSConsoleException(Exception):
+    """A node's loggers could not be read or set (rospy.logger_level_service_caller's)."""
+
+
+class LoggerLevelServiceCaller:
+    """The logger services of nodes, as rqt_logger_level and rospy's rosconsole use them:
+    which nodes serve ``~set_logger_level``, their loggers and levels, and level changes.
+    Node names are resolved in this process's namespace (ROS_NAMESPACE)."""
+
+    def __init__(self) -> None:
+        self._current_loggers: List[str] = []
+        self._current_levels: Dict[str, str] = {}
+
+    def get_levels(self) -> List[str]:
+        """The level names, lower-case as the services answer them, by increasing severity."""
+        return [level.lower() for level in LEVELS]
+
+    @staticmethod
+    def _resolve(node: str) -> str:
+        ns = names.get_ros_namespace()
+        return names.resolve_name(names.ns_join(ns, node), ns)
+
+    def get_node_names(self) -> List[str]:
+        """The nodes that serve ``<node>/set_logger_level``, sorted."""
+        from minros.tools.master import Master
+
+        _pubs, _subs, services = Master("/rosconsole").system_state()
+        providers = {name: set(nodes) for name, nodes in services}
+        return sorted(node for node in {n for nodes in providers.values() for n in nodes}
+                      if node in providers.get(names.ns_join(node, "set_logger_level"), ()))
+
+    def get_loggers(self, node: str) -> List[str]:
+        """The loggers of ``node`` (and remembers their levels); ROSConsoleException when the
+        node does not answer."""
+        try:
+            loggers = get_loggers(self._resolve(node))
+        except ToolError as exc:
+            raise ROSConsoleException(f"node '{node}' doesn't exist or doesn't support query: "
+                                      f"{exc}") from None
+        self._current_loggers = list(loggers)
+        self._current_levels = {name: level.upper() for name, level in loggers.items()}
+        return self._current_loggers
+
+    def send_logger_change_message(self, node: str, logger: str, level: str) -> bool:
+        """Set ``logger`` of ``node`` to ``level``; False when it already is at that level
+        (get_loggers first), ROSConsoleException when the node refuses."""
+        if self._current_levels.get(logger, "").upper() == level.upper():
+            return False
+        try:
+            set_logger_level(self._resolve(node), logger, level)
+        except ToolError as exc:
+            raise ROSConsoleException(f"node '{node}' logger request failed: {exc}") from None
+        self._current_levels[logger] = level.upper()
+        return True
+
+
 # ---------------------------------------------------------------------------------------------
 # echo
 
@@ -157,6 +213,41 @@ class ConsoleEcho:
         if text is not None:
             self.count += 1
             print(text, file=self.out, flush=True)
+
+
+class RosConsoleEcho(ConsoleEcho):
+    """rospy.rosconsole's echo: subscribes at once to ``options.topic`` and prints what passes
+    ``options.filter`` and ``options.level`` (``options.once``: the first, then shuts the node
+    down). Needs an initialised node."""
+
+    LEVEL_COLOR = COLORS
+    LEVEL_MAX_LENGTH = max(len(level) for level in LEVELS)
+
+    def __init__(self, options: Any) -> None:
+        super().__init__(options.filter, options.level, options.nocolor, options.verbose)
+        from minros.client.topics import Subscriber
+        from minros.msgs import get_message_class
+
+        self.once = bool(getattr(options, "once", False))
+        Subscriber(options.topic, get_message_class("rosgraph_msgs/Log"), self)
+
+    def __call__(self, msg: Any) -> None:
+        super().__call__(msg)
+        if self.once and self.count:
+            from minros import node
+
+            node.signal_shutdown("Done")
+
+    @staticmethod
+    def get_levels() -> List[str]:
+        """Level names by increasing severity."""
+        return sorted(LEVELS, key=LEVELS.__getitem__)
+
+
+def error(status: int, msg: str) -> None:
+    """Print ``rosconsole: error: msg`` on stderr and exit with ``status``."""
+    print(f"{NAME}: error: {msg}", file=sys.stderr)
+    sys.exit(status)
 
 
 def _cmd_echo(argv: List[str], prog: str) -> int:

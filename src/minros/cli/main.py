@@ -29,6 +29,9 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "web": ("minros.cli.web", "rosbridge, rosapi, Foxglove and video for browsers, on one port"),
     "bag": ("minros.cli.bag", "record, play, inspect and convert bag files (rosbag)"),
     "test": ("minros.cli.rostest", "run the <test> nodes of a launch file (rostest)"),
+    "unit": ("minros.cli.rosunit", "run a test program, its results as JUnit XML (rosunit)"),
+    "links": ("minros.cli.rosgraph", "print each node's inbound and outbound peers and the "
+                                     "services, every second (rosgraph)"),
     "console": ("minros.cli.console", "print log messages, list and set logger levels (rosconsole)"),
     "sim": ("minros.cli.sim", "a 2D robot simulator with map_server and move_base (Stage-like)"),
     "trace": ("minros.cli.trace", "trace the wire: XML-RPC, TCPROS headers and frames; show, pcap"),
@@ -58,6 +61,8 @@ ALIASES: Dict[str, Tuple[str, List[str]]] = {
     "catkin_make": ("ws", ["make"]),
     "rosbag": ("bag", []),
     "rostest": ("test", []),
+    "rosunit": ("unit", []),
+    "rosgraph": ("links", []),
     "rosconsole": ("console", []),
     "rosclean": ("clean", []),
     "roswtf": ("wtf", []),
@@ -140,6 +145,8 @@ catkin_create_pkg = _alias("catkin_create_pkg")
 catkin_make = _alias("catkin_make")
 rosbag = _alias("rosbag")
 rostest = _alias("rostest")
+rosunit = _alias("rosunit")
+rosgraph = _alias("rosgraph")
 rosconsole = _alias("rosconsole")
 rosclean = _alias("rosclean")
 roswtf = _alias("roswtf")

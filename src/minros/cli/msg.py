@@ -16,17 +16,27 @@ from __future__ import annotations
 
 import argparse
 import io
+import os
 import sys
 from typing import Any, Callable, Iterator, List, Tuple
 
 MODE_NAMES = {"msg": ("message type", "messages"), "srv": ("service type", "services")}
 
 
+class _UsageFormatter(argparse.HelpFormatter):
+    """Help that starts ``Usage:`` as rosmsg's (optparse) does: scripts look for it."""
+
+    def add_usage(self, usage: Any, actions: Any, groups: Any, prefix: Any = None) -> None:
+        super().add_usage(usage, actions, groups, "Usage: " if prefix is None else prefix)
+
+
 def _parser(kind: str, prog: str) -> argparse.ArgumentParser:
     what, plural = MODE_NAMES[kind]
     parser = argparse.ArgumentParser(
-        prog=prog, description=f"Display information about ROS {what}s.")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+        prog=prog, description=f"Display information about ROS {what}s.",
+        formatter_class=_UsageFormatter)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND",
+                                parser_class=_subparser_class())
     for name in ("show", "info"):
         p = sub.add_parser(name, help=f"show {what} description" if name == "show"
                            else "alias for show")
@@ -52,6 +62,15 @@ def _parser(kind: str, prog: str) -> argparse.ArgumentParser:
     return parser
 
 
+def _subparser_class() -> Any:
+    class SubParser(argparse.ArgumentParser):
+        def __init__(self, *args: Any, **kwds: Any) -> None:
+            kwds.setdefault("formatter_class", _UsageFormatter)
+            super().__init__(*args, **kwds)
+
+    return SubParser
+
+
 def _read_stdin_arg() -> str | None:
     for line in sys.stdin:
         if line.strip():
@@ -68,6 +87,10 @@ def _matches(kind: str, base_type: str) -> List[str]:
 
 def main(argv: List[str], prog: str = "minros msg", kind: str = "msg") -> int:
     """Run ``minros msg`` (or, with ``kind='srv'``, ``minros srv``)."""
+    if prog in ("rosmsg", "rossrv") and list(argv) in ([], ["-h"], ["--help"]):
+        # ROS's command prints its own overview (the commands), which scripts look for
+        print(fullusage(MODE_MSG if kind == "msg" else MODE_SRV))
+        return 0
     parser = _parser(kind, prog)
     args = parser.parse_args(argv)
     if args.command is None:
@@ -296,11 +319,19 @@ def list_srvs(package: str, rospack: object = None) -> List[str]:
 
 
 def iterate_packages(rospack: object, mode: str) -> Iterator[Tuple[str, str]]:
-    """``(package, its msg or srv folder)`` of every package that has one (minros's package
-    lookup: ROS_PACKAGE_PATH, then the packages minros bundles)."""
+    """``(package, its msg or srv folder)`` of every package that has one: the packages
+    ``rospack`` knows (a ``rospkg.RosPack``, as ROS's rosmsg takes), or without one minros's
+    package lookup (ROS_PACKAGE_PATH, then the packages minros bundles)."""
     from minros.msgs.registry import packages_with
 
-    for package, folder in packages_with(_kind(mode)).items():
+    kind = _kind(mode)
+    if rospack is not None and hasattr(rospack, "list") and hasattr(rospack, "get_path"):
+        for package in rospack.list():
+            folder = os.path.join(rospack.get_path(package), kind)
+            if os.path.isdir(folder):
+                yield package, folder
+        return
+    for package, folder in packages_with(kind).items():
         yield package, str(folder)
 
 

@@ -18,6 +18,7 @@ from urllib.parse import urlparse
 from minros import names
 from minros.tools.common import ToolError, dispatch, option_parser, resolve, run_tool
 from minros.tools.master import Master, MasterException, call_node
+from minros.wire import rosapi
 
 NAME = "rosnode"
 ID = "/rosnode"
@@ -63,12 +64,11 @@ def get_node_names(master: Master, namespace: str | None = None) -> List[str]:
 
 
 def _remote(triplet: list) -> object:
-    if not isinstance(triplet, (list, tuple)) or len(triplet) != 3:
-        raise ToolError(f"remote call failed: malformed reply {str(triplet)[:80]}")
-    code, msg, value = triplet
-    if code != 1:
-        raise ToolError(f"remote call failed: {msg}")
-    return value
+    """The value of a node's answer (rosapi.unwrap, the one place a code is read), or ToolError."""
+    try:
+        return rosapi.unwrap(triplet)
+    except rosapi.RemoteError as exc:
+        raise ToolError(f"remote call failed: {str(exc)[:200]}") from None
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1084,10 +1084,37 @@ def _library(fn: Callable[[], Any]) -> Any:
 
 
 def msgevalgen(pattern: str) -> Callable[[Any], Any] | None:
-    """A function message -> the field ``pattern`` names (``/pose/position/x``), or None."""
-    from minros.tools.echo import make_field_getter
+    """A function message -> the field ``pattern`` names (``/pose/position/x``), or None (and,
+    as rostopic's, the reason on stderr when the pattern is malformed: ``/vals[0``)."""
+    from minros.tools.echo import FieldError, make_field_getter
 
-    return make_field_getter(pattern) if pattern else None
+    if not pattern:
+        return None
+    try:
+        return make_field_getter(pattern)
+    except FieldError as exc:
+        print(exc, file=sys.stderr)
+        return None
+
+
+def str_plot_fields(val: Any, f: str, field_filter: Callable | None) -> str:
+    """rostopic's ``-p`` CSV header for message ``val``, its fields named from ``f``
+    (``time,field.x,field.y``)."""
+    from minros.tools.echo import plot_fields
+
+    return "time," + (plot_fields(val, f, field_filter) or "")
+
+
+def str_plot(val: Any, time_offset: Any = None, current_time: Any = None,
+             field_filter: Callable | None = None, type_information: str | None = None,
+             fixed_numeric_width: int | None = None, value_transform: Callable | None = None) -> str:
+    """rostopic's ``-p`` CSV line for message ``val``: the time in ns (``current_time``, else
+    the header's stamp, else now; less ``time_offset``), then every field's value."""
+    from minros.tools.echo import plot_line
+
+    if current_time is not None:
+        return plot_line(val, current_time, time_offset, field_filter, header_first=False)
+    return plot_line(val, _now(), time_offset, field_filter)
 
 
 def get_topic_type(topic: str, blocking: bool = False) -> Tuple[str | None, str | None, Any]:
@@ -1304,10 +1331,7 @@ class CallbackEcho:
                 data, time_offset=time_offset, current_time=current_time,
                 field_filter=field_filter, type_information=type_information,
                 fixed_numeric_width=fixed_numeric_width, value_transform=value_transform)
-        from minros.tools.echo import plot_line
-
-        return plot_line(data, current_time if current_time is not None else _now(), time_offset,
-                         field_filter)
+        return str_plot(data, time_offset, current_time, field_filter)
 
     def callback(self, data: Any, callback_args: Dict[str, Any], current_time: Any = None) -> None:
         """Print ``data`` received on ``callback_args['topic']`` (a bag's time as

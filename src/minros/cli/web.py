@@ -1,10 +1,11 @@
 """``minros web``: rosbridge v2 with rosapi, Foxglove WebSocket and video endpoints on one port.
 
 ``minros web [--port 9090] [--host 127.0.0.1] [--token TOKEN] [--allow-origin ORIGIN]
-[--trace PATH...] ...`` runs until Ctrl-C as the node ``/minros_web`` (``__name:=`` renames
-it); ``--allow-origin`` (or MINROS_WEB_ALLOW_ORIGIN) lets pages of another site use the server;
-``--trace`` names the wire traces (``minros trace -o FILE -- COMMAND``) the page's Wire view
-follows. roslaunch users
+[--trace PATH...] [--learn-dir DIR] ...`` runs until Ctrl-C as the node ``/minros_web``
+(``__name:=`` renames it); ``--allow-origin`` (or MINROS_WEB_ALLOW_ORIGIN) lets pages of another
+site use the server; ``--trace`` names the wire traces (``minros trace -o FILE -- COMMAND``) the
+page's Wire view follows; ``--learn-dir`` the folder the Learn view's exercises run in (as
+``minros learn --dir``). roslaunch users
 start the same server with ``roslaunch rosbridge_server rosbridge_websocket.launch`` or
 ``roslaunch foxglove_bridge foxglove_bridge.launch``.
 """
@@ -20,8 +21,9 @@ def _parser(prog: str) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=prog,
         description="Serve the ROS graph to browsers and GUIs on one port: a page at / to see "
-                    "and drive it (graph, topics, plots, images, turtlesim, parameters, services, "
-                    "console, the wire trace), rosbridge v2 with rosapi (roslibjs, roslibpy, "
+                    "and drive it (graph, topics, plots, images, a 3D view as Rviz's, turtlesim, "
+                    "parameters, services, console, the wire trace, and Learn: minros learn's "
+                    "exercises started, watched and checked), rosbridge v2 with rosapi (roslibjs, roslibpy, "
                     "webviz), the Foxglove WebSocket protocol (Foxglove, Lichtblick) and web_video_server's "
                     "/stream, /snapshot and /stream_viewer endpoints.")
     parser.add_argument("--port", type=int, default=9090, help="TCP port (default 9090)")
@@ -61,6 +63,10 @@ def _parser(prog: str) -> argparse.ArgumentParser:
                              "written by 'minros trace -o FILE -- COMMAND' or MINROS_TRACE=FILE "
                              "(they may not exist yet), directories (their *.jsonl) or quoted "
                              "glob patterns")
+    parser.add_argument("--learn-dir", metavar="DIR",
+                        help="the folder the Learn view's exercises run in, one folder each "
+                             "(default $MINROS_LEARN_DIR, else $ROS_HOME/learn, i.e. "
+                             "~/.ros/learn; 'minros learn --dir' names the same)")
     return parser
 
 
@@ -90,5 +96,6 @@ def main(argv: List[str], prog: str | None = None) -> int:
                         graph_interval=max(0.05, args.graph_interval),
                         send_timeout=max(0.5, args.send_timeout),
                         max_message_size=args.max_message_size, compression=args.compression,
-                        trace=args.trace, allow_origins=origins)
+                        trace=args.trace, allow_origins=origins,
+                        learn_dir=os.path.expanduser(args.learn_dir) if args.learn_dir else None)
     return run(settings, announce=lambda text: print(text, flush=True))

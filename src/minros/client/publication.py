@@ -3,7 +3,12 @@ connections (rospy's _PublisherImpl).
 
 Publishing serializes a message once (Header stamped first) and hands the same frame to every
 connection's ``send``; the connections are transports of any protocol (``minros.transport``),
-added by the protocol handler that accepted the subscriber. The publication keeps what ROS
+added by the protocol handler that accepted the subscriber. A publication made with
+``intraprocess=True`` hands subscribers of this process the message object itself, through
+the connections that take objects (``takes_objects``: the intra-process links); the others
+get the frame, serialized only when one of them is there. ``loan(nbytes)`` lends the memory of
+a message's large array from a shared-memory connection's slot, so that publishing it copies
+nothing (the other connections get the frame as usual). The publication keeps what ROS
 keeps per topic: the latched message (sent first to every new subscriber), the sequence number,
 the SubscribeListeners, the user's extra header fields.
 
@@ -14,11 +19,13 @@ own transports (:mod:`minros.rospy_internals.transport`) are transports of this 
 
 from __future__ import annotations
 
+import ctypes
 import io
 import logging
+import struct
 import threading
 import traceback
-from typing import TYPE_CHECKING, Any, Dict, List
+from typing import TYPE_CHECKING, Any, Dict, List, Tuple
 
 from minros.client.msg import args_kwds_to_message, frame_len, serialize_frame, stamp_header
 from minros.exceptions import ROSException
@@ -43,6 +50,12 @@ class Publication:
         self.type: str = data_class._type
         self.md5sum: str = data_class._md5sum
         self.connections: List[Transport] = []
+        #: the connections that take message objects (intra-process links), also in connections
+        self.takers: List[Any] = []
+        #: subscribers of this process get the published objects themselves (shared)
+        self.intraprocess = False
+        #: the loan not published yet: (the connection that lent it, its Loan)
+        self._loan: Tuple[Any, Any] | None = None
         self.lock = threading.RLock()
         self.listeners: List[Any] = []
         self.headers: Dict[str, str] = {}
@@ -78,13 +91,16 @@ class Publication:
                 transport.close()
                 return False
             self.connections = self.connections + [transport]
+            takes_objects = getattr(transport, "takes_objects", False)
+            if takes_objects:
+                self.takers = self.takers + [transport]
             if self.is_latch and self.latch is not None:
-                transport.send(self._serialize(self.latch))
+                self._send_one(transport, self.latch)
         for listener in list(self.listeners):
             def publish_single(*args: Any, _conn: Transport = transport, **kwds: Any) -> None:
                 msg = args_kwds_to_message(self.data_class, args, kwds)
                 with self.lock:
-                    _conn.send(self._serialize(msg))
+                    self._send_one(_conn, msg)
             try:
                 listener.peer_subscribe(self.resolved_name, self._publish_any, publish_single)
             except Exception:
@@ -97,6 +113,7 @@ class Publication:
             if transport not in self.connections:
                 return
             self.connections = [c for c in self.connections if c is not transport]
+            self.takers = [c for c in self.takers if c is not transport]
             remaining = len(self.connections)
         for listener in list(self.listeners):
             try:
@@ -108,6 +125,15 @@ class Publication:
         self.publish(args_kwds_to_message(self.data_class, args, kwds))
 
     # -- publishing --------------------------------------------------------------------------
+
+    def _send_one(self, conn: Any, msg: Any) -> None:
+        """Called with the lock held: ``msg`` to one connection."""
+        if getattr(conn, "takes_objects", False):
+            self.seq += 1
+            stamp_header(msg, self.seq)
+            conn.put(msg)
+        else:
+            conn.send(self._serialize(msg))
 
     def _serialize(self, msg: Any) -> Any:
         """Called with the lock held: Header.seq auto-fill, then one serialization."""
@@ -129,15 +155,87 @@ class Publication:
                 self.latch = msg
             conns = self.connections if connection_override is None else [connection_override]
             if not conns:
+                self._give_back()
                 return
             # Header auto-fill, then one serialization for every connection
             self.seq += 1
             if getattr(msg, "_has_header", False):
                 stamp_header(msg, self.seq)
+            takers = self.takers
+            if connection_override is not None:
+                takers = [t for t in takers if t is connection_override]
+            if takers:  # intra-process links: the object itself
+                for taker in takers:
+                    taker.put(msg)
+                if len(takers) == len(conns):
+                    return
+                conns = [c for c in conns if c not in takers]
+            lender = None
+            loan = self._loan
+            if loan is not None and any(c is loan[0] for c in conns):
+                # a loaned array: its connection copies nothing
+                lender = self._publish_loaned(msg)
+                if lender is not None:
+                    conns = [c for c in conns if c is not lender]
+                    if not conns:
+                        return
             frame = serialize_frame(msg)
-            self.message_data_sent += (len(frame) if frame.__class__ is bytes else frame_len(frame)) - 4
+            if lender is None:  # else counted once already
+                self.message_data_sent += (len(frame) if frame.__class__ is bytes else frame_len(frame)) - 4
             for conn in conns:
                 conn.send(frame)
+
+    # -- loans -------------------------------------------------------------------------------
+
+    def loan(self, nbytes: int) -> memoryview:
+        """Writable memory for a message's large ``uint8[]`` array (``nbytes``), to fill in
+        place and publish in the next message: from a shared-memory connection's slot when
+        there is one (no copy at all then), else plain memory (a latched or intra-process
+        publication, no such subscriber). One loan at a time: a new one cancels the last."""
+        if not isinstance(nbytes, int) or nbytes < 0:
+            raise ValueError("loan(nbytes): nbytes must be a non-negative int")
+        with self.lock:
+            self._give_back()
+            if not self.is_latch and not self.intraprocess and nbytes:
+                for conn in self.connections:
+                    lend = getattr(conn, "lend", None)
+                    loaned = lend(nbytes) if lend is not None else None
+                    if loaned is not None:
+                        self._loan = (conn, loaned)
+                        return loaned.view
+        return memoryview(bytearray(nbytes))
+
+    def _give_back(self) -> None:
+        """Called with the lock held: cancel the loan not published."""
+        loan, self._loan = self._loan, None
+        if loan is not None:
+            loan[0].give_back(loan[1])
+
+    def _publish_loaned(self, msg: Any) -> Any:
+        """Called with the lock held: send ``msg`` in place to the connection that lent its
+        array, if it holds the loan; that connection, or None."""
+        conn, loaned = self._loan  # type: ignore[misc]
+        self._loan = None
+        view = loaned.view
+        parts: List[Any] = []
+        try:
+            msg._serialize_parts(parts.append)
+        except Exception:  # noqa: BLE001 - serialize_frame says what is wrong, below
+            conn.give_back(loaned)
+            return None
+        address = _address(view)
+        for i, part in enumerate(parts):
+            if part.__class__ is memoryview and part.nbytes == view.nbytes and \
+                    _address(part) == address:
+                head = b"".join(parts[:i])
+                tail = b"".join(parts[i + 1:])
+                size = len(head) + view.nbytes + len(tail)
+                if conn.send_loaned(loaned, _U32.pack(size) + head, tail):
+                    self.message_data_sent += size
+                    return conn
+                return None
+        conn.give_back(loaned)  # the message does not hold it
+        return None
 
     # -- bookkeeping -------------------------------------------------------------------------
 
@@ -176,6 +274,18 @@ class Publication:
     def close(self) -> None:
         with self.lock:
             self.closed = True
+            self._give_back()
             conns, self.connections = self.connections, []
         for conn in conns:
             conn.close()
+
+
+_U32 = struct.Struct("<I")
+
+
+def _address(buf: Any) -> int:
+    """Where a writable buffer's memory starts (-1 for a read-only one)."""
+    try:
+        return ctypes.addressof(ctypes.c_char.from_buffer(buf))
+    except (TypeError, ValueError):
+        return -1

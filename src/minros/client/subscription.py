@@ -7,6 +7,10 @@ the handler of the protocol the publisher chose, the connection-header exchange,
 receive loop, which deserializes each frame and runs the callbacks itself (no hand-off, as in
 rospy). A connection that fails is tried again while the master still lists its publisher,
 backing off from 0.5 s to 8 s; a publisher that refuses the connection outright is left alone.
+A protocol that cannot carry the connection after all (``FallBack``: shared memory refused or
+broken) is said once and left out of the offers to that publisher from then on, at once.
+A publisher of this very node that hands over its objects (``intraprocess``) is connected
+without a requestTopic (``Node.local_transport``).
 """
 
 from __future__ import annotations
@@ -18,8 +22,7 @@ import traceback
 from typing import TYPE_CHECKING, Any, Callable, Dict, List, Tuple
 
 from minros.client import log
-from minros.msgs import reader_for
-from minros.transport.base import ProtocolHandler, Transport
+from minros.transport.base import FallBack, ProtocolHandler, Transport
 from minros.wire import tcpros
 from minros.wire.handshake import Handshake, Rejected, Role
 from minros.wire.rosapi import RemoteError, unwrap
@@ -58,6 +61,8 @@ class PublisherConnection:
         self.connected = False
         self.gen = 0
         self.reported: set = set()
+        #: protocols not offered to this publisher any more (they fell back)
+        self.excluded: set = set()
         self.thread = threading.Thread(target=self._run, daemon=True,
                                        name=f"minros-sub:{sub.resolved_name}")
 
@@ -107,6 +112,17 @@ class PublisherConnection:
         node = self.sub.node
         try:
             while not self.done and not node.is_shutdown():
+                local = node.local_transport(self.sub.resolved_name, self.pub_uri,
+                                             self.sub.data_class, self._fields())
+                if local is not None:
+                    self.transport = local
+                    self.connected = True
+                    try:
+                        self._receive_loop()
+                    finally:
+                        self.connected = False
+                        local.close()
+                    return
                 try:
                     handler, answer = self._request_topic()
                 except OSError as exc:
@@ -123,6 +139,9 @@ class PublisherConnection:
                         if self._connect(handler, answer):
                             interval = RETRY_FIRST
                             self._receive_loop()
+                    except FallBack as exc:  # the next protocol, at once
+                        self._fall_back(handler, exc)
+                        continue
                     except ValueError as exc:  # an answer the handler cannot use
                         _logger.debug("not connecting to %s: %s", self.pub_uri, exc)
                         return
@@ -154,19 +173,32 @@ class PublisherConnection:
             log.logwarn(f"[{self.sub.resolved_name}] connection to publisher "
                         f"[{self.pub_uri}] failed: {text}")
 
+    def _fall_back(self, handler: ProtocolHandler, exc: FallBack) -> None:
+        """``handler``'s protocol cannot carry this connection: one line, and it is not
+        offered to this publisher again."""
+        self.excluded.add(handler.protocol)
+        if not self.done and not self.sub.node.is_shutdown_requested():
+            log.logwarn(f"[{self.sub.resolved_name}] {handler.protocol} with publisher "
+                        f"[{self.pub_uri}] failed: {exc}; falling back to the next protocol")
+
+    def _offers(self) -> List[ProtocolHandler]:
+        protocols = self.sub.node.protocols
+        return [h for h in protocols[:-1] if h.protocol not in self.excluded] + protocols[-1:]
+
     def _request_topic(self) -> Tuple[ProtocolHandler, List[Any]]:
         """Ask the publisher for a connection, offering the protocols the node speaks."""
         node = self.sub.node
         proxy = ServerProxy(self.pub_uri, timeout=REQUEST_TOPIC_TIMEOUT)
+        offers = self._offers()
         try:
             answer = unwrap(proxy.requestTopic(node.caller_id, self.sub.resolved_name,
-                                               [handler.offer() for handler in node.protocols]))
+                                               [handler.offer() for handler in offers]))
         except RemoteError as exc:
             raise _GiveUp(f"requestTopic: {exc}") from None
         finally:
             proxy.close()
         if isinstance(answer, list) and answer:
-            for handler in node.protocols:
+            for handler in offers:
                 if handler.protocol == answer[0]:
                     return handler, answer
         raise _GiveUp(f"publisher returned invalid protocol choice: {answer}")
@@ -180,16 +212,22 @@ class PublisherConnection:
         if self.done:  # closed while connecting: close() did not see the transport
             transport.close()
             return False
-        transport.negotiate(Handshake(Role.SUBSCRIBER, {
+        transport.negotiate(Handshake(Role.SUBSCRIBER, self._fields()))
+        self.connected = True
+        return True
+
+    def _fields(self) -> Dict[str, str]:
+        """Our connection header."""
+        sub = self.sub
+        data_class = sub.data_class
+        return {
             "topic": sub.resolved_name,
             "message_definition": data_class._full_text,
             "tcp_nodelay": "1" if sub.tcp_nodelay else "0",
             "md5sum": data_class._md5sum,
             "type": data_class._type,
             "callerid": sub.node.caller_id,
-        }))
-        self.connected = True
-        return True
+        }
 
     def _receive_loop(self) -> None:
         sub = self.sub
@@ -197,7 +235,8 @@ class PublisherConnection:
         assert transport is not None
         header = transport.header
         latching = header.get("latching", "0") == "1"
-        read = reader_for(sub.data_class)
+        read = transport.message_reader(sub.data_class)
+        settle = transport.settle  # shared memory: the callbacks may keep a message
         deliver = sub.deliver if sub.statistics is None else sub.statistics.wrap(self, sub.deliver)
         receive = transport.receive
         while True:
@@ -226,6 +265,8 @@ class PublisherConnection:
                 if self.done:
                     return
                 deliver(msg)
+                if settle is not None:
+                    settle(msg)
             if self.done:
                 return
 

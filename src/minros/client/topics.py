@@ -76,12 +76,19 @@ def _acquire(registry: Dict[str, Any], make: Callable[[], Any], add: Callable[[A
         return impl, fresh
 
 
-def acquire_publication(name: str, data_class: Any) -> Publication:
-    """The process's publication of topic ``name``, with one more reference."""
+def acquire_publication(name: str, data_class: Any, intraprocess: bool = False) -> Publication:
+    """The process's publication of topic ``name``, with one more reference (``intraprocess``:
+    set before anyone can connect to it)."""
     _check(name, data_class)
     me = _node_mod.default_node()
     resolved = me.resolve_topic_name(name)
-    pub, fresh = _acquire(me.publications, lambda: Publication(me, name, resolved, data_class),
+
+    def make() -> Publication:
+        made = Publication(me, name, resolved, data_class)
+        made.intraprocess = intraprocess
+        return made
+
+    pub, fresh = _acquire(me.publications, make,
                           lambda p: me.add_publication(p, announce=False), resolved, data_class,
                           "publisher")
     if fresh:
@@ -123,9 +130,9 @@ class Topic:
     _kind = ""
     impl: Any
 
-    def __init__(self, name: str, data_class: Any) -> None:
+    def __init__(self, name: str, data_class: Any, intraprocess: bool = False) -> None:
         if self._kind == "pub":
-            self.impl = acquire_publication(name, data_class)
+            self.impl = acquire_publication(name, data_class, intraprocess)
         else:
             self.impl = acquire_subscription(name, data_class)
         self.name = self.impl.resolved_name
@@ -162,8 +169,12 @@ class Publisher(Topic):
 
     def __init__(self, name: str, data_class: Any, subscriber_listener: SubscribeListener | None = None,
                  tcp_nodelay: bool = False, latch: bool = False, headers: Dict[str, str] | None = None,
-                 queue_size: int | None = None) -> None:
-        super().__init__(name, data_class)
+                 queue_size: int | None = None, intraprocess: bool = False) -> None:
+        """rospy's arguments, and minros's ``intraprocess``: subscribers in this process get
+        the published message objects themselves, without serialization, as roscpp's
+        intra-process delivery of a published shared_ptr. The object is then shared: do not
+        change a message after publishing it, nor one a callback receives."""
+        super().__init__(name, data_class, intraprocess)
         impl = self.impl
         if subscriber_listener:
             impl.listeners.append(subscriber_listener)
@@ -182,6 +193,18 @@ class Publisher(Topic):
                 "The publisher should be created with an explicit keyword argument 'queue_size'. "
                 "Please see http://wiki.ros.org/rospy/Overview/Publishers%20and%20Subscribers "
                 "for more information.", SyntaxWarning, stacklevel=2)
+
+    def loan(self, nbytes: int) -> memoryview:
+        """minros: writable memory for the large ``uint8[]`` array of the next message
+        (``nbytes``: ``Image.data``, ``PointCloud2.data``), to fill in place and put in the
+        message before ``publish()``. With a subscriber on shared memory it is that
+        subscriber's slot, so the message is published without a copy; otherwise plain
+        memory. Fill it before publishing and not after; one loan at a time."""
+        impl = self.impl
+        if impl is None:
+            raise ROSException("loan() on an unregistered() handle")
+        view: memoryview = impl.loan(nbytes)
+        return view
 
     def publish(self, *args: Any, **kwds: Any) -> None:
         """Publish a message instance, or build one from positional or keyword fields."""

@@ -65,6 +65,118 @@ class ChildROSLaunchProcess(Process):
         self.uri = uri
 
 
+# -- roslaunch.remoteprocess ----------------------------------------------------------------
+
+TIMEOUT_SSH_CONNECT = 30.0  # seconds roslaunch gives an SSH connection
+
+_SSH_UNKNOWN_TEXT = """{host} is not in your SSH known_hosts file.
+
+Please manually:
+  ssh {port}{user}{host}
+
+then try roslaunching again.
+
+If you wish to configure roslaunch to automatically recognize unknown
+hosts, please set the environment variable ROSLAUNCH_SSH_UNKNOWN=1"""
+
+
+def _known_host_patterns(line: str) -> List[str]:
+    """The host patterns of one known_hosts line (``@cert-authority`` markers skipped)."""
+    fields = line.split()
+    if fields and fields[0].startswith("@"):
+        fields = fields[1:]
+    return fields[0].split(",") if len(fields) >= 3 else []
+
+
+def _known_host_matches(pattern: str, host: str, port: int) -> bool:
+    import base64
+    import hashlib
+    import hmac
+    import re
+
+    wanted = host if port == 22 else f"[{host}]:{port}"
+    if pattern.startswith("|1|"):  # hashed: |1|base64(salt)|base64(HMAC-SHA1(salt, host))
+        try:
+            _, _, salt, digest = pattern.split("|")
+            mac = hmac.new(base64.b64decode(salt), wanted.encode(), hashlib.sha1).digest()
+            return hmac.compare_digest(mac, base64.b64decode(digest))
+        except (ValueError, TypeError):
+            return False
+    # OpenSSH's wildcards are '*' and '?' only ('[host]:port' is literal)
+    regex = re.escape(pattern).replace(r"\*", ".*").replace(r"\?", ".")
+    return not pattern.startswith("!") and re.fullmatch(regex, wanted) is not None
+
+
+def is_known_host(host: str, port: int = 22, files: Optional[List[str]] = None) -> bool:
+    """Whether ``host`` has a key in the system's or the user's SSH known_hosts file."""
+    files = files if files is not None else [
+        "/etc/ssh/ssh_known_hosts", os.path.join(os.path.expanduser("~"), ".ssh", "known_hosts")]
+    for path in files:
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                lines = f.read().splitlines()
+        except OSError:
+            continue
+        for line in lines:
+            if line.strip() and not line.lstrip().startswith("#") and any(
+                    _known_host_matches(p, host, port) for p in _known_host_patterns(line)):
+                return True
+    return False
+
+
+def ssh_check_known_hosts(ssh: Any, address: str, port: int, username: Optional[str] = None,
+                          logger: Any = None) -> Optional[str]:
+    """roslaunch's advice when ``address`` is not in the SSH known_hosts files (None when it
+    is, or when ROSLAUNCH_SSH_UNKNOWN=1 accepts unknown hosts). ``ssh`` (paramiko's client in
+    ROS) is not used: minros reads the known_hosts files itself."""
+    if os.environ.get("ROSLAUNCH_SSH_UNKNOWN", "0") == "1" or is_known_host(address, port):
+        return None
+    return _SSH_UNKNOWN_TEXT.format(host=address, port=f"-p {port} " if port != 22 else "",
+                                    user=f"{username}@" if username else "")
+
+
+class SSHChildROSLaunchProcess(ChildROSLaunchProcess):
+    """A child roslaunch on another machine, which roslaunch starts over SSH. minros launches
+    on this machine only: the command line is built as roslaunch's, ``start()`` says why it
+    cannot run it and returns False, as roslaunch does when the SSH connection fails."""
+
+    def __init__(self, run_id: str, name: str, server_uri: str, machine: Any,
+                 master_uri: Optional[str] = None,
+                 sigint_timeout: float = DEFAULT_TIMEOUT_SIGINT,
+                 sigterm_timeout: float = DEFAULT_TIMEOUT_SIGTERM) -> None:
+        if not getattr(machine, "env_loader", None):
+            raise ValueError("machine.env_loader must have been assigned before creating ssh "
+                             "child instance")
+        args = [machine.env_loader, "roslaunch", "-c", name, "-u", server_uri, "--run_id", run_id,
+                "--sigint-timeout", str(sigint_timeout), "--sigterm-timeout", str(sigterm_timeout)]
+        super().__init__(name, args, {})
+        self.machine = machine
+        self.master_uri = master_uri
+        self.sigint_timeout = sigint_timeout
+        self.sigterm_timeout = sigterm_timeout
+        self.ssh = self.sshin = self.sshout = self.ssherr = None
+        self.started = False
+        self.is_dead = False
+
+    def start(self) -> bool:
+        m = self.machine
+        printerrlog(f"remote[{self.name}]: failed to launch on {m.name}:\n\n"
+                    f"minros launches nodes on this machine only; it does not start roslaunch "
+                    f"over SSH on [{m.address}]. Start a roslaunch there yourself, or drop "
+                    f"machine=\"{m.name}\" from the launch file.\n\n")
+        self.started = True
+        return False
+
+    def getapi(self) -> Any:
+        return xmlrpc.client.ServerProxy(self.uri) if self.uri else None
+
+    def is_alive(self) -> bool:
+        return not self.started  # not started counts as alive, as in roslaunch
+
+    def stop(self, errors: Optional[List[str]] = None) -> None:
+        self.ssh = self.sshin = self.sshout = self.ssherr = None
+
+
 # -- XML-RPC handlers ------------------------------------------------------------------------
 
 class ROSLaunchBaseHandler(XmlRpcHandler):

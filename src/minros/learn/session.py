@@ -221,7 +221,9 @@ class Runner:
             return
         (self.folder / "env.sh").write_text(
             f"# minros learn {facts['number']}: the learner's terminal\n"
-            f"export ROS_MASTER_URI={master}\nexport ROS_HOSTNAME=localhost\n")
+            f"export ROS_MASTER_URI={master}\nexport ROS_HOSTNAME=localhost\n"
+            "# the exercises teach TCPROS: minros nodes of one host would take shared memory\n"
+            "export MINROS_SHM=0\n")
 
     def _save(self) -> None:
         (self.folder / STATE).write_text(json.dumps(self.facts, indent=1, sort_keys=True) + "\n")
@@ -231,7 +233,11 @@ class Runner:
                if not k.startswith(("ROS_", "MINROS_")) and k != "PYTHONPATH"}
         master = facts["master_b"] if process.master == "b" else facts["master"]
         env.update(ROS_MASTER_URI=master, ROS_HOSTNAME="localhost", PYTHONUNBUFFERED="1",
-                   ROS_LOG_DIR=str(self.folder / "log"))
+                   ROS_LOG_DIR=str(self.folder / "log"),
+                   # the exercises teach TCPROS, the wire every ROS 1 speaks: a minros pair
+                   # on one host would otherwise take shared memory (a publisher set so
+                   # answers TCPROS to any subscriber, the learner's included)
+                   MINROS_SHM="0")
         if process.traced:
             env["MINROS_TRACE"] = str(self.folder / f"{process.name}.jsonl")
         return env

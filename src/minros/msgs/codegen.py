@@ -47,6 +47,11 @@ def numpy_class_name(type_name: str) -> str:
     return "Numpy_" + type_name.replace("/", "__")
 
 
+def in_place_class_name(type_name: str) -> str:
+    """The name of the in-place variant of ``type_name`` (see ``generate_source``)."""
+    return "InPlace_" + type_name.replace("/", "__")
+
+
 def _compress(run: List[Tuple[int, str]]) -> str:
     merged: List[List] = []
     for count, code in run:
@@ -256,8 +261,9 @@ class _SerializerGen(_Writer):
 
 class _DeserializerGen(_Writer):
     def __init__(self, structs: Dict[str, str], get_spec: GetSpec, type_name: str,
-                 numpy: bool) -> None:
+                 numpy: bool, in_place: bool = False) -> None:
         super().__init__(structs)
+        self.in_place = in_place
         self.get_spec = get_spec
         self.type_name = type_name
         self.numpy = numpy
@@ -359,6 +365,8 @@ class _DeserializerGen(_Writer):
                     self.need(ind, count, fpath)
                     if self.numpy:
                         self.emit(ind, f"{target} = _numpy_view('B', {count}, view, end)")
+                    elif self.in_place:  # a slice of the data: a view when it is a memoryview
+                        self.emit(ind, f"{target} = view[end:end + {count}]")
                     else:
                         self.emit(ind, f"{target} = bytes(view[end:end + {count}])")
                     self.emit(ind, f"end += {count}")
@@ -437,7 +445,8 @@ class _DeserializerGen(_Writer):
 
     def _flat_array(self, ind: int, items: str, bt: str, count: str, fpath: str) -> None:
         """Elements of fixed-size primitives only: one ``iter_unpack`` over the whole array."""
-        sub = _DeserializerGen(self.structs, self.get_spec, self.type_name, self.numpy)
+        sub = _DeserializerGen(self.structs, self.get_spec, self.type_name, self.numpy,
+                               self.in_place)
         sub.counter = self.counter
         var = sub.tmp("_e")
         sub.emit(0, f"{var} = _new({dep_name(bt)})")
@@ -489,12 +498,15 @@ def default_value(type_: str, base_type: str, is_array: bool, array_len: int | N
 
 
 def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: str,
-                    module: str | None = None, numpy: bool = False) -> str:
+                    module: str | None = None, numpy: bool = False,
+                    in_place: bool = False) -> str:
     """Python source defining the class for ``spec`` (named as its short name).
 
     The module needs ``_load(type_name) -> class`` in its globals for embedded types; with
     ``numpy=True`` it also needs ``_base_class`` and defines a subclass whose numeric arrays
-    deserialize as numpy views.
+    deserialize as numpy views; with ``in_place=True`` one whose variable-length ``uint8[]`` and
+    ``char[]`` fields are slices of the data read (memoryviews of it, not copies), which the
+    shared-memory transport reads its slots with.
     """
     name = spec.short_name
     structs: Dict[str, str] = {}
@@ -507,12 +519,12 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
     ser = _SerializerGen(structs, get_spec)
     ser.fields(spec, "self", "", 2)
     ser.flush(2)
-    de = _DeserializerGen(structs, get_spec, spec.full_name, numpy)
+    de = _DeserializerGen(structs, get_spec, spec.full_name, numpy, in_place)
     de.fields(spec, "self", "", 2, reuse=True)
     de.flush(2)
     # for a message made by __new__ (no fields yet): embedded messages and times are new
     # objects, so receivers skip building default fields that the data replaces anyway
-    fresh = _DeserializerGen(structs, get_spec, spec.full_name, numpy)
+    fresh = _DeserializerGen(structs, get_spec, spec.full_name, numpy, in_place)
     fresh.fields(spec, "self", "", 2, reuse=False)
     fresh.flush(2)
 
@@ -529,7 +541,13 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
             out.append(f"{sname} = _Struct({'<' + fmt!r})")
     out.append("")
     out.append("")
-    if numpy:
+    if in_place:
+        out.append(f"class {in_place_class_name(spec.full_name)}(_base_class):")
+        out.append(f'    """{spec.full_name} whose byte arrays are views of the received bytes."""')
+        out.append("")
+        out.append(f"    __slots__ = {attrs!r}")
+        out.append("    _keeps_buffer = True  # its byte arrays are views of the received bytes")
+    elif numpy:
         out.append(f"class {numpy_class_name(spec.full_name)}(_base_class):")
         out.append(f'    """{spec.full_name} whose numeric arrays are numpy views of the received bytes."""')
         out.append("")

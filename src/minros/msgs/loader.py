@@ -530,3 +530,48 @@ def compute_full_type_name(package_name: str, file_name: str) -> str:
             file_name = file_name[:-len(ext)]
             break
     return f"{package_name}/{file_name}"
+
+
+# ---------------------------------------------------------------------------------------------
+# the files a .msg/.srv depends on (genmsg.deps: what catkin lists as a generator's inputs)
+
+def _dependency_files(context: MsgContext, full_names: Sequence[str]) -> List[Tuple[str, str]]:
+    found = {(dep, context.get_file(dep) or "") for name in full_names
+             for dep in context.get_all_depends(name)}
+    return sorted(found)
+
+
+def find_msg_dependencies_with_type(pkg_name: str, msg_file: str,
+                                    search_paths: Dict[str, List[str]]) -> List[Tuple[str, str]]:
+    """``(type, file)`` of every message ``msg_file`` (of package ``pkg_name``) depends on,
+    directly or not, looked up in ``search_paths`` (``{package: [msg folders]}``)."""
+    context = MsgContext.create_default()
+    full_name = compute_full_type_name(pkg_name, os.path.basename(msg_file))
+    spec = load_msg_from_file(context, msg_file, full_name)
+    try:
+        load_depends(context, spec, search_paths)
+    except InvalidMsgSpec as exc:
+        raise MsgGenerationException(f"Cannot read .msg for {full_name}: {exc}") from None
+    return _dependency_files(context, [full_name])
+
+
+def find_msg_dependencies(pkg_name: str, msg_file: str, search_paths: Dict[str, List[str]]) -> List[str]:
+    """The files of the messages ``msg_file`` depends on."""
+    return [path for _type, path in find_msg_dependencies_with_type(pkg_name, msg_file, search_paths)]
+
+
+def find_srv_dependencies_with_type(pkg_name: str, srv_file: str,
+                                    search_paths: Dict[str, List[str]]) -> List[Tuple[str, str]]:
+    """``(type, file)`` of every message the request and response of ``srv_file`` depend on."""
+    context = MsgContext.create_default()
+    full_name = compute_full_type_name(pkg_name, os.path.basename(srv_file))
+    spec = load_srv_from_file(context, srv_file, full_name)
+    try:
+        load_depends(context, spec, search_paths)
+    except InvalidMsgSpec as exc:
+        raise MsgGenerationException(f"Cannot read .msg for {full_name}: {exc}") from None
+    return _dependency_files(context, [spec.request.full_name, spec.response.full_name])
+
+
+def find_srv_dependencies(pkg_name: str, srv_file: str, search_paths: Dict[str, List[str]]) -> List[str]:
+    return [path for _type, path in find_srv_dependencies_with_type(pkg_name, srv_file, search_paths)]

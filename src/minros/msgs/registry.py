@@ -15,7 +15,7 @@ import threading
 from pathlib import Path
 from typing import Any, Dict, List, Set, Tuple
 
-from .codegen import generate_source, numpy_class_name
+from .codegen import generate_source, in_place_class_name, numpy_class_name
 from .message import Message
 from .spec import (
     ACTION_SUFFIXES,
@@ -87,6 +87,7 @@ class MsgContext:
         self._md5: Dict[str, str] = {}
         self._classes: Dict[str, type] = {}
         self._numpy_classes: Dict[type, type] = {}
+        self._in_place_classes: Dict[type, type] = {}
         self._srv_classes: Dict[str, type] = {}
 
     # -- specs -------------------------------------------------------------------------------
@@ -225,12 +226,13 @@ class MsgContext:
         all_dependencies(spec, self.get_spec)
 
     # -- classes -------------------------------------------------------------------------------
-    def source(self, type_name: str, numpy: bool = False) -> str:
+    def source(self, type_name: str, numpy: bool = False, in_place: bool = False) -> str:
         """The generated Python source of the class for ``type_name``."""
         type_name = normalize_type(type_name)
         spec = self.get_spec(type_name)
         return generate_source(spec, self.get_spec, self.md5sum(type_name),
-                               self.full_text(type_name), self._module_for(type_name), numpy)
+                               self.full_text(type_name), self._module_for(type_name), numpy,
+                               in_place)
 
     def _module_for(self, type_name: str) -> str | None:
         if self._module_name is not None:
@@ -312,15 +314,31 @@ class MsgContext:
                 self._numpy_classes[cls] = found
             return found
 
-    def _compile(self, type_name: str, source: str, base_class: type | None) -> type:
-        filename = f"<minros msg {type_name}{' numpy' if base_class else ''}>"
+    def get_in_place_class(self, cls: Any) -> type:
+        """The variant of message class ``cls`` whose byte arrays deserialize as views of the
+        data (its deserializers are used on instances of ``cls``: ``reader_for(cls, True)``)."""
+        found = self._in_place_classes.get(cls)
+        if found is None:
+            with self._lock:
+                found = self._in_place_classes.get(cls)
+                if found is None:
+                    found = self._compile(cls._type, self.source(cls._type, in_place=True), cls,
+                                          in_place_class_name(cls._type))
+                    self._in_place_classes[cls] = found
+        return found
+
+    def _compile(self, type_name: str, source: str, base_class: type | None,
+                 name: str | None = None) -> type:
+        variant = "" if base_class is None else " in place" if name else " numpy"
+        filename = f"<minros msg {type_name}{variant}>"
         linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
         namespace: Dict[str, Any] = {"_load": self.get_class}  # embedded types from this context
         namespace["__name__"] = self._module_for(type_name) or "minros.msgs.generated"
         if base_class is not None:
             namespace["_base_class"] = base_class
         exec(compile(source, filename, "exec"), namespace)
-        name = numpy_class_name(type_name) if base_class is not None else type_name.rpartition("/")[2]
+        if name is None:
+            name = numpy_class_name(type_name) if base_class is not None else type_name.rpartition("/")[2]
         cls = namespace[name]
         cls._context = self  # numpy_msg() and tools find the registry a class came from
         return cls

@@ -38,7 +38,8 @@ from minros.node.registries import (
 )
 from minros.node.slave_api import SlaveApi
 from minros.node.tcpros_server import TCPROS_LIMITS, TCPROSServer
-from minros.transport.base import ProtocolHandler
+from minros.transport import intraprocess, shm
+from minros.transport.base import ProtocolHandler, Transport
 from minros.transport.tcpros_pubsub import TCPROSHandler
 from minros.wire import admission, tcpros, trace
 from minros.wire.handshake import route
@@ -64,8 +65,13 @@ class Node:
                                    XMLRPC_TIMEOUT)
         self.registration = Registration(self.master, self.registries, self.lifecycle,
                                          lambda: self.uri, self.rosrpc_uri)
-        #: the transports this node speaks, in the order a subscriber offers them
+        #: the transports this node speaks, in the order a subscriber offers them: shared
+        #: memory (same host, minros peers) when this system has it, TCPROS last
         self.protocols: List[ProtocolHandler] = [TCPROSHandler(lambda: self.tcpros_address())]
+        if shm.supported():
+            self.protocols.insert(0, shm.ShmHandler(
+                lambda topic: self.registries.publications.get(topic),
+                                                    self.is_shutdown_requested))
         self.uri: str | None = None  # the slave API's, once started
         self.host = ""
         self._xmlrpc: XmlRpcServer | None = None
@@ -205,6 +211,8 @@ class Node:
                 _logger.debug("close failed: %s", traceback.format_exc())
         if self._tcpros is not None:
             self._tcpros.close()
+        for handler in self.protocols:
+            handler.close()
         if self._xmlrpc is not None:
             self._xmlrpc.shutdown()
 
@@ -239,6 +247,18 @@ class Node:
             if handler.protocol == offer[0]:
                 return handler.answer(topic, offer)
         return None
+
+    def local_transport(self, topic: str, pub_uri: str, data_class: Any,
+                        fields: Dict[str, str]) -> Transport | None:
+        """The subscriber's end of an intra-process link when ``pub_uri`` is this node and its
+        publication of ``topic`` hands its messages over as objects (``intraprocess``) of
+        ``data_class``, the subscriber's (``fields``: its connection header); else None."""
+        if pub_uri != self.uri:
+            return None
+        pub = self.registries.publications.get(topic)
+        if pub is None or not pub.intraprocess or pub.closed or pub.data_class is not data_class:
+            return None
+        return intraprocess.link(pub, fields)
 
     def _dispatch(self, stream: Any, header: Dict[str, str], conn: admission.Connection) -> str | None:
         """Hand an inbound connection to what its header names; the error text when it cannot be."""

@@ -11,10 +11,12 @@ order: client hooks, pre-shutdown hooks, then (with the flag set) shutdown hooks
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import os
 import sys
 import threading
+import time
 import types
 import warnings
 import xmlrpc.client
@@ -46,6 +48,38 @@ from minros.client.log import (  # noqa: F401 - rospy.core's logging functions
     logwarn_throttle_identical,
 )
 from minros.exceptions import ROSException
+from minros.rospy_internals.names import (  # noqa: F401 - rospy.core does `from rospy.names import *`
+    ANYTYPE,
+    GLOBALNS,
+    REMAP,
+    SEP,
+    SERVICE_ANYTYPE,
+    TOPIC_ANYTYPE,
+    ROSInitException,
+    canonicalize_name,
+    get_caller_id,
+    get_mappings,
+    get_name,
+    get_namespace,
+    get_resolved_mappings,
+    get_ros_namespace,
+    global_name,
+    initialize_mappings,
+    is_global,
+    is_private,
+    isstring,
+    load_mappings,
+    make_global_ns,
+    namespace,
+    ns_join,
+    reload_mappings,
+    remap_name,
+    resolve_name,
+    resolve_name_without_node_name,
+    scoped_name,
+    valid_name_validator_resolved,
+    valid_name_validator_unresolved,
+)
 from minros.wire.rosapi import (  # noqa: F401
     ROSRPC,
     ParameterInvalid,
@@ -96,6 +130,58 @@ def deprecated(func: Callable) -> Callable:
 class NullHandler(logging.Handler):
     def emit(self, record: logging.LogRecord) -> None:
         pass
+
+
+# rospy's call-site filters of the log*_throttle/_identical/_once functions, as classes code can
+# use on its own keys (minros's log functions keep their own per-call-site state).
+
+class LoggingThrottle:
+    """``throttle(caller_id, period)`` is True at most once per ``period`` seconds of ROS time
+    for each ``caller_id`` (and again at once when time jumps backwards)."""
+
+    def __init__(self) -> None:
+        self.last_logging_time_table: Dict[Any, float] = {}
+
+    def __call__(self, caller_id: Any, period: float) -> bool:
+        from minros.client import rostime
+
+        now = rostime.get_time() if rostime.is_rostime_initialized() else time.time()
+        last = self.last_logging_time_table.get(caller_id)
+        if last is None or now - last > period:
+            self.last_logging_time_table[caller_id] = now
+            return True
+        if last > now:
+            self.last_logging_time_table = {caller_id: now}
+            return True
+        return False
+
+
+class LoggingIdentical:
+    """``identical(caller_id, msg)`` is True when ``msg`` differs from the last one of
+    ``caller_id``."""
+
+    def __init__(self) -> None:
+        self.last_logging_msg_table: Dict[Any, str] = {}
+
+    def __call__(self, caller_id: Any, msg: str) -> bool:
+        digest = hashlib.md5(str(msg).encode()).hexdigest()
+        if self.last_logging_msg_table.get(caller_id) == digest:
+            return False
+        self.last_logging_msg_table[caller_id] = digest
+        return True
+
+
+class LoggingOnce:
+    """``once(caller_id)`` is True the first time only."""
+
+    def __init__(self) -> None:
+        self.called_caller_ids: set = set()
+
+    def __call__(self, caller_id: Any) -> bool:
+        if caller_id in self.called_caller_ids:
+            return False
+        self.called_caller_ids.add(caller_id)
+        return True
 
 
 def get_ros_root(required: bool = False, env: Optional[Mapping[str, str]] = None) -> Optional[str]:
@@ -358,5 +444,54 @@ class _CoreModule(types.ModuleType):
     def _client_ready(self) -> bool:
         return is_initialized()
 
+    @property
+    def Log(self) -> type:  # noqa: N802 - rospy.core's name for rosgraph_msgs/Log
+        # generated on first use, so that importing rospy does not build the class
+        from minros.msgs import get_message_class
+
+        return get_message_class("rosgraph_msgs/Log")
+
 
 sys.modules[__name__].__class__ = _CoreModule
+
+#: what ``from rospy.core import *`` gives: rospy.core's public names
+__all__ = [
+    "ANYTYPE", "GLOBALNS", "Log", "LoggingIdentical", "LoggingOnce", "LoggingThrottle",  # noqa: F822 - Log: a property of the module
+    "MASTER_NAME", "NullHandler", "ParameterInvalid", "REMAP", "ROSException",
+    "ROSInitException", "ROSRPC", "SEP", "SERVICE_ANYTYPE", "TOPIC_ANYTYPE",
+    "add_client_shutdown_hook", "add_preshutdown_hook", "add_shutdown_hook", "canonicalize_name",
+    "configure_logging", "deprecated", "get_caller_id", "get_mappings", "get_name",
+    "get_namespace", "get_node_uri", "get_resolved_mappings", "get_ros_namespace",
+    "get_ros_root", "global_name", "initialize_mappings", "is_global", "is_initialized",
+    "is_private", "is_shutdown", "is_shutdown_requested", "is_topic", "isstring",
+    "load_mappings", "logdebug", "logdebug_once", "logdebug_throttle",
+    "logdebug_throttle_identical", "logerr", "logerr_once", "logerr_throttle",
+    "logerr_throttle_identical", "logerror", "logfatal", "logfatal_once", "logfatal_throttle",
+    "logfatal_throttle_identical", "loginfo", "loginfo_once", "loginfo_throttle",
+    "loginfo_throttle_identical", "logout", "logwarn", "logwarn_once", "logwarn_throttle",
+    "logwarn_throttle_identical", "make_global_ns", "namespace", "ns_join", "parse_rosrpc_uri",
+    "register_signals", "reload_mappings", "remap_name", "resolve_name",
+    "resolve_name_without_node_name", "rospydebug", "rospyerr", "rospyinfo", "rospywarn",
+    "scoped_name", "set_initialized", "set_node_uri", "signal_shutdown", "valid_name",
+    "valid_name_validator_resolved", "valid_name_validator_unresolved", "xmlrpcapi",
+]
+
+
+def star_import(target: Dict[str, Any]) -> None:
+    """``from rospy.core import *`` into ``target`` (a module's globals), as rospy's own
+    modules do, except ``Log``: that one the module serves through the ``__getattr__`` this
+    puts there, so the message class is built on first use only."""
+    module = sys.modules[__name__]
+    for name in __all__:
+        if name != "Log":
+            target[name] = getattr(module, name)
+    previous = target.get("__getattr__")
+
+    def __getattr__(name: str) -> Any:  # noqa: N807 - a module's attribute hook
+        if name == "Log":
+            return module.Log
+        if previous is not None:
+            return previous(name)
+        raise AttributeError(f"module {target.get('__name__')!r} has no attribute {name!r}")
+
+    target["__getattr__"] = __getattr__

@@ -10,6 +10,8 @@ from minros.wire.rosapi import ParameterInvalid
 from minros.wire.rosapi import api as apivalidate  # noqa: F401
 
 STATUS, MSG, VAL = 0, 1, 2  # the triplet's positions
+#: rospy logs each slave API call at debug level (minros's slave API logs its own)
+LOG_API = True
 
 
 def is_publishers_list(param_name: str) -> Callable[[Any, str], Any]:

@@ -13,9 +13,11 @@ from typing import Any, Dict, Optional
 
 from minros import names as _names
 from minros import node as _node
-from minros.exceptions import ROSException
+from minros.exceptions import ROSException, ROSInitException  # noqa: F401
 from minros.names import (  # noqa: F401 - rospy.names' namespace has them
     ANYTYPE,
+    GLOBALNS,
+    REMAP,
     SEP,
     SERVICE_ANYTYPE,
     TOPIC_ANYTYPE,
@@ -24,6 +26,7 @@ from minros.names import (  # noqa: F401 - rospy.names' namespace has them
     is_global,
     is_private,
     load_mappings,
+    make_global_ns,
     namespace,
     ns_join,
 )
@@ -34,6 +37,11 @@ from minros.wire.rosapi import (  # noqa: F401
     valid_name_validator_resolved,
     valid_name_validator_unresolved,
 )
+
+
+def isstring(s: Any) -> bool:
+    """True for a str (rospy's Python 2/3 string test)."""
+    return isinstance(s, str)
 
 
 def reload_mappings(argv: Any) -> None:
@@ -138,10 +146,12 @@ class _NamesModule(types.ModuleType):
 
 sys.modules[__name__].__class__ = _NamesModule
 
-__all__ = ["ANYTYPE", "SEP", "SERVICE_ANYTYPE", "TOPIC_ANYTYPE", "canonicalize_name",
-           "get_caller_id", "get_mappings", "get_name", "get_namespace", "get_resolved_mappings",
-           "global_name", "initialize_mappings", "is_global", "is_private", "namespace",
-           "ns_join", "reload_mappings", "remap_name", "resolve_name",
-           "resolve_name_without_node_name", "scoped_name", "valid_name",
-           "valid_name_validator_resolved", "valid_name_validator_unresolved"]
-
+#: what ``from rospy.names import *`` gives: rospy.names' public names
+__all__ = ["ANYTYPE", "GLOBALNS", "ParameterInvalid", "REMAP", "ROSException", "ROSInitException",
+           "SEP", "SERVICE_ANYTYPE", "TOPIC_ANYTYPE", "canonicalize_name", "get_caller_id",
+           "get_mappings", "get_name", "get_namespace", "get_resolved_mappings",
+           "get_ros_namespace", "global_name", "initialize_mappings", "is_global", "is_private",
+           "isstring", "load_mappings", "make_global_ns", "namespace", "ns_join",
+           "reload_mappings", "remap_name", "resolve_name", "resolve_name_without_node_name",
+           "scoped_name", "valid_name", "valid_name_validator_resolved",
+           "valid_name_validator_unresolved"]

@@ -22,6 +22,19 @@ from minros.exceptions import ServiceException
 from minros.wire.masterapi import MasterClient, RemoteError
 from minros.wire.rosapi import unwrap
 
+from .core import (  # noqa: F401 - rospy.impl.registration's namespace has them
+    add_preshutdown_hook,
+    is_shutdown_requested,
+    logdebug,
+    logerr,
+    logfatal,
+    loginfo,
+    logwarn,
+    signal_shutdown,
+    xmlrpcapi,
+)
+from .names import get_caller_id, get_namespace  # noqa: F401
+
 #: replaced by callers (rospy's tests stub it); looked up at each use
 is_shutdown = _node.is_shutdown
 

@@ -7,7 +7,9 @@ connections are made by the node's subscription."""
 from __future__ import annotations
 
 import socket
-from typing import Any, Dict, List, Optional, Tuple
+import threading
+import time
+from typing import Any, Dict, List, Optional, Tuple, cast
 
 from minros import node as _node
 from minros.names import TOPIC_ANYTYPE
@@ -152,3 +154,94 @@ class TCPROSHandler(ProtocolHandler):
         transport.set_cleanup_callback(topic.remove_connection)
         topic.add_connection(transport)
         return None
+
+
+def check_if_still_publisher(resolved_topic_name: str, pub_uri: str) -> bool:
+    """Whether the node at ``pub_uri`` still publishes ``resolved_topic_name`` (False when it
+    does not answer)."""
+    from .core import xmlrpcapi
+    from .names import get_name
+
+    try:
+        proxy = xmlrpcapi(pub_uri, cache=False)
+        if proxy is None:
+            return False
+        code, _msg, val = cast(Any, proxy.getPublications(get_name()))
+        return code == 1 and any(topic == resolved_topic_name for topic, _type in val)
+    except Exception:  # a dead or foreign peer: not a publisher any more
+        return False
+
+
+def robust_connect_subscriber(conn: Any, dest_addr: str, dest_port: int, pub_uri: str,
+                              receive_cb: Any, resolved_topic_name: str) -> None:
+    """Connect ``conn`` (a TCPROSTransport) to a publisher, retrying with a doubling interval
+    while the peer still publishes the topic, then run its receive loop."""
+    from minros.exceptions import TransportInitError
+
+    from .core import is_shutdown, rospyerr
+
+    interval = 0.5
+    while conn.socket is None and not conn.done and not is_shutdown():
+        try:
+            conn.connect(dest_addr, dest_port, pub_uri, timeout=60.0)
+        except TransportInitError as exc:
+            if conn.protocol is None:
+                conn.done = True
+                break
+            rospyerr("unable to create subscriber transport: %s.  Will try again in %ss", exc, interval)
+            interval = min(interval * 2, 30.0)
+            time.sleep(interval)
+            conn.done = not check_if_still_publisher(resolved_topic_name, pub_uri)
+    if not conn.done:
+        conn.receive_loop(receive_cb)
+
+
+class QueuedConnection:
+    """A transport whose ``write_data`` queues (dropping the oldest beyond ``queue_size``;
+    0 is unbounded) while a thread of its own writes to the wrapped transport; other
+    attributes are the wrapped transport's. A write error is raised by the next write_data."""
+
+    def __init__(self, connection: Any, queue_size: int) -> None:
+        self._connection = connection
+        self._queue_size = queue_size
+        self._lock = threading.Lock()
+        self._cond_data_available = threading.Condition(self._lock)
+        self._queue: List[Any] = []
+        self._error: Optional[BaseException] = None
+        connection.set_cleanup_callback(self._closed_connection_callback)
+        self._thread = threading.Thread(target=self._run, daemon=True,
+                                        name=f"QueuedConnection {getattr(connection, 'name', '')}")
+        self._thread.start()
+
+    def _closed_connection_callback(self, connection: Any) -> None:
+        with self._lock:
+            self._cond_data_available.notify()
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(self._connection, name)
+
+    def write_data(self, data: bytes) -> bool:
+        with self._lock:
+            if self._error is not None:
+                error, self._error = self._error, None
+                raise error
+            if self._queue_size > 0 and len(self._queue) >= self._queue_size:
+                del self._queue[0]
+            self._queue.append(data)
+            self._cond_data_available.notify()
+        return True
+
+    def _run(self) -> None:
+        while not self._connection.done:
+            with self._lock:
+                while not self._queue and not self._connection.done:
+                    self._cond_data_available.wait()
+                batch, self._queue = self._queue, []
+            for data in batch:
+                try:
+                    self._connection.write_data(data)
+                except Exception as exc:  # handed to the writer's next call
+                    with self._lock:
+                        self._error = exc

@@ -242,10 +242,12 @@ def _plot_values(val: Any, time_offset: Time | None, field_filter: Callable | No
 
 
 def plot_line(val: Any, now: Time, time_offset: Time | None = None,
-              field_filter: Callable | None = None) -> str:
+              field_filter: Callable | None = None, header_first: bool = True) -> str:
+    """The ``-p`` CSV line: the header's stamp (unless not ``header_first``) or ``now`` in ns,
+    less ``time_offset``, then the values."""
     text = _plot_values(val, time_offset, field_filter) or ""
     offset = time_offset.to_nsec() if time_offset is not None else 0
-    if getattr(val, "_has_header", False):
+    if header_first and getattr(val, "_has_header", False):
         return f"{val.header.stamp.to_nsec() - offset},{text}"
     return f"{now.to_nsec() - offset},{text}"
 

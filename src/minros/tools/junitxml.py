@@ -232,7 +232,7 @@ def print_summary(junit_results: Result, runner_name: str = "ROSUNIT") -> None:
             r.name, r.classname, r.time,
             failure="\n".join(f.text for f in r.failures) if r.failures else None,
             error="\n".join(e.text for e in r.errors) if r.errors else None))
-    sys.stdout.write(testing.summary_text(results, runner_name=runner_name, color=testing.is_tty()))
+    sys.stdout.write(testing.summary_text(results, runner_name=runner_name))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -13,6 +13,10 @@ an offer; and which inbound connections it takes. A node keeps an ordered list o
 (:attr:`minros.node.Node.protocols`: a subscriber offers them in that order, TCPROS last), so
 another transport joins by adding its handler there; the topic API (``minros.client``) only
 ever sees ``Transport``.
+
+A transport that cannot carry a connection after all (shared memory refused by the kernel, a
+peer breaking the protocol) raises :class:`FallBack`: the subscriber logs it once and asks the
+publisher again without offering that protocol, so the connection ends up on TCPROS.
 """
 
 from __future__ import annotations
@@ -20,18 +24,25 @@ from __future__ import annotations
 import abc
 import itertools
 import threading
-from typing import Any, Dict, List, Protocol, Tuple, Union
+from typing import Any, Callable, Dict, List, Protocol, Tuple, Union
 
 from minros.exceptions import TransportException
+from minros.msgs import reader_for
 from minros.wire.handshake import Handshake
 
-__all__ = ["Frame", "ProtocolHandler", "PublicationSide", "Transport", "next_connection_id"]
+__all__ = ["FallBack", "Frame", "ProtocolHandler", "PublicationSide", "Transport",
+           "next_connection_id"]
 
 #: a length-prefixed message: bytes, or a tuple of buffers (prefix first) sent without a join
 Frame = Union[bytes, Tuple[Any, ...]]
 
 _ids = itertools.count(1)
 _ids_lock = threading.Lock()
+
+
+class FallBack(TransportException):
+    """This protocol cannot carry the connection (the reason is the text): connect again with
+    the next protocol the node speaks."""
 
 
 def next_connection_id() -> int:
@@ -79,6 +90,16 @@ class Transport(abc.ABC):
         when large, a ``bytearray`` of their own that message fields may keep views of."""
         raise TransportException(f"this end of a {self.protocol} connection does not receive")
 
+    def message_reader(self, data_class: Any) -> Callable[[Any], Any]:
+        """The function from this end's received frames to new ``data_class`` messages."""
+        read: Callable[[Any], Any] = reader_for(data_class)
+        return read
+
+    #: None, or called with each message after its callbacks ran, before the next
+    #: ``receive``: a transport whose messages borrow its buffers makes a message that the
+    #: callbacks kept its own here (shared memory)
+    settle: Callable[[Any], None] | None = None
+
     @abc.abstractmethod
     def close(self) -> None:
         """End the connection (idempotent); a thread blocked in send or receive wakes up."""
@@ -106,8 +127,11 @@ class PublicationSide(Protocol):
     resolved_name: str
     type: str
     md5sum: str
+    data_class: Any
     queue_size: int | None
     tcp_nodelay: bool
+    #: whether subscribers in this process get the published objects themselves
+    intraprocess: bool
     closed: bool
 
     def header_fields(self) -> Dict[str, str]: ...
@@ -148,3 +172,6 @@ class ProtocolHandler(abc.ABC):
         """Take an inbound connection this handler claimed, for ``publication``: negotiate
         and add the publisher's end to it; raises ``Rejected`` after refusing."""
         raise TransportException(f"{self.protocol} takes no inbound TCP connections")
+
+    def close(self) -> None:  # noqa: B027 - most handlers run nothing of their own
+        """The node is shutting down: stop what this handler runs of its own (a server)."""

@@ -49,6 +49,8 @@ class Settings:
     set_actual_port: bool = False
     #: the asset allow-list (None: minros.web.assets' default, or ~asset_uri_allowlist)
     asset_uri_allowlist: Optional[List[str]] = None
+    #: the Learn view's exercises' folder (None: $MINROS_LEARN_DIR, else $ROS_HOME/learn)
+    learn_dir: Optional[str] = None
 
 
 def parse_globs(value: Any) -> List[str]:
@@ -123,7 +125,8 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
                                send_timeout=settings.send_timeout,
                                max_message_size=settings.max_message_size,
                                compression=settings.compression, trace=settings.trace,
-                               allow_origins=settings.allow_origins, asset_allowlist=allowlist)
+                               allow_origins=settings.allow_origins, asset_allowlist=allowlist,
+                               learn_dir=settings.learn_dir)
         except ValueError as exc:
             print(f"minros web: error: {exc}", file=sys.stderr)
             minros.signal_shutdown("bad settings")

@@ -9,10 +9,11 @@ the view's ops to the page's session:
 =================  ==========================================================================
 ``scene_watch``    ``{fixed}``: ``scene_frames`` now and whenever tf changes (at most 20 a
                    second): every frame's pose in the fixed frame, its parent and age
-``display_add``    ``{id, topic, kind?}`` or ``{id, kind: "robot", param}``: reply ``{kind,
-                   type}``, then the display's data (``scene_data`` JSON, or binary frames for
-                   clouds, scans and grids) and ``scene_status`` when its status changes; a
-                   topic not published yet is waited for when the page says its kind
+``display_add``    ``{id, topic, kind?, max_points?}`` or ``{id, kind: "robot", param}``: reply
+                   ``{kind, type}``, then the display's data (``scene_data`` JSON, or binary
+                   frames for clouds, scans and grids) and ``scene_status`` when its status
+                   changes; a topic not published yet is waited for when the page says its
+                   kind; a cloud is sent thinned to ``max_points`` (0 or none: all its points)
 ``display_remove`` ``{id}``
 ``im_feedback``    ``{id, marker, control, event, pose}``: an interactive marker moved or
                    clicked in the page (pose in the fixed frame): published on the server's
@@ -218,6 +219,7 @@ class Display:
         self.topic = topic
         self.type = type_name
         self.status: Tuple[str, str] = ("", "")
+        self.max_points = 0  # a cloud's points sent at most (0: all of them)
         self.slot = ("page", "scene", display_id)
         self.keys: List[Tuple[str, Hashable]] = []  # (topic, tap key) to untap
         self.imarkers: Optional[scenedata.InteractiveMarkerState] = None
@@ -272,9 +274,13 @@ class Display:
             problems.append(warning)
         place = {"frame": frame.lstrip("/"), "T": T, "stamp": header.stamp.to_sec()}
         if self.kind in ("cloud", "scan"):
-            convert = scenedata.cloud_arrays if self.kind == "cloud" else scenedata.scan_arrays
             # the arrays are the same for every page (only the placing differs): made once
-            xyz, colors, info = incoming.cached(("scene", self.kind), lambda: convert(msg))
+            if self.kind == "cloud":
+                max_points = self.max_points
+                xyz, colors, info = incoming.cached(
+                    ("scene", "cloud", max_points), lambda: scenedata.cloud_arrays(msg, max_points))
+            else:
+                xyz, colors, info = incoming.cached(("scene", "scan"), lambda: scenedata.scan_arrays(msg))
             arrays = [("position", xyz)] + ([("color", colors)] if colors is not None else [])
             return [pack({"op": "scene_data", **base, **place, "count": len(xyz), **info},
                          arrays)], problems
@@ -428,7 +434,11 @@ class SceneSession:
 
     def display_add(self, msg: Dict[str, Any]) -> None:
         _check(msg, [(True, "id", (str,)), (False, "topic", (str,)), (False, "kind", (str,)),
-                     (False, "param", (str,))])
+                     (False, "param", (str,)), (False, "max_points", (int,))])
+        max_points = msg.get("max_points", 0)
+        if isinstance(max_points, bool) or max_points < 0:
+            raise OpError(f"display_add: max_points must be a number of points (0: all), not "
+                          f"{max_points!r}")
         display_id = msg["id"]
         self.display_remove({"id": display_id})
         if len(self.displays) >= MAX_DISPLAYS:
@@ -454,6 +464,7 @@ class SceneSession:
                                 f"{', '.join(sorted(KINDS))}")
             return
         display = Display(self, display_id, kind, topic, type_name)
+        display.max_points = max_points
         self.page.outbox.open_slot(display.slot, display.render, maxlen=QUEUE.get(kind, 1),
                                    max_bytes=64 << 20)
         with self.lock:

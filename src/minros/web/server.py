@@ -293,7 +293,8 @@ class WebServer:
                  max_message_size: int = DEFAULT_MAX_MESSAGE_SIZE, compression: bool = False,
                  static_dir: Path = STATIC_DIR, trace: Sequence[str] = (),
                  allow_origins: Sequence[str] = (),
-                 asset_allowlist: Sequence[str] = assets.DEFAULT_ALLOWLIST) -> None:
+                 asset_allowlist: Sequence[str] = assets.DEFAULT_ALLOWLIST,
+                 learn_dir: Optional[str] = None) -> None:
         self.state = state
         self.host = host
         self.port = port
@@ -307,8 +308,8 @@ class WebServer:
         self.clients: Dict[str, _Client] = {}
         #: the wire traces followed for the page's Wire view (``--trace``)
         self.wire = WireFeed(trace) if trace else None
-        #: the exercise a page started (the Learn view), in minros learn's folder
-        self.learn = LearnHub()
+        #: the exercise a page started (the Learn view), in minros learn's folder (or --learn-dir)
+        self.learn = LearnHub(Path(learn_dir) if learn_dir else None)
         self.page_hub = PageHub(state, self.wire, self.learn)
         self.viewers = 0
         self._ids = itertools.count(1)

@@ -21,7 +21,8 @@ Every line has ``t`` (wall-clock seconds, the clock all processes share), ``pid`
                   bytes themselves as text: ``request``/``response`` with their real lengths
                   ``request_len``/``response_len``.
 ``tcp.open``      a TCPROS connection: ``conn`` (its number in this process), ``side``
-                  (``connect`` or ``accept``), ``local``, ``remote``.
+                  (``connect`` or ``accept``), ``local``, ``remote``; ``protocol`` when it is
+                  not TCPROS: ``MINROSSHM``, a Unix socket whose addresses are ``@name``.
 ``tcpros.header`` a connection header, ``dir`` ``out`` (sent) or ``in`` (received), its
                   ``fields`` as ``[key, value]`` pairs in wire order and ``len`` (bytes, the
                   length prefix included).
@@ -31,6 +32,12 @@ Every line has ``t`` (wall-clock seconds, the clock all processes share), ``pid`
                   responses' status byte), and ``msg``, the decoded message, when
                   ``MINROS_TRACE_MESSAGES=1``. ``topic`` or ``service`` names what it carries.
 ``tcp.data``      bytes that are not TCPROS (a peer speaking something else): ``len``, ``head``.
+``tcpros.segment`` on a MINROSSHM connection, a shared-memory segment announced (its memfd
+                  passed with it): ``dir``, ``off``, ``generation``, ``slots``, ``slot_size``.
+                  Its messages are ``tcpros.frame`` events whose ``slot`` is
+                  ``[generation, slot]`` (the body is in shared memory: no ``head``), or inline
+                  ones as over TCPROS; ``tcpros.fallback`` (``reason``) is the publisher giving
+                  up on shared memory.
 ``tcp.eof``       the peer closed its side; ``tcp.close`` this process closed the connection,
                   with the byte and frame counts of both directions.
 
@@ -184,7 +191,11 @@ def plain(value: Any, depth: int = 0) -> Any:
 
 
 def address(addr: Any) -> str:
-    """``host:port`` (``[v6]:port``) of a socket address."""
+    """``host:port`` (``[v6]:port``) of a socket address; ``@name`` for an abstract Unix one."""
+    if isinstance(addr, bytes):
+        addr = addr.decode("utf-8", "replace")
+    if isinstance(addr, str):
+        return "@" + addr[1:] if addr.startswith("\0") else addr or "(unnamed)"
     try:
         host, port = addr[0], addr[1]
     except (TypeError, IndexError):
@@ -471,24 +482,27 @@ def xmlrpc_served(addresses: Tuple[str, str], n: int, t0: float, request: bytes,
 # --------------------------------------------------------------------------- TCPROS
 
 
-def watch(sock: socket.socket, side: str) -> Any:
+def watch(sock: socket.socket, side: str, protocol: str = "TCPROS") -> Any:
     """``sock`` itself when tracing is off, else a :class:`TracedSocket` around it. Called once
-    per TCPROS connection, where it is set up (``side``: ``connect`` or ``accept``)."""
+    per TCPROS connection, where it is set up (``side``: ``connect`` or ``accept``), and per
+    MINROSSHM one (``protocol``)."""
     writer = _writer
     if writer is None:
         return sock
-    return TracedSocket(sock, side, writer)
+    return TracedSocket(sock, side, writer, protocol)
 
 
 class _Connection:
     """What the two directions of one traced connection share."""
 
     __slots__ = ("id", "side", "kind", "name", "header_out", "header_in", "writer", "decoders",
-                 "closed")
+                 "closed", "records")
 
-    def __init__(self, side: str, writer: _Writer) -> None:
+    def __init__(self, side: str, writer: _Writer, protocol: str = "TCPROS") -> None:
         self.id = next(writer.conn_ids)
         self.side = side
+        #: after the headers: MINROSSHM's records, not TCPROS frames
+        self.records = protocol == "MINROSSHM"
         self.kind = ""  # "topic", "service" or "probe", once the client's header is seen
         self.name = ""  # the topic or service
         self.header_out: Dict[str, str] = {}
@@ -560,7 +574,7 @@ class _Tap:
                  "left", "head", "body", "ok", "frames", "traced", "limit", "head_bytes",
                  "writer", "_fields", "_fields_key")
 
-    HEADER, PREFIX, BODY, OPAQUE = range(4)
+    HEADER, PREFIX, BODY, OPAQUE, RECORD = range(5)
 
     def __init__(self, conn: _Connection, direction: str) -> None:
         self.conn = conn
@@ -683,6 +697,9 @@ class _Tap:
             _event_at(self.t_start if self.dir == "out" else t, "tcpros.header", base)
             self._next_frame()
             return
+        if self.state == self.RECORD:
+            self._record_done(t)
+            return
         # a frame's prefix
         if len(part) == 5:
             self.ok = part[0]
@@ -700,9 +717,58 @@ class _Tap:
             self._frame_done(t)
 
     def _next_frame(self) -> None:
-        self.state = self.PREFIX
         self.part = bytearray()
+        if self.conn.records:
+            self.state = self.RECORD
+            self.need = 4  # the tag
+            return
+        self.state = self.PREFIX
         self.need = 5 if self.conn.ok_byte(self.dir) else 4
+
+    #: MINROSSHM records (minros.wire.shm): tag -> the record's size, or its head's
+    _RECORDS = {b"SLOT": 28, b"SEGM": 24, b"DONE": 12, b"MSG ": 8, b"FALL": 8}
+
+    def _record_done(self, t: float) -> None:
+        """A MINROSSHM record's tag, head or whole (``part``) is in."""
+        part = self.part
+        tag = bytes(part[:4])
+        size = self._RECORDS.get(tag)
+        if size is None:
+            self._to_opaque(t)
+            return
+        if len(part) < size:
+            self.need = size
+            return
+        if tag == b"MSG ":  # an inline message: its frame follows, as over TCPROS
+            self.part = part[4:]
+            self.state = self.PREFIX
+            self.start += 4
+            self._part_done(t)
+            return
+        if tag == b"FALL":
+            (length,) = _U32.unpack_from(part, 4)
+            if len(part) < 8 + min(length, 1024):
+                self.need = 8 + min(length, 1024)
+                return
+        when = self.t_start if self.dir == "out" else t
+        fields = self.conn.base()
+        fields.update(dir=self.dir, off=self.start)
+        if tag == b"SLOT":
+            generation, index, _offset, length, _seq = struct.unpack_from("<IIIIQ", part, 4)
+            self.frames += 1
+            if self.limit < 0 or self.traced < self.limit:
+                self.traced += 1
+                fields.update(n=self.frames, len=max(length - 4, 0), head="",
+                              slot=[generation, index])
+                _event_at(when, "tcpros.frame", fields)
+        elif tag == b"SEGM":
+            generation, slots, slot_size, _size = struct.unpack_from("<IIIQ", part, 4)
+            fields.update(generation=generation, slots=slots, slot_size=slot_size)
+            _event_at(when, "tcpros.segment", fields)
+        elif tag == b"FALL":
+            fields.update(reason=bytes(part[8:]).decode("utf-8", "replace"))
+            _event_at(when, "tcpros.fallback", fields)
+        self._next_frame()  # DONE records (slots given back) are not written
 
     def _frame_done(self, t: float) -> None:
         self.frames += 1
@@ -761,18 +827,21 @@ class TracedSocket:
     """A TCPROS socket that traces what it sends and receives; everything else is the
     socket's own (``fileno``, ``settimeout``, ``getsockname``, ...)."""
 
-    def __init__(self, sock: socket.socket, side: str, writer: _Writer) -> None:
+    def __init__(self, sock: socket.socket, side: str, writer: _Writer,
+                 protocol: str = "TCPROS") -> None:
         self._sock = sock
-        self._conn = conn = _Connection(side, writer)
+        self._conn = conn = _Connection(side, writer, protocol)
         self._out = _Tap(conn, "out")
         self._in = _Tap(conn, "in")
         try:
             self._addresses = (address(sock.getsockname()), address(sock.getpeername()))
         except OSError:
             self._addresses = ("?", "?")
-        _event_at(time.time(), "tcp.open", {"conn": conn.id, "side": side,
-                                            "local": self._addresses[0],
-                                            "remote": self._addresses[1]})
+        opened = {"conn": conn.id, "side": side, "local": self._addresses[0],
+                  "remote": self._addresses[1]}
+        if protocol != "TCPROS":
+            opened["protocol"] = protocol
+        _event_at(time.time(), "tcp.open", opened)
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._sock, name)
@@ -833,6 +902,21 @@ class TracedSocket:
         elif size or len(memoryview(buffer)):
             self._eof()
         return n
+
+    def recvmsg_into(self, buffers: Any, *args: Any) -> Any:
+        buffers = list(buffers)
+        result = self._sock.recvmsg_into(buffers, *args)
+        left = result[0]
+        if not left:
+            self._eof()
+        t = time.time()
+        for buf in buffers:
+            if left <= 0:
+                break
+            view = memoryview(buf).cast("B")
+            self._in.feed(view[:left], t)
+            left -= len(view)
+        return result
 
     # -- the end
 

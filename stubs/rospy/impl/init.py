@@ -1,5 +1,6 @@
 """rospy.impl.init: the node's start and console handler (minros.rospy_internals.init)."""
 
+from minros.rospy_internals.core import is_shutdown, rospyerr, signal_shutdown  # noqa: F401
 from minros.rospy_internals.init import (  # noqa: F401
     DEFAULT_MASTER_PORT,
     DEFAULT_MASTER_URI,
@@ -7,3 +8,5 @@ from minros.rospy_internals.init import (  # noqa: F401
     RosStreamHandler,
     start_node,
 )
+from minros.rospy_internals.masterslave import ROSHandler  # noqa: F401
+from minros.rospy_internals.tcpros import init_tcpros  # noqa: F401

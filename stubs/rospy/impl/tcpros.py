@@ -6,3 +6,4 @@ from minros.rospy_internals.tcpros import (  # noqa: F401
     get_tcpros_handler,
     init_tcpros,
 )
+from minros.rospy_internals.tcpros_base import init_tcpros_server  # noqa: F401

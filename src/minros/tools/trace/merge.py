@@ -370,10 +370,12 @@ class Call:
 
 @dataclass
 class Connection:
-    """One TCPROS connection: ``client`` connected to ``server`` (addresses)."""
+    """One TCPROS connection: ``client`` connected to ``server`` (addresses); or one of
+    another ``protocol`` (MINROSSHM: a Unix socket, messages in shared memory)."""
 
     client: str
     server: str
+    protocol: str = "TCPROS"
     client_node: str = "?"
     server_node: str = "?"
     kind: str = ""  # topic, service, probe ("" while no header was seen)
@@ -397,7 +399,8 @@ class Connection:
 @dataclass
 class Wire:
     """Something on a TCPROS connection: ``open``, ``header``, ``frame``, ``data`` (not
-    TCPROS), ``eof`` or ``close``; ``dir`` is ``c2s`` (client to server) or ``s2c``."""
+    TCPROS), ``eof`` or ``close``; on a MINROSSHM one also ``segment`` and ``fallback``, and
+    frames in a ``slot``. ``dir`` is ``c2s`` (client to server) or ``s2c``."""
 
     t: float
     what: str
@@ -416,6 +419,10 @@ class Wire:
     #: when the receiver had it, if the receiver was traced (with the sender: the latency)
     t_in: float = 0.0
     sent: bool = False  # the sender's view is here (``t`` is when it went out)
+    #: MINROSSHM: ``[generation, slot]`` of a frame in shared memory; a segment's
+    #: ``[generation, slots, slot_size]``; a fallback's reason
+    slot: Optional[List[int]] = None
+    reason: str = ""
 
     @property
     def subject(self) -> Tuple[str, str]:
@@ -576,7 +583,8 @@ class Merger:
             conn = self.conns.get(key)
             fresh = conn is None or side in conn.sides
             if fresh:
-                conn = Connection(client=key[0], server=key[1])
+                conn = Connection(client=key[0], server=key[1],
+                                  protocol=str(ev.get("protocol", "TCPROS")))
                 conn.server_node = self.names.name(key[1])
                 self.conns[key] = conn
             assert conn is not None
@@ -608,7 +616,8 @@ class Merger:
             item = Wire(t=ev["t"], what=what, conn=conn, node=node, stats=stats, views=[side])
             item.n = 1 if first else 2  # the first close of a connection, or a later one
             return item
-        what = {"tcpros.header": "header", "tcpros.frame": "frame", "tcp.data": "data"}.get(kind)
+        what = {"tcpros.header": "header", "tcpros.frame": "frame", "tcp.data": "data",
+                "tcpros.segment": "segment", "tcpros.fallback": "fallback"}.get(kind)
         if what is None:
             return None
         key = (conn.client, conn.server, id(conn), what, flow, int(ev.get("off", 0)))
@@ -632,6 +641,13 @@ class Merger:
             item.t_in = ev["t"]
         else:
             item.sent = True
+        slot = ev.get("slot")
+        if isinstance(slot, list):
+            item.slot = [int(x) for x in slot if isinstance(x, int)]
+        elif what == "segment":
+            item.slot = [int(ev.get(k, 0)) for k in ("generation", "slots", "slot_size")]
+        elif what == "fallback":
+            item.reason = str(ev.get("reason", ""))
         if what == "header":
             item.fields = [list(pair) for pair in ev.get("fields") or []]
             conn.headers.setdefault(flow, item.fields)

@@ -8,9 +8,12 @@ Topics (the 0-6 sequence of *ROS Robot Programming* and the Autolabor course):
     [2] the master tells the subscriber who publishes: the answer to registerSubscriber when
         the publisher was first, else a publisherUpdate call to the subscriber
     [3] the subscriber asks the publisher for a connection (requestTopic)
-    [4] the publisher answers with its TCPROS host and port
-    [5] TCP connection and the two connection headers
-    [6] messages, length-prefixed
+    [4] the publisher answers with its TCPROS host and port (between minros nodes of one host:
+        MINROSSHM and its Unix socket)
+    [5] TCP connection and the two connection headers (MINROSSHM: a Unix socket connection,
+        then the shared-memory segment, its memfd passed over the socket)
+    [6] messages, length-prefixed (MINROSSHM: large ones in a slot of the segment, announced
+        by a record on the socket; small ones inline)
 
 Services: [0] registerService, [1] lookupService, [2] its answer (the rosrpc:// URI), [3] TCP
 connection and headers, [4] request, [5] response. Lines are in time order, so a subscriber
@@ -39,6 +42,11 @@ LEGEND = (
     "  service: [0] registerService  [1] lookupService  [2] the server's address  [3] TCP"
     " connection and headers\n"
     "           [4] request  [5] response")
+
+#: said under a run that has shared-memory connections
+SHM_NOTE = ("MINROSSHM is minros's shared memory between minros nodes of one host: [4] the "
+            "publisher's Unix socket, [5] that connection, its headers and the segment, [6] "
+            "messages in the segment's slots (their bytes are not on the socket, nor in the trace)")
 
 #: the plumbing every rospy node has: hidden unless asked for (--all, --topic, --service)
 PLUMBING_TOPICS = ("/rosout", "/rosout_agg")
@@ -183,7 +191,7 @@ def step_of(item: Item, reply: bool = False) -> str:
             return {"registerService": "0", "lookupService": "1"}.get(method, "")
         return ""
     if kind == "topic":
-        return {"open": "5", "header": "5", "frame": "6"}.get(item.what, "")
+        return {"open": "5", "header": "5", "segment": "5", "frame": "6"}.get(item.what, "")
     if kind == "service":
         if item.what in ("open", "header"):
             return "3"
@@ -241,8 +249,17 @@ def item_rows(item: Item, label: str = "") -> List[Row]:
     conn = item.conn
     step = step_of(item)
     if item.what == "open":
+        if conn.protocol == "MINROSSHM":
+            return [(step, item.t, who, f"{tag}MINROSSHM: Unix socket connection {conn.client} -> "
+                     f"{conn.server} (shared memory)")]
         probe = " (a probe: is the service there?)" if conn.kind == "probe" else ""
         return [(step, item.t, who, f"{tag}TCP connection {conn.client} -> {conn.server}{probe}")]
+    if item.what == "segment":
+        generation, slots, size = (item.slot or [0, 0, 0]) + [0] * (3 - len(item.slot or []))
+        return [(step, item.t, who, f"{tag}shared-memory segment {generation}: {slots} slots of "
+                 f"{size} bytes (its memfd passed with this record)")]
+    if item.what == "fallback":
+        return [(step, item.t, who, f"{tag}shared memory given up, TCPROS next: {item.reason}")]
     if item.what == "header":
         fields = item.fields or []
         name = "connection header" if not any(k == "error" for k, _ in fields) else \
@@ -257,6 +274,10 @@ def item_rows(item: Item, label: str = "") -> List[Row]:
         if conn.kind == "service":
             kind = "request" if item.dir == "c2s" else "response"
         status = f" ok={item.ok}," if item.ok >= 0 else ""
+        if item.slot:
+            generation, index = (item.slot + [0, 0])[:2]
+            return [(step, item.t, who, f"{tag}{kind} {item.n}: {item.len} bytes in slot {index} "
+                     f"of segment {generation} (shared memory){_latency(item)}")]
         rows = [(step, item.t, who, f"{tag}{kind} {item.n}:{status} length prefix "
                  f"{prefix_hex(item.len)} = {item.len} bytes{_latency(item)}")]
         if item.head:
@@ -430,6 +451,9 @@ def render_run(run: Run, flt: Filter) -> List[str]:
         type_name = type_of(section_items)
         out.extend(_section(f"{kind} {name}" + (f"  [{type_name}]" if type_name else ""),
                             section_items, t0, flt, layout))
+    if any(isinstance(item, Wire) and item.conn.protocol == "MINROSSHM"
+           for part in sections.values() for item in part):
+        out.extend(["", SHM_NOTE])
     return out
 
 

@@ -64,6 +64,8 @@ export class Display {
   static fields = [];
   /** Whether the server sends this display data (display_add). */
   get remote() { return true; }
+  /** What display_add asks the server for besides the topic (a cloud's max_points). */
+  get request() { return {}; }
 
   get title() { return TITLES[this.kind] || this.kind; }
   get source() { return this.topic || this.param; }
@@ -79,6 +81,8 @@ export class Display {
   }
 
   setLocal(key, level, text) {
+    const was = this.local.get(key);
+    if (was ? was.level === level && was.text === text : !level) return;  // as it is (data at 10 Hz)
     if (level) this.local.set(key, {level, text});
     else this.local.delete(key);
     this.onStatus();
@@ -86,7 +90,10 @@ export class Display {
 
   get status() {
     let worst = this.serverStatus;
-    for (const s of this.local.values()) if (LEVELS[s.level] > LEVELS[worst.level]) worst = s;
+    for (const s of this.local.values()) {
+      // the worst level; at the same level, a text rather than none ("ok" with a note)
+      if (LEVELS[s.level] > LEVELS[worst.level] || (s.level === worst.level && !worst.text)) worst = s;
+    }
     if (!worst.level && !this.remote) return {level: "ok", text: ""};
     if (!worst.level && !this.received) return {level: "", text: "waiting for messages"};
     return worst;
@@ -250,6 +257,7 @@ export class RobotDisplay extends Display {
     this.clear();
     this.links.clear();
     this.local.clear();
+    this.onStatus();
     this.robot = msg.robot;
     const problems = [];
     for (const link of msg.robot.links) {
@@ -433,7 +441,10 @@ export class PointsDisplay extends Display {
 
   applyOptions() {
     this.material.size = Number(this.options.size) || 0.02;
-    this.material.color.setRGB(...hexColor(this.options.color).slice(0, 3));
+    // a colored cloud's colors are its points' own (white multiplies them): the flat color is
+    // for clouds without colors, also when another option (max points, size) changes
+    this.material.color.setRGB(...(this.material.vertexColors
+      ? [1, 1, 1] : hexColor(this.options.color).slice(0, 3)));
     const alpha = Number(this.options.alpha);
     this.material.transparent = alpha < 1;
     this.material.opacity = alpha;
@@ -485,6 +496,7 @@ export class PointsDisplay extends Display {
     this.geometry.setDrawRange(0, count);
     this.coarseGeometry.setDrawRange(0, Math.ceil(count / STRIDE));
     this.count = count;
+    this.total = msg.total ?? count;
     const place = {frame: msg.frame, T: msg.T, fixed: msg.fixed};
     if (!this.anchor) {
       this.anchor = this.scene.anchor(place, this.group);
@@ -494,6 +506,42 @@ export class PointsDisplay extends Display {
       this.scene.placeAnchor(this.anchor);
     }
     this.scene.invalidate();
+  }
+}
+
+/** The points of a cloud a software renderer draws by default: SwiftShader spends about
+ * 0.7 us of CPU on each point it draws, so a 100,000-point cloud costs ~70 ms a frame and
+ * 25,000 points ~17 ms (measured in tests/integration/test_page_3d.py). */
+export const SOFTWARE_MAX_POINTS = 25000;
+
+export class CloudDisplay extends PointsDisplay {
+  static fields = [...PointsDisplay.fields,
+                   ["max_points", "max points (0: all)", "number", {min: 0, step: 5000}]];
+
+  constructor(view, config) {
+    super(view, config);
+    // the server sends at most this many points of each cloud, spread over it: on a GPU all of
+    // them, on a software renderer as many as it draws smoothly (see SOFTWARE_MAX_POINTS)
+    if (!(config.options && "max_points" in config.options)) {
+      this.options.max_points = this.scene.software ? SOFTWARE_MAX_POINTS : 0;
+    }
+  }
+
+  /** What display_add asks the server for. */
+  get request() {
+    return {max_points: Math.max(0, Math.round(Number(this.options.max_points) || 0))};
+  }
+
+  setOption(key, value) {
+    super.setOption(key, value);
+    if (key === "max_points") this.view.resubscribe(this);
+  }
+
+  data(msg) {
+    super.data(msg);
+    const max = this.request.max_points;
+    this.setLocal("thinned", max && this.total > max ? "ok" : "",
+                  `${this.count.toLocaleString("en")} of ${this.total.toLocaleString("en")} points shown (max points)`);
   }
 }
 
@@ -527,6 +575,19 @@ function palette(scheme) {
 }
 const PALETTES = {map: palette("map"), costmap: palette("costmap")};
 
+const MAP_VERTEX = `varying vec2 vUv;
+void main() {
+  vUv = uv;
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+}`;
+const MAP_FRAGMENT = `uniform sampler2D map;
+uniform float opacity;
+varying vec2 vUv;
+void main() {
+  vec4 texel = texture2D(map, vUv);
+  gl_FragColor = vec4(texel.rgb, texel.a * opacity);
+}`;
+
 export class MapDisplay extends Display {
   static defaults = {alpha: 0.7, scheme: "map"};
   static fields = [["alpha", "alpha", "number", {min: 0, max: 1, step: 0.1}],
@@ -551,14 +612,19 @@ export class MapDisplay extends Display {
     if (!this.mesh || this.size !== `${width}x${height}x${resolution}`) {
       this.clear();
       this.size = `${width}x${height}x${resolution}`;
+      // one cell, one texel, no filtering (as Rviz draws a map); the palette's sRGB bytes are
+      // what the screen shows, so the shader hands them on (no sRGB decode per texel and
+      // encode per pixel): a map covers much of the view, and every pixel of it costs a
+      // software renderer (a third of a frame with the standard material, a tenth with this)
       const texture = new THREE.DataTexture(rgba, width, height, THREE.RGBAFormat);
       texture.magFilter = THREE.NearestFilter;
-      texture.minFilter = THREE.LinearFilter;
-      texture.colorSpace = THREE.SRGBColorSpace;
+      texture.minFilter = THREE.NearestFilter;
       texture.needsUpdate = true;
-      const mat = new THREE.MeshBasicMaterial({map: texture, side: THREE.DoubleSide, transparent: true,
-                                               depthWrite: false, polygonOffset: true,
-                                               polygonOffsetFactor: 1, polygonOffsetUnits: 1});
+      const mat = new THREE.ShaderMaterial({
+        uniforms: {map: {value: texture}, opacity: {value: 1}},
+        vertexShader: MAP_VERTEX, fragmentShader: MAP_FRAGMENT, side: THREE.DoubleSide,
+        transparent: true, depthWrite: false, polygonOffset: true, polygonOffsetFactor: 1,
+        polygonOffsetUnits: 1});
       this.mesh = new THREE.Mesh(new THREE.PlaneGeometry(width * resolution, height * resolution), mat);
       this.mesh.position.set(width * resolution / 2, height * resolution / 2, 0);
       this.origin = new THREE.Group();
@@ -566,8 +632,9 @@ export class MapDisplay extends Display {
       this.anchor = this.scene.anchor({frame: msg.frame, locked: true}, this.group);
       this.anchor.add(this.origin);
     } else {
-      this.mesh.material.map.image.data = rgba;
-      this.mesh.material.map.needsUpdate = true;
+      const texture = this.mesh.material.uniforms.map.value;
+      texture.image.data = rgba;
+      texture.needsUpdate = true;
       this.anchor.userData.place = {frame: msg.frame, locked: true};
       this.scene.placeAnchor(this.anchor);
     }
@@ -577,7 +644,7 @@ export class MapDisplay extends Display {
   }
 
   applyOptions() {
-    if (this.mesh) this.mesh.material.opacity = Number(this.options.alpha);
+    if (this.mesh) this.mesh.material.uniforms.opacity.value = Number(this.options.alpha);
     if (this.last && this.last.scheme !== this.options.scheme) this.data(this.last);
   }
 

@@ -243,6 +243,9 @@ export class Scene3D {
 
   /** Page coordinates of a point of the fixed frame (for tests and labels). */
   project(x, y, z) {
+    // the camera's matrices follow its pose only at a render: bring them up to date, so a point
+    // projected right after lookAt (before the next frame is drawn) is where it will be drawn
+    this.camera.updateMatrixWorld();
     const v = new THREE.Vector3(x, y, z).project(this.camera);
     const rect = this.canvas.getBoundingClientRect();
     return {x: rect.left + (v.x + 1) / 2 * rect.width, y: rect.top + (1 - v.y) / 2 * rect.height,

@@ -16,8 +16,8 @@ import {datalist, errorLine, h} from "../ui.js";
 import {Scene3D} from "./scene.js";
 import {MeshCache} from "./shapes.js";
 import {
-  GridDisplay, KINDS, MapDisplay, MarkersDisplay, OdometryDisplay, PathDisplay, PointsDisplay,
-  PolygonDisplay, PoseArrayDisplay, PoseDisplay, RobotDisplay, TFDisplay, TITLES,
+  CloudDisplay, GridDisplay, KINDS, MapDisplay, MarkersDisplay, OdometryDisplay, PathDisplay,
+  PointsDisplay, PolygonDisplay, PoseArrayDisplay, PoseDisplay, RobotDisplay, TFDisplay, TITLES,
 } from "./displays.js";
 import {Dragger, InteractiveMarkersDisplay} from "./interactive.js";
 import {GroundTool, TOOLS} from "./tools.js";
@@ -25,7 +25,7 @@ import {GroundTool, TOOLS} from "./tools.js";
 const STORAGE_KEY = "minros.view3d.v1";
 const CLASSES = {
   grid3d: GridDisplay, tf: TFDisplay, robot: RobotDisplay, markers: MarkersDisplay,
-  scan: PointsDisplay, cloud: PointsDisplay, grid: MapDisplay, path: PathDisplay, pose: PoseDisplay,
+  scan: PointsDisplay, cloud: CloudDisplay, grid: MapDisplay, path: PathDisplay, pose: PoseDisplay,
   pose_array: PoseArrayDisplay, odometry: OdometryDisplay, polygon: PolygonDisplay,
   imarkers: InteractiveMarkersDisplay,
 };
@@ -101,6 +101,8 @@ export function createView(app, el) {
     fixedChosen: Boolean(saved && saved.fixed), removedTopics: new Set(saved ? saved.removed || [] : []),
     meshes: new MeshCache(() => scene3d.invalidate()),
     displaysChanged: () => renderList(),
+    /** Ask the server again for a display's data (an option it applies changed). */
+    resubscribe: (display) => { if (display.enabled) subscribe(display); },
     setTool(tool) {
       view.tool = tool;
       for (const [key, button] of Object.entries(toolButtons)) button.classList.toggle("active", key === tool);
@@ -189,7 +191,7 @@ export function createView(app, el) {
   function subscribe(display) {
     if (!display.remote || app.conn.state !== "connected") return;
     const fields = display.kind === "robot" ? {kind: "robot", param: display.param}
-      : {topic: display.topic, kind: display.kind};  // the kind: for a topic not published yet
+      : {topic: display.topic, kind: display.kind, ...display.request};  // the kind: for a topic not published yet
     app.conn.request("display_add", {id: display.id, ...fields})
       .catch((err) => display.setServerStatus("error", err.message));
   }
@@ -417,7 +419,7 @@ export function createView(app, el) {
     /** What a test reads: each display's kind, source, status and counts. */
     summary() {
       return view.displays.map((d) => ({id: d.id, kind: d.kind, source: d.source, enabled: d.enabled,
-                                        received: d.received, count: d.count || 0,
+                                        received: d.received, count: d.count || 0, total: d.total || 0,
                                         markers: d.markers ? d.markers.size : undefined, ...d.status}));
     },
   });
