@@ -918,7 +918,7 @@ class Runner:
             first, second = _pinned(first, 0), _pinned(second, 0 if placement == "same" else 1)
         r = self.pair(who, first, second)
         if "cpu_us" in r:
-            key = queue + placement
+            key = queue + placement + ("shm" if self.shm else "")
             self.cpu[(key, who)] = self.cpu.get((key, who), []) + [r["cpu_us"]]
         return r.get("median_us")
 
@@ -944,7 +944,7 @@ class Runner:
                                                           "--seconds", seconds]),
                           first_measures=True)
         if r.get("received") and "pub_cpu_s" in r and "sub_cpu_s" in r:
-            key = f"{kind}{queue}"
+            key = f"{kind}{queue}{'shm' if self.shm else ''}"
             per = (r["pub_cpu_s"] + r["sub_cpu_s"]) / r["received"] * 1e6
             self.cpu[(key, who)] = self.cpu.get((key, who), []) + [per]
         return r.get("rate")
@@ -1294,7 +1294,14 @@ def main(argv=None) -> int:
                     "flood": ("small10", "CPU per message received, both processes (µs)"),
                     "vga": ("vga10", "CPU per frame received, both processes (µs)"),
                     "hd": ("hd10", "CPU per frame received, both processes (µs)"),
+                    "hdshm": ("hd10shm", "CPU per frame received, both processes (µs)"),
                     "hdsync": ("hdnone", "CPU per frame received, both processes (µs)"),
+                    "4k": ("4k10", "CPU per frame received, both processes (µs)"),
+                    "4kshm": ("4k10shm", "CPU per frame received, both processes (µs)"),
+                    "cloud": ("cloud10", "CPU per cloud received, both processes (µs)"),
+                    "cloudshm": ("cloud10shm", "CPU per cloud received, both processes (µs)"),
+                    "floodshm": ("small10shm", "CPU per message received, both processes (µs)"),
+                    "lat10shm": ("10shm", "CPU per round trip, ping side, shared memory (µs)"),
                     "srv": ("srv", "CPU per persistent call, client side (µs)"),
                     "srvsame": ("srvsame", "CPU per persistent call, one CPU (µs)"),
                     "srvsplit": ("srvsplit", "CPU per persistent call, different CPUs (µs)"),
