@@ -24,7 +24,9 @@ Scenarios
   publisher has queue_size=10, so a loop publishing faster than the wire drops frames and its
   spinning competes for the CPUs with the thread that sends (on every implementation); the
   1920x1080 flood is also run with queue_size=None (publish() sends before it returns, as the
-  raw floor's sendall does), which measures the receive path at wire speed;
+  raw floor's sendall does), which measures the receive path at wire speed; each flood also
+  shows the CPU both processes spent per message received (publishing loop and sending
+  thread included), steadier than the rate on a shared machine;
 * idle node memory: RSS of a node that did nothing but init_node;
 * service calls of std_srvs/SetBool, persistent and with a new connection (and master
   lookup) per call, median round trip;
@@ -61,6 +63,7 @@ import argparse
 import hashlib
 import json
 import os
+import platform
 import shutil
 import socket
 import statistics
@@ -209,13 +212,15 @@ def role_flood_pub(args) -> None:
     _wait_connections(pub, args.subs)
     time.sleep(0.3)
     sent = 0
+    cpu = time.process_time()
     end = time.monotonic() + args.seconds
     while time.monotonic() < end:
         for _ in range(10):
             pub.publish(msg)
         sent += 10
-    print(json.dumps({"sent": sent}), flush=True)
-    time.sleep(1.0)
+    time.sleep(0.5)  # what is queued still goes out: the writer's CPU counts too
+    print(json.dumps({"sent": sent, "pub_cpu_s": time.process_time() - cpu}), flush=True)
+    time.sleep(0.5)
     rospy.signal_shutdown("done")
 
 
@@ -225,7 +230,11 @@ def role_flood_sub(args) -> None:
     cls, _ = _make(args.kind)
     stamps: list = []
 
+    cpu = [0.0]
+
     def on_msg(_msg) -> None:
+        if not stamps:
+            cpu[0] = time.process_time()
         stamps.append(time.perf_counter())
 
     rospy.init_node("bench_flood_sub", anonymous=True)
@@ -240,7 +249,8 @@ def role_flood_sub(args) -> None:
         last = len(stamps)
     n = len(stamps)
     rate = (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0
-    print(json.dumps({"received": n, "rate": rate}), flush=True)
+    print(json.dumps({"received": n, "rate": rate, "sub_cpu_s": time.process_time() - cpu[0]}),
+          flush=True)
     rospy.signal_shutdown("done")
 
 
@@ -537,17 +547,20 @@ def role_raw_flood_sub(args) -> None:
     head = bytearray(4)
     body = bytearray(32 << 20)
     stamps = []
+    cpu = 0.0
     try:
         while True:
             _recv_exact(conn, memoryview(head))
             (size,) = struct.unpack("<I", head)
             _recv_exact(conn, memoryview(body)[:size])
+            if not stamps:
+                cpu = time.process_time()
             stamps.append(time.perf_counter())
     except (ConnectionError, OSError):
         pass
     n = len(stamps)
-    print(json.dumps({"received": n, "rate": (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0}),
-          flush=True)
+    print(json.dumps({"received": n, "rate": (n - 1) / (stamps[-1] - stamps[0]) if n > 1 else 0.0,
+                      "sub_cpu_s": time.process_time() - cpu}), flush=True)
 
 
 def role_raw_flood_pub(args) -> None:
@@ -558,13 +571,14 @@ def role_raw_flood_pub(args) -> None:
         size = _frame_size(args.kind)
         frame = struct.pack("<I", size) + bytes(size)
     sent = 0
+    cpu = time.process_time()
     end = time.monotonic() + args.seconds
     while time.monotonic() < end:
         for _ in range(10):
             sock.sendall(frame)
         sent += 10
     sock.close()
-    print(json.dumps({"sent": sent}), flush=True)
+    print(json.dumps({"sent": sent, "pub_cpu_s": time.process_time() - cpu}), flush=True)
 
 
 ROLES = {
@@ -904,7 +918,7 @@ class Runner:
             first, second = _pinned(first, 0), _pinned(second, 0 if placement == "same" else 1)
         r = self.pair(who, first, second)
         if "cpu_us" in r:
-            key = queue + placement
+            key = queue + placement + ("shm" if self.shm else "")
             self.cpu[(key, who)] = self.cpu.get((key, who), []) + [r["cpu_us"]]
         return r.get("median_us")
 
@@ -929,6 +943,10 @@ class Runner:
                           self.command(who, "flood-pub", ["--kind", kind, "--queue", queue,
                                                           "--seconds", seconds]),
                           first_measures=True)
+        if r.get("received") and "pub_cpu_s" in r and "sub_cpu_s" in r:
+            key = f"{kind}{queue}{'shm' if self.shm else ''}"
+            per = (r["pub_cpu_s"] + r["sub_cpu_s"]) / r["received"] * 1e6
+            self.cpu[(key, who)] = self.cpu.get((key, who), []) + [per]
         return r.get("rate")
 
     def service(self, who: str, persistent: bool, placement: str = ""):
@@ -1180,6 +1198,28 @@ def _own_ratios(med: dict, contenders: list) -> list:
     return cells
 
 
+def _load() -> str:
+    """The 1-minute load average (other users of a shared machine show here)."""
+    try:
+        return f"{os.getloadavg()[0]:.2f}"
+    except OSError:
+        return "?"
+
+
+def machine() -> str:
+    """The CPU model (from /proc/cpuinfo) and the kernel: per-call costs depend on both."""
+    model = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.partition(":")[2].strip()
+                    break
+    except OSError:
+        pass
+    return f"CPU: {model} x {os.cpu_count()}; kernel: {platform.system()} {platform.release()}"
+
+
 def _python_version(python: str) -> str:
     out = subprocess.run([python, "-c", "import sys; print(sys.version.split()[0])"],
                          capture_output=True, text=True)
@@ -1218,6 +1258,7 @@ def main(argv=None) -> int:
     byte_compile_minros()
     if args.baseline:  # its checkout, when the interpreter is that checkout's .venv
         byte_compile_minros(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(args.baseline)))))
+    load = (_load(),)
     runner = Runner(args)
     try:
         contenders = runner.contenders()
@@ -1250,6 +1291,17 @@ def main(argv=None) -> int:
         cpu_rows = {"lat10": ("10", "CPU per round trip, ping side, q=10 (µs)"),
                     "lat10same": ("10same", "CPU per round trip, one CPU (µs)"),
                     "lat10split": ("10split", "CPU per round trip, different CPUs (µs)"),
+                    "flood": ("small10", "CPU per message received, both processes (µs)"),
+                    "vga": ("vga10", "CPU per frame received, both processes (µs)"),
+                    "hd": ("hd10", "CPU per frame received, both processes (µs)"),
+                    "hdshm": ("hd10shm", "CPU per frame received, both processes (µs)"),
+                    "hdsync": ("hdnone", "CPU per frame received, both processes (µs)"),
+                    "4k": ("4k10", "CPU per frame received, both processes (µs)"),
+                    "4kshm": ("4k10shm", "CPU per frame received, both processes (µs)"),
+                    "cloud": ("cloud10", "CPU per cloud received, both processes (µs)"),
+                    "cloudshm": ("cloud10shm", "CPU per cloud received, both processes (µs)"),
+                    "floodshm": ("small10shm", "CPU per message received, both processes (µs)"),
+                    "lat10shm": ("10shm", "CPU per round trip, ping side, shared memory (µs)"),
                     "srv": ("srv", "CPU per persistent call, client side (µs)"),
                     "srvsame": ("srvsame", "CPU per persistent call, one CPU (µs)"),
                     "srvsplit": ("srvsplit", "CPU per persistent call, different CPUs (µs)"),
@@ -1280,6 +1332,7 @@ def main(argv=None) -> int:
         print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
         for row in rows:
             print("| " + " | ".join(str(c).ljust(w) for c, w in zip(row, widths)) + " |")
+        print(machine() + f"; load average before/after: {load[0]} / {_load()}")
         if failures:
             print("\nruns without a figure (the medians above are of the other rounds):")
             for line in failures:

@@ -1,7 +1,8 @@
 """Big service requests and responses against slow, stalled and vanishing peers.
 
-The service sockets wake up every ``_POLL`` second to notice node shutdown; a send must not
-take that as a limit: it goes on while the peer takes bytes, however slowly (rospy waits
+The service sockets block; node shutdown wakes a call waiting for its response by shutting
+its socket down, and a send to a peer that reads nothing waits ``_POLL`` seconds at a time to
+notice node shutdown; a send must not take that as a limit: it goes on while the peer takes bytes, however slowly (rospy waits
 forever), and gives up only when the node shuts down, the peer is gone, or the peer took
 nothing for ``SEND_STALL_TIMEOUT`` seconds. The slow peers here are raw sockets doing the
 TCPROS service exchange by hand, reading in small chunks with pauses: the pauses are the
@@ -353,6 +354,40 @@ def test_node_shutdown_interrupts_a_stalled_send(master_env, tmp_path):
     server = RawServer(master_env, serve)
     script = tmp_path / "stalled_caller.py"
     script.write_text(STALLED_CALLER)
+    proc = Proc([PYTHON, str(script)], master_env)
+    try:
+        proc.read_until("CALLING", 30)
+        assert started.wait(20)
+        os.killpg(proc.pid, signal.SIGINT)
+        out = proc.read_until("RESULT", 15)
+    finally:
+        done.set()
+        proc.stop()
+        server.join()
+    line = out.split("RESULT ", 1)[1].splitlines()[0]
+    outcome, after = line.split(" | after shutdown ")
+    assert outcome == "ROSInterruptException: node shutdown interrupted service call"
+    assert -1.0 < float(after.split()[0]) < 3.0
+
+
+WAITING_CALLER = STALLED_CALLER.replace("CameraInfo(D=[0.5] * 4000000)", "CameraInfo(D=[0.5] * 4)")
+
+
+def test_node_shutdown_interrupts_a_call_waiting_for_its_response(master_env, tmp_path):
+    """The request is sent whole and the server never answers: the call, blocked in recv
+    (no socket timeout wakes it), ends at SIGINT with ROSInterruptException."""
+    done = threading.Event()
+    started = threading.Event()
+
+    def serve(sock: socket.socket) -> None:
+        (size,) = struct.unpack("<I", recv_exact(sock, 4))
+        recv_exact(sock, size)  # the whole request: the caller now waits for the response
+        started.set()
+        done.wait(20)
+
+    server = RawServer(master_env, serve)
+    script = tmp_path / "waiting_caller.py"
+    script.write_text(WAITING_CALLER)
     proc = Proc([PYTHON, str(script)], master_env)
     try:
         proc.read_until("CALLING", 30)

@@ -199,3 +199,33 @@ def test_read_header_keeps_only_what_arrived_and_honours_its_deadline():
         with pytest.raises(tcpros.HeaderError, match="timed out"):
             sockets.read_header(ours, deadline=time.monotonic() + 0.2, charge=charged.append)
         assert sum(charged) == 7 and time.monotonic() - start < 1.5
+
+
+def test_closing_the_server_wakes_a_connection_blocked_in_recv():
+    """A service connection waits for its next request in a blocking recv (no timeout): the
+    server's close() at node shutdown shuts it down, so its thread ends at once."""
+    from minros.node.tcpros_server import TCPROSServer
+
+    waiting = threading.Event()
+    ended = threading.Event()
+    got: list = []
+
+    def dispatch(stream, header, conn):
+        stream.settimeout(None)
+        waiting.set()
+        got.append(stream.recv(10))  # what a persistent connection between requests does
+        ended.set()
+        return None
+
+    server = TCPROSServer(dispatch, lambda: False)
+    server.start("127.0.0.1", 0)
+    client = socket.create_connection(("127.0.0.1", server.port), timeout=5)
+    try:
+        client.sendall(tcpros.encode_header({"service": "/s", "md5sum": "*", "callerid": "/c"}))
+        assert waiting.wait(5)
+        assert not ended.wait(0.3)  # blocked: nothing wakes it but the close
+        server.close()
+        assert ended.wait(2.0) and got == [b""]
+    finally:
+        client.close()
+        server.close()

@@ -106,6 +106,27 @@ def test_a_full_queue_drops_the_oldest_but_never_the_half_sent_frame():
     sender.close()
 
 
+def test_a_full_queue_of_big_frames_waits_for_room_then_drops_the_oldest(monkeypatch):
+    """A publisher a whole queue ahead waits (a frame's send time, at most BACKOFF_MAX) for
+    the writer to take a frame instead of dropping at once; a subscriber that reads nothing
+    costs it that wait and no more, and the queue keeps the newest frame."""
+    from minros.transport import tcpros_pubsub
+
+    sender, sub_end, _ = sender_pair(queue_size=1, capacity=4096)
+    waits: List[float] = []
+    wait = sender.space.wait
+    monkeypatch.setattr(sender.space, "wait", lambda t: waits.append(t) or wait(t))
+    big = [bytes([i]) * 300_000 for i in range(1, 6)]  # 0.3 ms each at BACKOFF_RATE
+    sending = threading.Thread(target=lambda: [sender.send(f) for f in frames_of(big)])
+    sending.start()
+    sending.join(TIMEOUT)
+    assert not sending.is_alive()  # the stalled subscriber did not hold the publisher
+    assert waits and all(w == pytest.approx(300_004 / tcpros_pubsub.BACKOFF_RATE) for w in waits)
+    got = read_frames(sub_end, 0, last=big[-1])
+    assert got[0] == big[0] and got[-1] == big[-1]  # the half-sent first, the newest last
+    sender.close()
+
+
 def test_close_interrupts_a_synchronous_send_to_a_stalled_subscriber():
     """queue_size=None sends all before returning; a subscriber that stopped reading must not
     keep unregister or shutdown waiting."""

@@ -21,13 +21,16 @@ this module only moves their bytes through sockets.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import socket
+import struct
 import sys
 import threading
 import time
 import traceback
 import warnings
+import weakref
 from types import TracebackType
 from typing import Any, Callable, Dict
 
@@ -64,7 +67,8 @@ WAIT_FOR_SERVICE_INTERVAL = 0.3
 CONNECT_TIMEOUT = 10.0
 #: rospy's text when the peer closes the connection before a whole message arrived
 _PEER_GONE = "unable to receive data from sender, check sender's logs for details"
-#: sockets wake up this often to notice node shutdown while waiting for a peer
+#: a send waiting for a peer that reads nothing wakes up this often to notice node shutdown
+#: (a wait for a request or a response blocks in recv: shutdown wakes it by closing the socket)
 _POLL = 1.0
 #: a send gives up on a peer that took no byte for this long (the bound topics.SYNC_SEND_TIMEOUT
 #: puts on synchronous publishing). rospy's sendall waits forever; as long as the peer keeps
@@ -80,6 +84,8 @@ _SMALL_PART = 4096
 _FIRST_CHUNK = 64 << 10
 #: the ok byte that starts a successful service response
 _OK = b"\x01"
+_REQUEST_PREFIX = struct.Struct("<I").pack
+_OK_PREFIX = struct.Struct("<BI").pack
 
 _logger = logging.getLogger("rospy.service")
 
@@ -89,7 +95,8 @@ _logger = logging.getLogger("rospy.service")
 def _send_all(sock: socket.socket, data: Any) -> None:
     """Send ``data`` completely; give up at node shutdown or on a peer stalled for
     SEND_STALL_TIMEOUT seconds (TransportTerminated)."""
-    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=node.is_shutdown)
+    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=node.is_shutdown,
+                     pace=_POLL)
 
 
 # --------------------------------------------------------------------------- server
@@ -148,8 +155,8 @@ class Service:
         self.error_handler = error_handler or _default_error_handler
         self.buff_size = buff_size
         self.seq = 0
+        self._seqs = itertools.count(1)
         self.done = False
-        self._lock = threading.Lock()
         node.register_service(self.resolved_name, self._handle_connection)
 
     @property
@@ -199,7 +206,11 @@ class Service:
         a deadline fixed from its length once it starts (a one-shot client must send it
         within the header timeout), its bytes count against the node's budget, and a
         persistent connection waiting for its next request may be closed to make room."""
-        sock.settimeout(_POLL)  # every wait, sending or receiving, wakes up to check for shutdown
+        # A blocking socket: the wait for a request is one recv, as is the request itself; a
+        # deadline sets a timeout while it applies (FrameSource), a send waits only when the
+        # client reads nothing (_send_all), and node shutdown or an eviction wakes a thread
+        # blocked here by shutting the socket down (the TCPROS server's close() and evict()).
+        sock.settimeout(None)
         refuse = None
         if self.done:
             refuse = f"[{node.get_caller_id()}] is not a provider of  [{self.resolved_name}]"
@@ -213,23 +224,28 @@ class Service:
         persistent = handshake.persistent
         reader = tcpros.FrameReader(buff_size=max(self.buff_size, 16), first_chunk=_FIRST_CHUNK)
         source = sockets.FrameSource(sock, reader, stop=node.is_shutdown, guard=conn)
+        read_request = self._read_request
+        conn.release(idle=True)
         while not self.done:
-            conn.idle()
             wait_until = None if persistent else time.monotonic() + conn.limits.head_timeout
-            frame = source.next(wait_until)
-            conn.busy()
+            frame = source.next(wait_until)  # charged, and busy once whole
             if frame is None:
                 if not persistent:
                     logerr(f"incoming connection failed: {_PEER_GONE}")
                 return
             try:
-                request = self._read_request(frame)
+                request = read_request(frame)
             except Exception as exc:
                 logerr(f"[{self.resolved_name}] error deserializing incoming request: {exc}")
                 return
             request._connection_header = header
-            del frame
-            conn.release()
+            if frame.__class__ is not bytes:
+                # a big request in a buffer of its own: its memory is free once it is read
+                # (a small one sits in the connection's receive buffer, held anyway)
+                del frame
+                conn.release()
+            else:
+                del frame
             try:
                 _send_all(sock, self._respond(request))
             except TransportTerminated as exc:
@@ -241,16 +257,22 @@ class Service:
                 return
             if not persistent:
                 return
+            del request
+            conn.release(idle=True)
 
     def _respond(self, request: Any) -> Any:
         """What answers ``request`` (bytes or buffers for ``_send_all``): ok + response, or
         not-ok + error text."""
         try:
-            response = _convert_return_to_response(self.handler(request), self.response_class)
-            with self._lock:
-                self.seq += 1
-                seq = self.seq
+            response = self.handler(request)
+            if response.__class__ is not self.response_class:
+                response = _convert_return_to_response(response, self.response_class)
+            seq = next(self._seqs)  # atomic: connections are served in threads of their own
+            self.seq = seq
             stamp_header(response, seq)
+            frame = _small_frame(response, _OK_PREFIX)
+            if frame is not None:
+                return frame
             buff = _Buffer()
             response.serialize(buff)
             # ok byte + length, then the response as written (not copied into one buffer)
@@ -264,6 +286,26 @@ class Service:
             except Exception:  # a broken error handler must not kill the connection
                 _logger.exception("service [%s]: error handler failed", self.resolved_name)
             return tcpros.encode_service_error(f"error processing request: {exc}")
+
+
+def _small_frame(msg: Any, prefix: Callable[..., bytes]) -> Any:
+    """The frame of a message without array fields (strings and numbers: the usual request
+    and response), serialized through its generated code in one piece: ``bytes``, or for a
+    big one its prefix and body. None for any other message, and on a bad field value (the
+    general path, ``serialize()``, names the field)."""
+    if getattr(msg, "_zero_copy", True):
+        return None
+    parts: list = []
+    try:
+        msg._serialize_parts(parts.append)
+    except Exception:  # noqa: BLE001 - serialize() raises it again, with the field's name
+        return None
+    body = b"".join(parts)
+    size = len(body)
+    head = prefix(1, size) if prefix is _OK_PREFIX else prefix(size)
+    if size <= _JOIN_LIMIT:
+        return head + body
+    return [head, body]
 
 
 class _Buffer:
@@ -322,6 +364,10 @@ class _Buffer:
 
 # --------------------------------------------------------------------------- client
 
+#: argument types that are a request's field value, never a message
+_PLAIN = frozenset((bool, int, float, str, bytes, list, tuple))
+
+
 def _args_kwds_to_request(request_class: Any, args: tuple, kwds: dict) -> Any:
     """A request from call arguments: one request instance, positional fields or keywords."""
     if args and kwds:
@@ -330,6 +376,8 @@ def _args_kwds_to_request(request_class: Any, args: tuple, kwds: dict) -> Any:
         return request_class(**kwds)
     if len(args) == 1:
         arg = args[0]
+        if arg.__class__ is request_class or arg.__class__ in _PLAIN:
+            return arg if arg.__class__ is request_class else request_class(arg)
         if getattr(arg, "_md5sum", None) == request_class._md5sum:
             return arg
         if hasattr(arg, "_type") and hasattr(arg, "_slot_types"):  # some other message
@@ -339,6 +387,35 @@ def _args_kwds_to_request(request_class: Any, args: tuple, kwds: dict) -> Any:
             if arg._type != slot_types[0]:
                 raise TypeError(f"expected [{slot_types[0]}] but got [{arg._type}]")
     return request_class(*args)
+
+
+#: the proxies with a connection open, whose sockets node shutdown closes
+_open_proxies: weakref.WeakSet[ServiceProxy] = weakref.WeakSet()
+_proxies_lock = threading.Lock()
+_hooked = False
+
+
+def _watch_proxy(proxy: ServiceProxy) -> None:
+    """``proxy`` has a connection open: node shutdown shuts its socket down, waking a call
+    blocked on it (the call then raises ROSInterruptException)."""
+    global _hooked
+    with _proxies_lock:
+        _open_proxies.add(proxy)
+        if not _hooked:
+            node.add_shutdown_hook(_close_proxies)
+            _hooked = True
+
+
+def _close_proxies(reason: str = "") -> None:
+    with _proxies_lock:
+        proxies = list(_open_proxies)
+    for proxy in proxies:
+        sock = proxy._sock
+        if sock is not None:
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
 
 
 def _lookup_service(resolved_name: str) -> str:
@@ -407,8 +484,11 @@ class ServiceProxy:
         except (TransportException, OSError) as exc:
             sockets.close(sock)
             raise ServiceException(f"unable to connect to service: {exc}") from None
-        sock.settimeout(_POLL)
+        # blocking: a call is one send and one recv; node shutdown wakes a call waiting
+        # for its response by shutting the socket down (_close_proxies)
+        sock.settimeout(None)
         self._sock = sock
+        _watch_proxy(self)
         self._server_header = header
         self._source = sockets.FrameSource(sock, tcpros.FrameReader(buff_size=self.buff_size, ok_byte=True),
                                            stop=node.is_shutdown)
@@ -435,9 +515,11 @@ class ServiceProxy:
                 # as rospy: a request is numbered once connected, and sent in that order
                 self.seq += 1
                 stamp_header(request, self.seq)
-                buff = _Buffer()
-                request.serialize(buff)
-                frame = buff.frame(tcpros.frame_prefix(buff.size))
+                frame = _small_frame(request, _REQUEST_PREFIX)
+                if frame is None:
+                    buff = _Buffer()
+                    request.serialize(buff)
+                    frame = buff.frame(tcpros.frame_prefix(buff.size))
                 assert self._sock is not None and self._source is not None
                 _send_all(self._sock, frame)
                 del frame  # its joined small fields need not live while the response comes in

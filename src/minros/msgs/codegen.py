@@ -575,7 +575,12 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
         out.append("    def __init__(self, *args, **kwds):")
         if spec.fields:
             out.append("        if args or kwds:")
-            out.append("            _init_fields(self, args, kwds)")
+            # every field positionally, the usual call (SetBoolResponse(True, "ok")): no
+            # per-field setattr; anything else, errors included, by genpy's rules
+            out.append(f"            if not kwds and len(args) == {len(attrs)}:")
+            out.append(f"                {', '.join(f'self.{a}' for a in attrs)}, = args")
+            out.append("            else:")
+            out.append("                _init_fields(self, args, kwds)")
             for f, attr in zip(spec.fields, attrs):
                 out.append(f"            if self.{attr} is None:")
                 out.append(f"                self.{attr} = {default_value(f.type, f.base_type, f.is_array, f.array_len)}")

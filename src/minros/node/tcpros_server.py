@@ -66,8 +66,13 @@ class TCPROSServer:
         return self.sock.getsockname()[1] if self.sock is not None else 0
 
     def close(self) -> None:
+        """Stop accepting, and end the inbound connections still being served (a service
+        connection's thread blocks in recv without a timeout: the shutdown wakes it)."""
         self._closed.set()
         sockets.close(self.sock)
+        with self._inbound_lock:
+            keys = list(self._inbound)
+        self._evict(keys)
 
     @staticmethod
     def refused(peer: str, reason: str) -> None:
@@ -143,7 +148,7 @@ class TCPROSServer:
                 sockets.close(stream)
                 return
             conn.release()
-            conn.busy()
+            conn.busy()  # handed over: the service or topic owns it now
             try:
                 error = self.dispatch(stream, header, conn)
             except Rejected as exc:  # refused by the handshake, which answered already

@@ -79,8 +79,9 @@ class Transport(abc.ABC):
         TransportException."""
 
     def send(self, frame: Frame) -> None:
-        """Send one frame to the peer (the publisher's end). Never blocks a queued
-        publisher; drops the oldest queued frame when the queue is full."""
+        """Send one frame to the peer (the publisher's end). A queued publisher does not
+        wait for a slow subscriber (at most a big frame's send time, a few milliseconds,
+        when the queue is full); the oldest queued frame is dropped when the queue is full."""
         raise TransportException(f"this end of a {self.protocol} connection does not send")
 
     def receive(self) -> List[Any] | None:

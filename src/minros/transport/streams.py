@@ -11,13 +11,11 @@ descriptor to poll, also provides ``wait_writable(timeout)``.
 from __future__ import annotations
 
 import select
-import socket
 from typing import Any, Iterable, Protocol, Tuple
 
-__all__ = ["MSG_DONTWAIT", "Stream", "wait_writable"]
+from minros.wire.sockets import MSG_DONTWAIT
 
-#: a send that takes what fits and never blocks
-MSG_DONTWAIT: int = getattr(socket, "MSG_DONTWAIT", 0)
+__all__ = ["MSG_DONTWAIT", "Stream", "wait_writable"]
 
 
 class Stream(Protocol):

@@ -1,9 +1,13 @@
 """TCPROS for topics: the publisher's end, the subscriber's end, and the protocol handler.
 
-The publisher's end (:class:`TCPROSSender`) keeps latency at raw-socket level without ever
-blocking a queued publisher on a slow subscriber: ``send`` first tries one non-blocking send
-in the publishing thread; only what the kernel did not take waits in a bounded queue (oldest
-dropped when full, never a half-sent frame) for the connection's writer thread. A
+The publisher's end (:class:`TCPROSSender`) keeps latency at raw-socket level without
+making a queued publisher wait for a slow subscriber: ``send`` first tries one non-blocking
+send in the publishing thread; only what the kernel did not take waits in a bounded queue
+(oldest dropped when full, never a half-sent frame) for the connection's writer thread. A
+publisher that is a whole queue ahead gives the writer a big frame's send time (BACKOFF_*)
+to take a frame before it drops one: a loop publishing images faster than the wire would
+otherwise spin and take the CPU the writer needs (6 ms for a 1920x1080 image, nothing for a
+small message). A
 ``queue_size=None`` publisher sends everything before ``send`` returns, as rospy does, but
 gives up on a subscriber that takes nothing for SYNC_SEND_TIMEOUT seconds.
 
@@ -36,6 +40,13 @@ _logger = logging.getLogger("minros.transport.tcpros")
 
 #: a synchronous (queue_size=None) publisher waits at most this long for a slow subscriber
 SYNC_SEND_TIMEOUT = 60.0
+#: a publisher whose subscriber is a whole queue behind waits for the writer to take a frame
+#: for as long as its frame takes to send at this many bytes per second (loopback's order),
+#: at most BACKOFF_MAX seconds and not at all below BACKOFF_MIN: a 1920x1080 image 6 ms, a
+#: small message never
+BACKOFF_RATE = 1e9
+BACKOFF_MAX = 0.01
+BACKOFF_MIN = 50e-6
 
 
 def _yield_gil() -> None:
@@ -81,7 +92,9 @@ class TCPROSSender(TCPROSTransport):
         self.queue_size = queue_size
         self.sync = queue_size is None
         self.lock = threading.Lock()  # C-level `with` on the hot path; cond shares it
-        self.cond = threading.Condition(self.lock)
+        self.cond = threading.Condition(self.lock)  # the writer waits here for frames
+        self.space = threading.Condition(self.lock)  # a publisher, for room in a full queue
+        self.room_wanted = 0  # publishers waiting on space
         self.busy = False
         self.on_close = on_close
         self.thread: threading.Thread | None = None
@@ -114,8 +127,9 @@ class TCPROSSender(TCPROSTransport):
     # -- sending ---------------------------------------------------------------------------
 
     def send(self, frame: Frame) -> None:
-        """Send one frame: queued publishers never block (the frame waits in the queue for the
-        writer thread), queue_size=None ones send it all before returning, as rospy does."""
+        """Send one frame: queued publishers do not wait for the subscriber (the frame waits
+        in the queue for the writer thread; a full queue makes a big frame wait a moment for
+        room), queue_size=None ones send it all before returning, as rospy does."""
         if self.done:
             return
         with self.lock:
@@ -147,6 +161,17 @@ class TCPROSSender(TCPROSTransport):
                 return
             queue = self.queue
             if self.queue_size and len(queue) >= self.queue_size:
+                # A whole queue behind: a publishing loop would only spin here, dropping
+                # frames, and take the CPU the writer (and the subscriber) need. Give the
+                # writer a big frame's send time to take one first (nothing for a small one).
+                wait = (len(frame) if frame.__class__ is bytes else sum(map(len, frame))) / BACKOFF_RATE
+                if wait >= BACKOFF_MIN:
+                    self.room_wanted += 1
+                    self.space.wait(min(wait, BACKOFF_MAX))
+                    self.room_wanted -= 1
+                    if self.done:
+                        return
+            if self.queue_size and len(queue) >= self.queue_size:
                 # drop the oldest, but never the half-sent frame at the front
                 if type(queue[0]) is _Partial:
                     if len(queue) > 1:
@@ -154,7 +179,8 @@ class TCPROSSender(TCPROSTransport):
                 else:
                     queue.popleft()
             queue.append(frame)
-            self.cond.notify()
+            if not self.busy:  # a busy writer takes it without being told (and a notify
+                self.cond.notify()  # costs a microsecond even with no one waiting)
         # The writer thread is behind: let it have the GIL now rather than after the
         # interpreter's switch interval (5 ms), or a publishing loop starves it.
         _yield_gil()
@@ -233,9 +259,15 @@ class TCPROSSender(TCPROSTransport):
                     cond.wait()
                 if self.done:
                     return
-                batch = list(self.queue)
-                self.queue.clear()
+                queue = self.queue
+                if queue[0].__class__ is bytes:  # small frames: all of them, in one send
+                    batch = list(queue)
+                    queue.clear()
+                else:  # a big frame: one at a time, so that the queue keeps the newest
+                    batch = [queue.popleft()]
                 self.busy = True
+                if self.room_wanted:  # (a notify costs a microsecond even with no one waiting)
+                    self.space.notify()
             try:
                 if len(batch) > 1 and all(type(f) is bytes for f in batch):
                     # many small frames: one system call for the lot
@@ -269,6 +301,7 @@ class TCPROSSender(TCPROSTransport):
         self.done = True
         self.queue.clear()
         self.cond.notify_all()
+        self.space.notify_all()
         if exc is not None and not isinstance(exc, (BrokenPipeError, ConnectionResetError)):
             _logger.info("publisher connection to [%s] on [%s] closed: %s",
                          self.callerid, self.topic, exc)
@@ -292,6 +325,7 @@ class TCPROSSender(TCPROSTransport):
             self.done = True
             self.queue.clear()
             self.cond.notify_all()
+            self.space.notify_all()
         sockets.close(self.stream)
 
 

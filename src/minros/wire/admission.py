@@ -121,6 +121,11 @@ class Admission:
         self._peer_held: Dict[str, int] = {}
         self._reported: Dict[str, float] = {}
         self._keys = itertools.count(1)
+        # the limits are frozen: charge() compares with these on every request (a peer's
+        # share of the whole budget or more is no limit of its own)
+        self._budget = self.limits.budget
+        self._peer_budget = (self.limits.peer_budget if self.limits.peer_budget < self._budget
+                             else 1 << 62)
         self.evictions = 0
         self.refusals = 0
 
@@ -197,42 +202,61 @@ class Admission:
 
     # -- memory ----------------------------------------------------------------------------
 
-    def charge(self, key: Any, size: int) -> List[Any]:
+    def charge(self, key: Any, size: int, busy: bool = False) -> List[Any]:
         """``size`` more bytes of ``key``'s request are in memory (an idle connection is then
-        reading a request, from now). Returns the connections to close to make room (older
-        unfinished requests); raises Refused when the request does not fit, even so, or when
-        its peer holds its whole share."""
-        limits = self.limits
+        reading a request, from now; with ``busy`` the request is whole and being served).
+        Returns the connections to close to make room (older unfinished requests); raises
+        Refused when the request does not fit, even so, or when its peer holds its whole
+        share."""
         with self._lock:
             ticket = self._tickets.get(key)
             if ticket is None or ticket.evicted:
                 raise Refused("connection closed to make room for others")
-            if ticket.state == IDLE:
-                ticket.state = READING
-                ticket.since = self.clock()
             victims: List[Any] = []
             peer = ticket.peer
-            if (limits.peer_budget < limits.budget
-                    and self._peer_held.get(peer, 0) + size > limits.peer_budget):
-                self._make_room(ticket, size, victims, peer)
-                if self._peer_held.get(peer, 0) + size > limits.peer_budget:
-                    raise Refused(f"requests from {peer} hold {limits.peer_budget} bytes of "
-                                  f"{self.what}'s memory already: try again")
-            if self._held + size > limits.budget:
-                self._make_room(ticket, size, victims, None)
-                if self._held + size > limits.budget:
-                    raise Refused(f"{self.what} is busy with large requests: try again")
+            peer_held = self._peer_held.get(peer, 0) + size
+            if peer_held > self._peer_budget or self._held + size > self._budget:
+                if ticket.state == IDLE:
+                    ticket.state = READING
+                    ticket.since = self.clock()
+                self._make_room_for(ticket, size, victims)
+                peer_held = self._peer_held.get(peer, 0) + size
             ticket.held += size
             self._held += size
-            self._peer_held[peer] = self._peer_held.get(peer, 0) + size
+            self._peer_held[peer] = peer_held
+            if busy:
+                ticket.state = BUSY
+            elif ticket.state == IDLE:
+                ticket.state = READING
+                ticket.since = self.clock()
             return victims
 
-    def release(self, key: Any) -> None:
-        """``key``'s request is done: the memory it held is free again."""
+    def _make_room_for(self, ticket: _Ticket, size: int, victims: List[Any]) -> None:
+        """``size`` more bytes of ``ticket``'s request do not fit its peer's share or the
+        budget: evict older unfinished requests, or raise Refused."""
+        limits = self.limits
+        peer = ticket.peer
+        if self._peer_held.get(peer, 0) + size > self._peer_budget:
+            self._make_room(ticket, size, victims, peer)
+            if self._peer_held.get(peer, 0) + size > self._peer_budget:
+                raise Refused(f"requests from {peer} hold {limits.peer_budget} bytes of "
+                              f"{self.what}'s memory already: try again")
+        if self._held + size > self._budget:
+            self._make_room(ticket, size, victims, None)
+            if self._held + size > self._budget:
+                raise Refused(f"{self.what} is busy with large requests: try again")
+
+    def release(self, key: Any, idle: bool = False) -> None:
+        """``key``'s request is done: the memory it held is free again (and with ``idle``
+        the connection waits for its next request, from now)."""
         with self._lock:
             ticket = self._tickets.get(key)
             if ticket is not None and not ticket.evicted:
-                self._uncharge(ticket)
+                if ticket.held:
+                    self._uncharge(ticket)
+                if idle:
+                    ticket.state = IDLE
+                    ticket.since = self.clock()
 
     def held(self) -> int:
         """Bytes charged right now, all connections together."""
@@ -328,14 +352,17 @@ class Connection:
     def busy(self) -> None:
         self.admission.set_state(self.key, BUSY)
 
-    def charge(self, size: int) -> None:
-        """``size`` more bytes held; Refused when they do not fit (see Admission.charge)."""
-        victims = self.admission.charge(self.key, size)
+    def charge(self, size: int, busy: bool = False) -> None:
+        """``size`` more bytes held (``busy``: the request is whole and being served);
+        Refused when they do not fit (see Admission.charge)."""
+        victims = self.admission.charge(self.key, size, busy)
         if victims:
             self._evict(victims)
 
-    def release(self) -> None:
-        self.admission.release(self.key)
+    def release(self, idle: bool = False) -> None:
+        """The request's memory is free again (``idle``: and the connection waits for its
+        next request)."""
+        self.admission.release(self.key, idle)
 
     def evicted(self) -> bool:
         return self.admission.evicted(self.key)

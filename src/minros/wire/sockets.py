@@ -10,6 +10,7 @@ only moves its bytes. Callers pass ``stop``, a function that says when to give u
 from __future__ import annotations
 
 import collections
+import select
 import socket
 import struct
 import time
@@ -25,6 +26,8 @@ _HEADER_CHUNK = 65536
 #: buffers handed to one sendmsg call (Linux takes up to IOV_MAX = 1024)
 _MAX_IOV = 512
 _HAS_SENDMSG = hasattr(socket.socket, "sendmsg")
+#: a send that takes what fits and never blocks
+MSG_DONTWAIT: int = getattr(socket, "MSG_DONTWAIT", 0)
 
 
 def _never() -> bool:
@@ -87,16 +90,41 @@ def read_header(sock: socket.socket, max_size: int = tcpros.DEFAULT_MAX_HEADER, 
     return tcpros.decode_header(_recv_exact(sock, size, deadline, charge))
 
 
+def _wait_writable(sock: Any, timeout: float) -> None:
+    """Wait up to ``timeout`` seconds for ``sock`` to take bytes again."""
+    wait = getattr(sock, "wait_writable", None)  # an in-memory test stream
+    if wait is not None:
+        wait(timeout)
+        return
+    poller = select.poll()  # not select(): descriptors may be above FD_SETSIZE
+    poller.register(sock, select.POLLOUT)
+    poller.poll(max(timeout, 0.0) * 1000)
+
+
 def send_all(sock: socket.socket, data: Any, *, stall_timeout: float,
-             stop: Callable[[], bool] = _never) -> None:
+             stop: Callable[[], bool] = _never, pace: float = 1.0) -> None:
     """Send ``data`` (bytes, or a list of buffers sent in order) completely.
 
-    The socket's timeout only paces the waiting, so that ``stop()`` is noticed: ``sendall``
-    would apply it to the whole transfer and fail a big message to a slow reader. The send
-    goes on while the peer takes bytes and raises TransportTerminated when ``stop()`` says so,
-    the peer is gone, or the peer took nothing for ``stall_timeout`` seconds.
+    Every send is non-blocking, so the usual small message costs one system call and the
+    socket may be a blocking one (a closer wakes a thread blocked in it by shutting it down).
+    Only when the kernel takes nothing does the sender wait for the socket to be writable,
+    ``pace`` seconds at most at a time, so that ``stop()`` is noticed: the send goes on while
+    the peer takes bytes and raises TransportTerminated when ``stop()`` says so, the peer is
+    gone, or the peer took nothing for ``stall_timeout`` seconds. (A socket with a timeout
+    paces itself by it too: ``sendall`` would apply it to the whole transfer and fail a big
+    message to a slow reader.)
     """
-    if not isinstance(data, list):
+    if data.__class__ is bytes:
+        try:  # the usual case: one small frame, taken whole by the kernel
+            sent = sock.send(data, MSG_DONTWAIT)
+        except (BlockingIOError, socket.timeout):
+            sent = 0
+        except OSError as exc:
+            raise TransportTerminated(f"unable to send data: {exc}") from None
+        if sent == len(data):
+            return
+        data = [memoryview(data)[sent:]]
+    elif not isinstance(data, list):
         data = [data]
     parts = [memoryview(part) for part in data if len(part)]  # an empty one would never go
     first = 0  # parts[first:] are unsent; parts[first] may have been sliced
@@ -106,17 +134,20 @@ def send_all(sock: socket.socket, data: Any, *, stall_timeout: float,
             raise TransportTerminated("node shutdown")
         try:
             if _HAS_SENDMSG and first + 1 < len(parts):
-                sent = sock.sendmsg(parts[first:first + _MAX_IOV])
+                sent = sock.sendmsg(parts[first:first + _MAX_IOV], (), MSG_DONTWAIT)
             else:
-                sent = sock.send(parts[first])
-        except socket.timeout:  # not writable for one socket timeout
-            if time.monotonic() >= deadline:
-                raise TransportTerminated(f"peer took no data for {stall_timeout:g} s") from None
-            continue
+                sent = sock.send(parts[first], MSG_DONTWAIT)
+        except (BlockingIOError, socket.timeout):  # not writable (for one socket timeout)
+            sent = 0
         except OSError as exc:
             raise TransportTerminated(f"unable to send data: {exc}") from None
-        if sent:
-            deadline = time.monotonic() + stall_timeout
+        now = time.monotonic()
+        if not sent:
+            if now >= deadline:
+                raise TransportTerminated(f"peer took no data for {stall_timeout:g} s")
+            _wait_writable(sock, min(pace, deadline - now))
+            continue
+        deadline = now + stall_timeout
         while sent:
             size = parts[first].nbytes
             if sent < size:
@@ -130,9 +161,14 @@ class FrameSource:
     """Frames from one socket, one at a time (a FrameReader may parse several per recv).
 
     With a ``guard`` (a :class:`minros.wire.admission.Connection`, on a server) frames are read
-    under the admission policy: their bytes are charged as they arrive, and once a frame's
-    first byte is in, the whole frame must arrive by a deadline fixed from its announced
-    length, however slowly the peer trickles it.
+    under the admission policy: their bytes are charged as they arrive, once a frame's first
+    byte is in the whole frame must arrive by a deadline fixed from its announced length,
+    however slowly the peer trickles it, and a frame handed out is being served (the guard is
+    busy: charged and busy in one call when the frame came whole, the usual case).
+
+    A blocking socket (no timeout) waits in ``recv`` itself, one system call per frame; whoever
+    ends the connection wakes it by shutting the socket down. A socket timeout paces checks of
+    ``stop()``, and deadlines set a timeout for as long as they apply.
     """
 
     def __init__(self, sock: socket.socket, reader: tcpros.FrameReader,
@@ -143,21 +179,29 @@ class FrameSource:
         self.guard = guard
         self.pending: Deque[Any] = collections.deque()
         self._poll = sock.gettimeout()  # paces the checks of stop()
+        self._timeout = self._poll  # the socket's timeout now (settimeout is a system call)
         self._started: float | None = None  # when the frame in progress began to arrive
 
     def next(self, wait_until: float | None = None) -> Any:
         """The next frame; None if the peer closed cleanly between frames. A socket timeout
         only paces the check of ``stop()``. ``wait_until`` (``time.monotonic()``, with a
         guard) bounds the wait for a frame's first byte: TransportTerminated after it."""
-        reader = self.reader
+        pending = self.pending
         guard = self.guard
-        while not self.pending:
+        if pending:  # a frame that came with an earlier one
+            if guard is not None:
+                guard.busy()
+            return pending.popleft()
+        reader = self.reader
+        recv_into = self.sock.recv_into
+        while not pending:
             target = reader.recv_buffer()
             while True:
-                if guard is not None:
+                if guard is not None and (wait_until is not None or self._started is not None
+                                          or self._timeout != self._poll):
                     self._pace(wait_until)
                 try:
-                    n = self.sock.recv_into(target)
+                    n = recv_into(target)
                     break
                 except socket.timeout:
                     if self.stop():
@@ -172,11 +216,13 @@ class FrameSource:
                 return None
             frames = reader.received_frames(n)
             if guard is not None:
-                guard.charge(n)  # the policy counts a request as reading from its first bytes
+                # the policy counts a request as reading from its first bytes, and as served
+                # once it is whole
+                guard.charge(n, bool(frames))
                 if frames or self._started is None:
                     self._started = time.monotonic() if reader.pending() else None
-            self.pending.extend(frames)
-        return self.pending.popleft()
+            pending.extend(frames)
+        return pending.popleft()
 
     def _pace(self, wait_until: float | None) -> None:
         """Before a guarded recv: fail past the deadline, else wait no longer than it."""
@@ -187,10 +233,12 @@ class FrameSource:
             deadline = self._started + self.guard.limits.transfer_time(self.reader.announced() or 0)
             what = "the request did not arrive"
         if deadline is None:
-            if self.sock.gettimeout() != self._poll:  # settimeout() is a system call
+            if self._timeout != self._poll:
                 self.sock.settimeout(self._poll)
+                self._timeout = self._poll
             return
         remaining = deadline - time.monotonic()
         if remaining <= 0:
             raise TransportTerminated(f"{what} within the deadline")
-        self.sock.settimeout(remaining if self._poll is None else min(self._poll, remaining))
+        self._timeout = remaining if self._poll is None else min(self._poll, remaining)
+        self.sock.settimeout(self._timeout)

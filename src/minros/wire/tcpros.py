@@ -320,10 +320,24 @@ class FrameReader:
         else:
             self._end += n
             try:
-                if self.ok_byte:
+                if not self.ok_byte:
+                    end = self._end
+                    if not self._start and end >= 4 and not self._ready:
+                        # one whole message in one recv, the usual case: one unpack, one slice
+                        (size,) = _U32.unpack_from(self._buf, 0)
+                        if end == 4 + size and size <= self.max_frame:
+                            self._end = 0
+                            return [bytes(self._view[4:end])]
+                    self._parse_frames()
+                elif not self._start and self._end >= 5 and not self._ready:
+                    # a service response, usually whole in one recv: one unpack, one slice
+                    ok, size = _OK_LEN.unpack_from(self._buf, 0)
+                    if ok <= 1 and size <= self.max_frame and self._end == 5 + size:
+                        self._end = 0
+                        return [(bool(ok), bytes(self._view[5:5 + size]))]
                     self._parse()
                 else:
-                    self._parse_frames()
+                    self._parse()
             except FrameError as exc:
                 # the frames before the bad one are still good: they are handed out first
                 self._error = exc

@@ -49,13 +49,19 @@ counted in ``tcp.close``).
 
 Cost: the XML-RPC server and client test :data:`ON` once per call, and TCPROS sockets are
 wrapped when a connection is set up (:func:`watch`) only while tracing is on, so an untraced
-process runs exactly the code it ran before. A file that cannot be written costs one line on
-stderr and the process runs on untraced.
+process runs exactly the code it ran before. A traced frame costs its thread a tuple (the
+frames of a send or recv are cut by a fast path when they come whole); a thread of the writer
+formats them and writes them in batches, every FLUSH_INTERVAL seconds (so a reader following
+the file sees frames that late), and every other event, written at once, first writes the
+frames before it: the lines of one process stay in order. A file that cannot be written costs
+one line on stderr and the process runs on untraced.
 """
 
 from __future__ import annotations
 
+import atexit
 import base64
+import collections
 import json
 import math
 import os
@@ -65,7 +71,7 @@ import sys
 import threading
 import time
 import xmlrpc.client
-from typing import Any, Callable, Dict, Optional, Tuple
+from typing import Any, Callable, Deque, Dict, List, Optional, Tuple
 
 from minros import rosenv
 from minros.msgs.tval import TVal
@@ -99,6 +105,11 @@ FORMAT = 1
 
 DEFAULT_FRAMES = 1000
 DEFAULT_BYTES = 64
+#: frame events are written in batches: every this many seconds, or once this many wait;
+#: past MAX_PENDING the thread recording one writes them itself
+FLUSH_INTERVAL = 0.2
+FLUSH_AT = 2048
+MAX_PENDING = 1 << 16
 #: HTTP texts and connection header values longer than this are cut
 RAW_LIMIT = 64 << 10
 #: a frame up to this size is decoded when messages are asked for
@@ -111,6 +122,7 @@ DEPTH_LIMIT = 8
 ON = False
 
 _U32 = struct.Struct("<I")
+_now = time.time
 
 
 # --------------------------------------------------------------------------- plain values
@@ -208,8 +220,14 @@ def _raw_text(data: bytes) -> Tuple[str, int]:
 
 
 class _Writer:
-    """Owns the trace file of this process: one ``os.write`` of one line per event (the file
-    is opened for appending, so the lines of several processes sharing it never mix)."""
+    """Owns the trace file of this process (opened for appending, so the lines of several
+    processes sharing it never mix: every write is whole lines).
+
+    Frame events, the many, are recorded as tuples on the hot path (:meth:`queue`: one
+    append) and written as JSON lines in batches by a thread of their own, every
+    FLUSH_INTERVAL seconds or as soon as FLUSH_AT are waiting; every other event is written
+    at once, after the frames recorded before it, so the file keeps the order of events.
+    ``stop()`` and the end of the process write what is left."""
 
     def __init__(self, path: str, fd: int) -> None:
         self.path = path
@@ -222,19 +240,80 @@ class _Writer:
         frames = os.environ.get(ENV_FRAMES, "")
         self.frame_limit = -1 if frames == "all" else _int(frames, DEFAULT_FRAMES)
         self.head_bytes = max(0, _int(os.environ.get(ENV_BYTES, ""), DEFAULT_BYTES))
+        #: frame events not written yet: (tap, t, n, off, len, head, ok)
+        self.pending: Deque[Tuple[Any, ...]] = collections.deque()
+        self.wake = threading.Event()
+        self.flusher = threading.Thread(target=self._flush_loop, daemon=True,
+                                        name="minros-trace-writer")
+        self.flusher.start()
+
+    def queue(self, item: Tuple[Any, ...]) -> None:
+        """Record one frame event (the hot path: no formatting, no system call)."""
+        pending = self.pending
+        pending.append(item)
+        size = len(pending)
+        if size == FLUSH_AT:
+            self.wake.set()
+        elif size > MAX_PENDING:  # the writer thread cannot keep up: write them here
+            self.flush()
 
     def write(self, fields: Dict[str, Any]) -> None:
+        """Write one event now (after the frame events recorded before it)."""
         line = json.dumps(fields, ensure_ascii=False, separators=(",", ":"), default=str)
-        data = (line + "\n").encode("utf-8", "backslashreplace")
         with self.lock:
-            if self.fd < 0:
-                return
-            try:
-                os.write(self.fd, data)
-            except OSError as exc:
-                _fail(f"cannot write the trace to {self.path}: {exc.strerror or exc}; "
-                      "going on without a trace")
-                self.fd = -1
+            lines = self._pending_lines()
+            lines.append(line)
+            self._write(lines)
+
+    def flush(self) -> None:
+        """Write the frame events recorded so far."""
+        with self.lock:
+            lines = self._pending_lines()
+            if lines:
+                self._write(lines)
+
+    def _pending_lines(self) -> List[str]:
+        """The recorded frame events as lines, taken off the queue (lock held)."""
+        pending = self.pending
+        lines: List[str] = []
+        append = lines.append
+        node = self.node
+        templates: Dict[Any, Tuple[str, str]] = {}
+        last_t = None
+        stamp = ""
+        for _ in range(len(pending)):
+            tap, t, n, off, size, head, ok = pending.popleft()
+            if t != last_t:  # the frames of one recv or send share it
+                last_t = t
+                stamp = f'{{"t":{t:.6f},'
+            template = templates.get(tap)
+            if template is None:
+                template = templates[tap] = tap.frame_line(node)
+            if ok < 0:
+                append(stamp + template[0] % (n, off, size, head.hex()))
+            else:
+                append(stamp + template[1] % (n, off, size, head.hex(), ok))
+        return lines
+
+    def _write(self, lines: List[str]) -> None:
+        if self.fd < 0:
+            return
+        lines.append("")
+        data = "\n".join(lines).encode("utf-8", "backslashreplace")
+        try:
+            while data:  # one write of whole lines, unless the disk takes less
+                data = data[os.write(self.fd, data):]
+        except OSError as exc:
+            _fail(f"cannot write the trace to {self.path}: {exc.strerror or exc}; "
+                  "going on without a trace")
+            self.fd = -1
+
+    def _flush_loop(self) -> None:
+        while self.fd >= 0:
+            self.wake.wait(FLUSH_INTERVAL)
+            self.wake.clear()
+            if self.pending:
+                self.flush()
 
 
 def _int(text: str, default: int) -> int:
@@ -294,10 +373,23 @@ def stop() -> None:
     ON = False
     writer, _writer = _writer, None
     if writer is not None:
+        writer.flush()
         with writer.lock:
             fd, writer.fd = writer.fd, -1
+        writer.wake.set()  # its thread ends
         if fd >= 0:
             os.close(fd)
+
+
+def flush() -> None:
+    """Write the frame events recorded so far (they are written in batches, every
+    FLUSH_INTERVAL seconds; every other event is written at once)."""
+    writer = _writer
+    if writer is not None:
+        writer.flush()
+
+
+atexit.register(flush)
 
 
 def set_node(name: str, uri: str = "", master: str = "") -> None:
@@ -479,7 +571,8 @@ class _Tap:
     header and then the frames in the bytes as they go by, and writes their events."""
 
     __slots__ = ("conn", "dir", "offset", "state", "part", "need", "start", "t_start", "size",
-                 "left", "head", "body", "ok", "frames", "traced", "limit", "head_bytes")
+                 "left", "head", "body", "ok", "frames", "traced", "limit", "head_bytes",
+                 "writer", "_fields", "_fields_key")
 
     HEADER, PREFIX, BODY, OPAQUE, RECORD = range(5)
 
@@ -499,10 +592,56 @@ class _Tap:
         self.ok = -1
         self.frames = 0
         self.traced = 0
+        self.writer = conn.writer
         self.limit = conn.writer.frame_limit
         self.head_bytes = conn.writer.head_bytes
+        self._fields: Tuple[str, str] = ("", "")
+        self._fields_key: Any = None
+
+    def frame_line(self, node: str) -> Tuple[str, str]:
+        """The %-templates of this direction's frame events after ``t`` (without and with the
+        ok byte): what they all share made once, as JSON text (the writer formats many)."""
+        key = (node, self.conn.kind)
+        if key != self._fields_key:
+            fields: Dict[str, Any] = {"pid": self.writer.pid, "node": node, "ev": "tcpros.frame"}
+            fields.update(self.conn.base())
+            fields["dir"] = self.dir
+            shared = json.dumps(fields, ensure_ascii=False, separators=(",", ":"),
+                                default=str)[1:-1].replace("%", "%%")
+            line = shared + ',"n":%d,"off":%d,"len":%d,"head":"%s"'
+            self._fields = (line + "}", line + ',"ok":%d}')
+            self._fields_key = key
+        return self._fields
 
     def feed(self, data: Any, t: float) -> None:
+        """``data`` went by at time ``t``: bytes, or a memoryview of bytes."""
+        if self.state == self.PREFIX and not self.part and not self.writer.messages:
+            # The usual case, whole frames, read here: one tuple each for the writer
+            end = len(data)
+            pos = 0
+            need = self.need
+            while end - pos >= need:
+                if need == 5:
+                    ok = data[pos]
+                    (size,) = _U32.unpack_from(data, pos + 1)
+                else:
+                    ok = -1
+                    (size,) = _U32.unpack_from(data, pos)
+                body = pos + need
+                stop = body + size
+                if stop > end:
+                    break
+                self.frames += 1
+                if self.limit < 0 or self.traced < self.limit:
+                    self.traced += 1
+                    self.writer.queue((self, t, self.frames, self.offset + pos, size,
+                                       bytes(data[body:min(stop, body + self.head_bytes)]), ok))
+                pos = stop
+            if pos:
+                self.offset += pos
+                if pos == end:
+                    return
+                data = data[pos:]
         view = memoryview(data).cast("B") if not isinstance(data, bytes) else data
         pos, end = 0, len(view)
         while pos < end:
@@ -633,7 +772,11 @@ class _Tap:
 
     def _frame_done(self, t: float) -> None:
         self.frames += 1
-        if self.limit < 0 or self.traced < self.limit:
+        if (self.limit < 0 or self.traced < self.limit) and self.body is None:
+            self.traced += 1
+            self.writer.queue((self, self.t_start if self.dir == "out" else t, self.frames,
+                               self.start, self.size, bytes(self.head), self.ok))
+        elif self.limit < 0 or self.traced < self.limit:
             self.traced += 1
             fields = self.conn.base()
             fields.update(dir=self.dir, n=self.frames, off=self.start, len=self.size,
@@ -715,10 +858,13 @@ class TracedSocket:
     # -- sending
 
     def send(self, data: Any, flags: int = 0) -> int:
-        t = time.time()
+        t = _now()
         sent = self._sock.send(data, flags)
         if sent:
-            self._out.feed(memoryview(data).cast("B")[:sent], t)
+            if data.__class__ is bytes and sent == len(data):
+                self._out.feed(data, t)
+            else:
+                self._out.feed(memoryview(data).cast("B")[:sent], t)
         return sent
 
     def sendall(self, data: Any, flags: int = 0) -> None:
@@ -744,7 +890,7 @@ class TracedSocket:
     def recv(self, size: int, flags: int = 0) -> bytes:
         data = self._sock.recv(size, flags)
         if data:
-            self._in.feed(data, time.time())
+            self._in.feed(data, _now())
         elif size:
             self._eof()
         return data
@@ -752,7 +898,7 @@ class TracedSocket:
     def recv_into(self, buffer: Any, size: int = 0, flags: int = 0) -> int:
         n = self._sock.recv_into(buffer, size, flags)
         if n:
-            self._in.feed(memoryview(buffer).cast("B")[:n], time.time())
+            self._in.feed(memoryview(buffer).cast("B")[:n], _now())
         elif size or len(memoryview(buffer)):
             self._eof()
         return n
