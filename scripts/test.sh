@@ -31,11 +31,10 @@ fi
 .venv/bin/mypy  # the types of the modules [tool.mypy] lists in pyproject.toml
 
 # Every Python the README promises: the unit and integration tests also run on the oldest and
-# the newest CPython (pyenv's, on this project's image), in venvs of their own, beside the main
-# run but at the lowest priority (nice 19), so that they use the CPU time the main run leaves
-# and its timing tests see the machine as they would alone; the tests marked `timing` run in
-# the main run only. CI requires both; elsewhere a missing one is named and skipped.
-# OTHER_PYTHONS= skips them.
+# the newest CPython (pyenv's, on this project's image), in venvs of their own. Their venvs are
+# built while the main run goes; their tests run after it, one Python at a time, each with the
+# machine to itself (run beside the main one at a low priority, they starved and timed out).
+# CI requires both; elsewhere a missing one is named and skipped. OTHER_PYTHONS= skips them.
 find_python() {
   local v=$1 p
   p=$(command -v "python$v" 2>/dev/null) && "$p" -c 'import ensurepip' 2>/dev/null && { echo "$p"; return; }
@@ -62,20 +61,20 @@ for entry in "${others[@]}"; do
     set -e
     [ -x ".venv-$v/bin/python" ] || "$py" -m venv ".venv-$v"
     ".venv-$v/bin/python" -m pip install -q --upgrade pip
-    ".venv-$v/bin/python" -m pip install -q -e '.[test]'
-    nice -n 19 ".venv-$v/bin/python" -m pytest -q -p no:cacheprovider \
-      -m "not interop and not timing" tests/unit tests/integration
+    nice -n 19 ".venv-$v/bin/python" -m pip install -q -e '.[test]'
   ) > ".venv-$v.log" 2>&1 &
   pids+=("$v:$!")
 done
 status=0
-# The main run in parallel workers (pytest-xdist; WORKERS=1 runs it in one process): a test
+# The runs in parallel workers (pytest-xdist; WORKERS=1 runs each in one process): a test
 # spends most of its time waiting on the processes it starts, so three workers on two CPUs
 # finish far sooner than one. Every test picks free ports and its own ROS_HOME, so workers do
 # not meet. The tests marked `timing` run afterwards on their own, with no workers beside them.
 workers=${WORKERS:-3}
+parallel=()
+[ "$workers" -gt 1 ] && parallel=(-n "$workers")
 if [ "$workers" -gt 1 ]; then
-  .venv/bin/python -m pytest -n "$workers" -m "not timing" "$@" || status=$?
+  .venv/bin/python -m pytest "${parallel[@]}" -m "not timing" "$@" || status=$?
   code=0
   .venv/bin/python -m pytest -m timing "$@" || code=$?
   [ "$code" -eq 0 ] || [ "$code" -eq 5 ] || status=$code  # 5: the arguments chose no timing test
@@ -84,7 +83,8 @@ else
 fi
 for entry in "${pids[@]}"; do
   v=${entry%%:*}
-  if wait "${entry#*:}"; then
+  if wait "${entry#*:}" && ".venv-$v/bin/python" -m pytest -q -p no:cacheprovider "${parallel[@]}" \
+      -m "not interop and not timing" tests/unit tests/integration >> ".venv-$v.log" 2>&1; then
     echo "Python $v: $(tail -n 1 ".venv-$v.log")"
   else
     echo "Python $v: unit and integration tests FAILED; the end of .venv-$v.log:" >&2

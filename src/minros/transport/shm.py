@@ -689,8 +689,8 @@ class ShmReceiver(Transport):
     def _settle(self, msg: Any) -> None:
         """After the callbacks: a message kept beyond them (referenced from anywhere but the
         receive loop, or latched) gets copies of its views before the slot goes back."""
-        # references: the receive loop's variable, this parameter, getrefcount's argument
-        if self.latching or sys.getrefcount(msg) > 3:
+        # references: the receive loop's variable and what the call itself holds
+        if self.latching or sys.getrefcount(msg) > 1 + _CALL_REFS:
             own(msg)
 
     def receive(self) -> List[Any] | None:
@@ -786,6 +786,24 @@ class ShmReceiver(Transport):
         maps, self.maps = self.maps, {}
         for mapping in maps.values():
             mapping.close()
+
+
+class _RefProbe:
+    def refs(self, obj: Any) -> int:
+        return sys.getrefcount(obj)
+
+
+def _call_refs() -> int:
+    """The references a call like ``settle(msg)`` (a bound method in a local) adds to its
+    argument, as ``getrefcount`` sees them inside: the parameter and getrefcount's argument,
+    and before Python 3.11 the caller's stack slot too."""
+    obj = object()
+    refs = _RefProbe().refs
+    return refs(obj) - 1  # less the caller's own variable
+
+
+#: measured, not assumed: the calling convention changed in 3.11 (and may again)
+_CALL_REFS = _call_refs()
 
 
 def own(msg: Any) -> None:
