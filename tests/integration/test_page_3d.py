@@ -288,8 +288,14 @@ def test_the_robot_model_has_every_geometry_and_mesh(page):
     page.wait(f"[...{V}.displays.find((d) => d.source === '/second/robot_description').links.values()]"
               ".every((anchor) => anchor.visible)")
     assert page.js(f"{V}.displays.find((d) => d.source === '/second/robot_description').options.prefix") == "second"
-    base = page.js(f"{V}.displays.find((d) => d.source === '/second/robot_description')"
-                   ".links.get('base_footprint').matrixWorld.elements.slice(12, 14)")
+    # matrixWorld follows the new fixed frame at the next render: wait for it, then read it
+    where = (f"{V}.displays.find((d) => d.source === '/second/robot_description')"
+             ".links.get('base_footprint').matrixWorld.elements.slice(12, 14)")
+    try:
+        page.wait(f"((e) => Math.abs(e[0] + 1) < 1e-6 && Math.abs(e[1] - 2) < 1e-6)({where})", 10_000)
+    except Exception:  # the assertion below says where it is instead
+        pass
+    base = page.js(where)
     assert base == pytest.approx([-1.0, 2.0], abs=1e-6)
     # a new description is drawn when the parameter changes; a broken one says why
     master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{page.system.port}/")
