@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import errno
 import os
+import select
 import socket
 import struct
 import threading
@@ -339,6 +340,31 @@ def test_a_slot_goes_back_when_the_subscriber_asks_again(pair):
     got += receive(receiver, 1)  # asking again gave the first two back
     assert got == [payload(n, 100_000) for n in range(3)]
     assert settled(sender, lambda: sender.slots.in_flight == 1)
+
+
+def test_the_publishing_thread_takes_slots_back_itself(monkeypatch):
+    """A publisher copying frames back to back holds the GIL: when the window is full it reads
+    the subscriber's DONE records itself, not waiting for its watcher thread to get the GIL
+    (which took up to the 5 ms switch interval per slot: most frames were dropped)."""
+    monkeypatch.setattr(ShmSender, "_watch", lambda self: None)  # no watcher thread at all
+    sender, receiver, _ = connect()
+    try:
+        for n in range(2):
+            sender.send(serialize_frame(AnyMsg(payload(n, 100_000))))
+        got = receive(receiver, 2)
+        assert sender.slots.in_flight == 2
+        third: List[Any] = []
+        asking = threading.Thread(target=lambda: third.extend(receive(receiver, 1)), daemon=True)
+        asking.start()  # gives the two slots back, then waits for the next frame
+        readable, _, _ = select.select([sender.stream], [], [], TIMEOUT)
+        assert readable, "the subscriber's DONE records never came"
+        sender.send(serialize_frame(AnyMsg(payload(2, 100_000))))
+        asking.join(TIMEOUT)
+        assert got + third == [payload(n, 100_000) for n in range(3)]
+        assert sender.slots.in_flight == 1
+    finally:
+        sender.close()
+        receiver.close()
 
 
 def test_a_slow_subscriber_never_blocks_the_publisher_and_sees_the_latest():

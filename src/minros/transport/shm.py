@@ -28,6 +28,7 @@ import logging
 import mmap
 import os
 import secrets
+import select
 import socket
 import struct
 import sys
@@ -216,6 +217,11 @@ class ShmSender(Transport):
         self.on_fallback = on_fallback
         self.peer_pid = _peer_pid(stream)
         self.fileno = stream.fileno()
+        # the subscriber's DONE records: read by the watcher thread, and by a publishing
+        # thread that finds the window full (it holds the GIL while it copies frames, so the
+        # watcher would wait up to sys.getswitchinterval() to free each slot)
+        self.done_reader = shm.DoneReader()
+        self.reading = threading.Lock()
 
     @property
     def stat_bytes(self) -> int:
@@ -419,6 +425,10 @@ class ShmSender(Transport):
         while True:
             if not self.out:
                 if not self._next_out():
+                    slots = self.slots
+                    if (slots.items and slots.in_flight >= slots.window and not self.failed
+                            and self._take_done()):
+                        continue  # slots came back: the window has room again
                     return
             try:
                 if self.out_fd >= 0:
@@ -520,16 +530,54 @@ class ShmSender(Transport):
                     self._pump()
                 cond.notify_all()
 
+    def _take_done(self) -> bool:
+        """With the lock: the DONE records already on the socket, read without blocking (and
+        without waiting for the watcher thread); True when a slot came back."""
+        if not self.reading.acquire(blocking=False):
+            return False  # the watcher is reading them
+        try:
+            try:
+                n = self.stream.recv_into(self.done_reader.space(), 0, MSG_DONTWAIT)
+            except OSError:  # nothing there (BlockingIOError), or an error the watcher sees
+                return False
+            if not n:
+                return False  # the end of the stream: the watcher sees it too
+            records = self.done_reader.received(n)
+            for record in records:
+                self.slots.done(record.generation, record.slot)
+        except shm.ShmError as exc:
+            self._broken(exc)
+            self._fail(exc)
+            return False
+        finally:
+            self.reading.release()
+        return bool(records)
+
+    def _broken(self, exc: shm.ShmError) -> None:
+        if _once(f"{self.topic}: {exc}"):
+            _rosout.warning("subscriber [%s] of [%s] broke the shared-memory protocol: %s; "
+                            "connection closed", self.callerid, self.topic, exc)
+
     def _watch(self) -> None:
         """Reads the subscriber's DONE records; its end of the stream ends the connection."""
-        reader = shm.DoneReader()
+        reader = self.done_reader
+        poller = select.poll()
+        poller.register(self.fileno, select.POLLIN)
         error: BaseException | None = None
         try:
             while not self.done:
-                n = self.stream.recv_into(reader.space())
-                if not n:
-                    break
-                records = reader.received(n)
+                # readable, then read under the lock a publishing thread shares (the timeout:
+                # a descriptor closed meanwhile and reused is never waited on for long)
+                if not poller.poll(1000):
+                    continue
+                with self.reading:
+                    try:
+                        n = self.stream.recv_into(reader.space(), 0, MSG_DONTWAIT)
+                    except BlockingIOError:  # a publishing thread took them
+                        continue
+                    if not n:
+                        break
+                    records = reader.received(n)
                 with self.cond:
                     for record in records:
                         self.slots.done(record.generation, record.slot)
@@ -537,9 +585,7 @@ class ShmSender(Transport):
                     self.cond.notify_all()
         except shm.ShmError as exc:
             error = exc
-            if _once(f"{self.topic}: {exc}"):
-                _rosout.warning("subscriber [%s] of [%s] broke the shared-memory protocol: %s; "
-                                "connection closed", self.callerid, self.topic, exc)
+            self._broken(exc)
         except OSError as exc:
             error = exc
         if not self.done:
