@@ -4,13 +4,14 @@ read and set through its ~get_loggers/~set_logger_level services."""
 from __future__ import annotations
 
 import subprocess
+import xmlrpc.client
 from pathlib import Path
 
 import pytest
 
 from minros.cli.console import ConsoleEcho
 from minros.msgs import get_message_class
-from support import PYTHON, Proc, ros_env
+from support import PYTHON, Proc, ros_env, wait_until
 
 NOISY = '''
 import rospy
@@ -42,6 +43,10 @@ def noisy(minros_core: int, ros_home: Path):
     env = ros_env(minros_core, ros_home)
     proc = Proc([PYTHON, "-c", NOISY], env)
     try:
+        # its logger services are registered during init_node: wait for them
+        master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{minros_core}/")
+        wait_until(lambda: master.lookupService("/t", "/noisy/set_logger_level")[0] == 1, 30,
+                   what="/noisy's logger services")
         yield env
     finally:
         proc.stop()
