@@ -69,10 +69,11 @@ status=0
 # The runs in parallel workers (pytest-xdist; WORKERS=1 runs each in one process): a test
 # spends most of its time waiting on the processes it starts, so three workers on two CPUs
 # finish far sooner than one. Every test picks free ports and its own ROS_HOME, so workers do
-# not meet. The tests marked `timing` run afterwards on their own, with no workers beside them.
+# not meet; a test file stays in one worker (--dist loadfile), in its order, as its
+# module-scoped fixtures expect. The tests marked `timing` run afterwards on their own.
 workers=${WORKERS:-3}
 parallel=()
-[ "$workers" -gt 1 ] && parallel=(-n "$workers")
+[ "$workers" -gt 1 ] && parallel=(-n "$workers" --dist loadfile)
 if [ "$workers" -gt 1 ]; then
   .venv/bin/python -m pytest "${parallel[@]}" -m "not timing" "$@" || status=$?
   code=0
