@@ -45,9 +45,11 @@ def test_graph_follows_nodes_topics_and_connections(minros_core: int, ros_home: 
 
         def connected() -> bool:
             graph.update()
-            return Edge("/talker", "/listener", "/chatter") in graph.nn_edges
+            # the talker registers its service on its own schedule: wait for it too
+            return (Edge("/talker", "/listener", "/chatter") in graph.nn_edges
+                    and "/talker/ping" in graph.srvs)
 
-        wait_until(connected, 20, what="talker -> listener edge")
+        wait_until(connected, 20, what="talker -> listener edge and /talker/ping")
         assert {"/talker", "/listener"} <= graph.nn_nodes
         assert topic_node("/chatter") in graph.nt_nodes and "/talker/ping" in graph.srvs
         assert Edge("/talker", " /chatter") in graph.nt_edges
