@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import threading
 import warnings
-from typing import Any, Callable, Dict, List
+from typing import Any, Callable, Dict, List, Tuple
 
 from minros import names, node
 from minros.exceptions import ROSException
@@ -85,17 +85,23 @@ class ParamCache:
             self.set(key, value)
             return
         with self.lock:
-            parts = self._parts(key)
-            d = self.tree
-            if d is None or not parts:
+            d, last = self._holder(key)
+            d[last] = value
+
+    def _holder(self, key: str) -> Tuple[dict, str]:
+        """The cached dict holding ``key`` and its last name; KeyError if ``key`` is not cached.
+        The caller holds the lock."""
+        parts = self._parts(key)
+        d = self.tree
+        if d is None or not parts:
+            raise KeyError(key)
+        for part in parts[:-1]:
+            d = d.get(part) if isinstance(d, dict) else None
+            if d is None:
                 raise KeyError(key)
-            for part in parts[:-1]:
-                d = d.get(part) if isinstance(d, dict) else None
-                if d is None:
-                    raise KeyError(key)
-            if not isinstance(d, dict) or parts[-1] not in d:
-                raise KeyError(key)
-            d[parts[-1]] = value
+        if not isinstance(d, dict) or parts[-1] not in d:
+            raise KeyError(key)
+        return d, parts[-1]
 
     def get(self, key: str) -> Any:
         """The cached value; KeyError if absent or an empty namespace (= unset on the master)."""
@@ -114,17 +120,8 @@ class ParamCache:
     def delete(self, key: str) -> None:
         """Forget ``key``; KeyError if it is not cached (rospy.impl.paramserver's contract)."""
         with self.lock:
-            parts = self._parts(key)
-            d = self.tree
-            if d is None or not parts:
-                raise KeyError(key)
-            for part in parts[:-1]:
-                d = d.get(part) if isinstance(d, dict) else None
-                if d is None:
-                    raise KeyError(key)
-            if not isinstance(d, dict) or parts[-1] not in d:
-                raise KeyError(key)
-            del d[parts[-1]]
+            d, last = self._holder(key)
+            del d[last]
 
     def clear(self) -> None:
         with self.lock:
