@@ -33,7 +33,9 @@ for i in range(30):
     counts["sum"] += client.get_result().sum
 print("goals", counts["active"], counts["done"], counts["sum"], flush=True)
 last = client.gh.comm_state_machine.action_goal.goal_id.id
-done_at = rospy.get_time()  # the last goal's result is here: the server's 0.5 s runs from about now
+# the server stamped the last result when it finished the goal: its 0.5 s runs from there (the
+# client's own clock would start late on a loaded machine, when the result took a while to arrive)
+done_at = client.gh.comm_state_machine.latest_result.header.stamp.to_sec()
 gone = threading.Event()
 gone_at = []
 def on_status(msg):
