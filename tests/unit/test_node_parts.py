@@ -8,6 +8,7 @@ import threading
 import pytest
 
 from minros.exceptions import ROSException, ROSInitException, ServiceException
+from minros.node.connections import Connections
 from minros.node.lifecycle import Lifecycle
 from minros.node.names import NodeNames
 from minros.node.registries import Registries
@@ -109,3 +110,30 @@ def test_param_updates_reach_the_handlers_and_the_subscribed_keys():
     reg.add_param_subscription("/gains")
     assert reg.param_update("/gains/p", 3) and reg.param_update("/", {})
     assert seen[:2] == [("/cached", 1), ("/elsewhere", 2)]
+
+
+def test_connections_route_inbound_headers_and_start_no_server_before_init(monkeypatch):
+    monkeypatch.delenv("ROS_MASTER_URI", raising=False)
+    names, reg = NodeNames(["prog"]), Registries()
+    names.name_node("n", ["prog"], argv_given=True, anonymous=False)
+    stopping = threading.Event()
+    conns = Connections(names, reg, stopping.is_set, lambda: False)
+    assert [h.protocol for h in conns.protocols][-1] == "TCPROS"  # TCPROS last
+    with pytest.raises(ROSInitException, match="init_node"):
+        conns.tcpros_address()
+    assert conns.server is None  # not started by asking too early
+    served: list = []
+    reg.add_service("/srv", lambda stream, header, conn: served.append(header["service"]))
+    assert conns.dispatch(None, {"service": "/srv", "callerid": "/c"}, None) is None
+    assert served == ["/srv"]
+    assert conns.dispatch(None, {"service": "/other", "callerid": "/c"}, None) == (
+        "[/n] is not a provider of [/other]")
+    assert "is not a publisher of [/t]" in conns.dispatch(
+        None, {"topic": "/t", "md5sum": "*", "callerid": "/c"}, None)
+    assert conns.dispatch(None, {"callerid": "/c"}, None) == "no topic or service name detected"
+    stopping.set()
+    assert conns.dispatch(None, {"topic": "/t", "md5sum": "*", "callerid": "/c"}, None) == (
+        "Node is shutting down")
+    assert conns.answer_protocol("/t", "TCPROS") is None  # not a list: not an offer
+    assert conns.answer_protocol("/t", ["UDPROS"]) is None  # not spoken
+    assert conns.local_transport("/t", object, {}) is None  # nothing published here

@@ -17,7 +17,7 @@ def api(monkeypatch):
     monkeypatch.delenv("ROS_MASTER_URI", raising=False)
     fake = node.Node(argv=["fake", "__name:=fake"])  # never started: no sockets
     fake.uri = "http://localhost:1234/"
-    fake.tcpros_address = lambda: ("localhost", 4321)
+    fake.connections.tcpros_address = lambda: ("localhost", 4321)
     return node.SlaveApi(fake)
 
 

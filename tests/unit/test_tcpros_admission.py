@@ -64,7 +64,7 @@ def tcpros_node(master: Master, limits: Limits) -> tuple:
     node = Node(argv=["prog", f"__master:={master.uri}", "__hostname:=127.0.0.1"])
     node.init("tcpros_probe", args_key=("tcpros_probe",))
     node.add_publication(FakePublication("/chatter"))
-    node.tcpros_limits = limits
+    node.connections.limits = limits
     return node, node.tcpros_address()[1]
 
 

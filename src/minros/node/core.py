@@ -7,9 +7,10 @@ concern (goroslib keeps a file per concern of its Node; here each is an object):
 * ``registration`` (:class:`Registration`): those registered with the master, again after
   a master restart, undone with one multicall;
 * ``master`` (:class:`MasterClient`): the typed Master API, as this node;
-* two servers: the slave API (:class:`SlaveApi` on an XML-RPC server) and the TCPROS server
-  (:class:`TCPROSServer`), which hands each inbound connection to what its header names;
-* ``protocols``: the transports the node speaks (:mod:`minros.transport`), TCPROS last.
+* ``connections`` (:class:`Connections`): the transports the node speaks
+  (:mod:`minros.transport`, TCPROS last) and the TCPROS server, which hands each inbound
+  connection to what its header names;
+* the slave API (:class:`SlaveApi` on an XML-RPC server).
 
 The Node wires them together and is their façade: its methods are the node's API, each one
 the concern's. Lock order where locks nest: ``registration.lock`` (held across one exchange
@@ -20,12 +21,12 @@ from __future__ import annotations
 
 import logging
 import sys
-import threading
 import traceback
 from typing import Any, Callable, Dict, List, Sequence, Set, Tuple
 
 from minros import names, rosenv
 from minros.exceptions import ROSException, ROSInitException
+from minros.node.connections import Connections
 from minros.node.lifecycle import Lifecycle
 from minros.node.names import NodeNames
 from minros.node.registration import Registration
@@ -37,12 +38,9 @@ from minros.node.registries import (
     Subscription,
 )
 from minros.node.slave_api import SlaveApi
-from minros.node.tcpros_server import TCPROS_LIMITS, TCPROSServer
-from minros.transport import intraprocess, shm
+from minros.node.tcpros_server import TCPROSServer
 from minros.transport.base import ProtocolHandler, Transport
-from minros.transport.tcpros_pubsub import TCPROSHandler
-from minros.wire import admission, tcpros, trace
-from minros.wire.handshake import route
+from minros.wire import trace
 from minros.wire.masterapi import MasterClient, RemoteError
 from minros.wire.xmlrpc import XmlRpcServer
 
@@ -65,22 +63,13 @@ class Node:
                                    XMLRPC_TIMEOUT)
         self.registration = Registration(self.master, self.registries, self.lifecycle,
                                          lambda: self.uri, self.rosrpc_uri)
-        #: the transports this node speaks, in the order a subscriber offers them: shared
-        #: memory (same host, minros peers) when this system has it, TCPROS last
-        self.protocols: List[ProtocolHandler] = [TCPROSHandler(lambda: self.tcpros_address())]
-        if shm.supported():
-            self.protocols.insert(0, shm.ShmHandler(
-                lambda topic: self.registries.publications.get(topic),
-                                                    self.is_shutdown_requested))
+        self.connections = Connections(self.names, self.registries, self.is_shutdown_requested,
+                                       lambda: self.registration.started)
+        #: the transports this node speaks, in the order a subscriber offers them
+        self.protocols: List[ProtocolHandler] = self.connections.protocols
         self.uri: str | None = None  # the slave API's, once started
-        self.host = ""
         self._xmlrpc: XmlRpcServer | None = None
-        self._ports = (0, 0)  # XML-RPC, TCPROS (0: any free port)
-        self._tcpros: TCPROSServer | None = None
-        self._tcpros_lock = threading.Lock()
-        #: the TCPROS server's admission policy (read when the server starts)
-        self.tcpros_limits = TCPROS_LIMITS
-        self._allowed: Any = None  # ROS_ALLOWED_HOSTS, read by start()
+        self._xmlrpc_port = 0  # 0: any free port
 
     # -- names -------------------------------------------------------------------------------
 
@@ -156,7 +145,7 @@ class Node:
             return False
         argv_list = list(sys.argv if argv is None else argv)
         self.names.name_node(name, argv_list, argv is not None, anonymous)
-        self._ports = (xmlrpc_port, tcpros_port)
+        self._xmlrpc_port, self.connections.port = xmlrpc_port, tcpros_port
         self.start()
         if self.is_shutdown_requested():
             raise ROSInitException("init_node interrupted before it could complete")
@@ -175,21 +164,21 @@ class Node:
 
     def start(self) -> None:
         """Start the slave API, register everything with the master, watch the master."""
-        self.host = self.names.host_name()
+        self.connections.host = self.names.host_name()
         try:
-            self._allowed = rosenv.allowed_hosts()
+            self.connections.allowed = rosenv.allowed_hosts()
         except ValueError as exc:
             raise ROSInitException(str(exc)) from None
         self._xmlrpc = XmlRpcServer(SlaveApi(self), host=self.names.bind_address(),
-                                    port=self._ports[0], allowed=self._allowed,
+                                    port=self._xmlrpc_port, allowed=self.connections.allowed,
                                     on_refused=TCPROSServer.refused,
                                     what=f"node [{self.caller_id}]")
         self._xmlrpc.start()
-        self.uri = f"http://{self.host}:{self._xmlrpc.port}/"
+        self.uri = f"http://{self.connections.host}:{self._xmlrpc.port}/"
         _logger.info("ROS Slave URI: [%s]", self.uri)
         trace.set_node(self.caller_id, self.uri, self.master_uri)
         self.registration.started = True
-        if self._ports[1]:
+        if self.connections.port:
             self.tcpros_address()
         self.registration.register_all(first=True)
         self.registration.start_probe()
@@ -198,7 +187,7 @@ class Node:
         """Unregister everything with one multicall, close every connection, stop the servers."""
         if self.registration.closed.is_set():
             return
-        serving = self._tcpros is not None and self.registries.services
+        serving = self.connections.server is not None and self.registries.services
         self.registration.unregister_all(self.rosrpc_uri() if serving else None)
         if not self.registration.started:
             return
@@ -209,30 +198,23 @@ class Node:
                 endpoint.close()
             except Exception:
                 _logger.debug("close failed: %s", traceback.format_exc())
-        if self._tcpros is not None:
-            self._tcpros.close()
-        for handler in self.protocols:
-            handler.close()
+        self.connections.close()
         if self._xmlrpc is not None:
             self._xmlrpc.shutdown()
 
-    # -- the TCPROS server and the protocols -------------------------------------------------
+    # -- connections --------------------------------------------------------------------------
+
+    @property
+    def host(self) -> str:
+        return self.connections.host
 
     def tcpros_address(self) -> Tuple[str, int]:
         """(advertised host, port) of the node's TCPROS server (started on first use)."""
-        if not self.registration.started:
-            raise ROSInitException("client code must call rospy.init_node() first")
-        with self._tcpros_lock:
-            if self._tcpros is None:
-                server = TCPROSServer(self._dispatch, self.is_shutdown_requested, self._allowed,
-                                      what=f"node [{self.caller_id}]", limits=self.tcpros_limits)
-                server.start(self.names.bind_address(), self._ports[1])
-                self._tcpros = server
-            return self.host, self._tcpros.port
+        return self.connections.tcpros_address()
 
     @property
     def tcpros_server(self) -> TCPROSServer | None:
-        return self._tcpros
+        return self.connections.server
 
     def rosrpc_uri(self) -> str:
         """The ``rosrpc://host:port`` URI of the node's services."""
@@ -241,48 +223,15 @@ class Node:
 
     def answer_protocol(self, topic: str, offer: Any) -> List[Any] | None:
         """requestTopic: the answer to one offered protocol, None if we do not speak it."""
-        if not isinstance(offer, list) or not offer:
-            return None
-        for handler in self.protocols:
-            if handler.protocol == offer[0]:
-                return handler.answer(topic, offer)
-        return None
+        return self.connections.answer_protocol(topic, offer)
 
     def local_transport(self, topic: str, pub_uri: str, data_class: Any,
                         fields: Dict[str, str]) -> Transport | None:
-        """The subscriber's end of an intra-process link when ``pub_uri`` is this node and its
-        publication of ``topic`` hands its messages over as objects (``intraprocess``) of
-        ``data_class``, the subscriber's (``fields``: its connection header); else None."""
+        """The subscriber's end of an intra-process link when ``pub_uri`` is this node (see
+        :meth:`Connections.local_transport`); else None."""
         if pub_uri != self.uri:
             return None
-        pub = self.registries.publications.get(topic)
-        if pub is None or not pub.intraprocess or pub.closed or pub.data_class is not data_class:
-            return None
-        return intraprocess.link(pub, fields)
-
-    def _dispatch(self, stream: Any, header: Dict[str, str], conn: admission.Connection) -> str | None:
-        """Hand an inbound connection to what its header names; the error text when it cannot be."""
-        kind = route(header)
-        if kind == "topic":
-            if self.is_shutdown_requested():
-                return "Node is shutting down"
-            pub = self.registries.publications.get(header["topic"])
-            if pub is None:
-                return tcpros.publisher_header_error(
-                    header, self.caller_id, self.registries.publication_types()) or (
-                    f"[{self.caller_id}] is not a publisher of [{header['topic']}]")
-            for handler in self.protocols:
-                if handler.claims(header):
-                    handler.accept(stream, header, pub)  # Rejected when it refused
-                    return None
-            return "no transport takes this connection"
-        if kind == "service":
-            serve = self.registries.services.get(header["service"])
-            if serve is None:
-                return f"[{self.caller_id}] is not a provider of [{header['service']}]"
-            serve(stream, header, conn)
-            return None
-        return "no topic or service name detected"
+        return self.connections.local_transport(topic, data_class, fields)
 
     # -- what the node offers and asks for ---------------------------------------------------
 
