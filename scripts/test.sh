@@ -75,7 +75,7 @@ workers=${WORKERS:-3}
 parallel=()
 [ "$workers" -gt 1 ] && parallel=(-n "$workers" --dist loadfile)
 if [ "$workers" -gt 1 ]; then
-  .venv/bin/python -m pytest "${parallel[@]}" -m "not timing" "$@" || status=$?
+  .venv/bin/python -m pytest "${parallel[@]}" -m "not timing" --durations=30 "$@" || status=$?
   code=0
   .venv/bin/python -m pytest -m timing "$@" || code=$?
   [ "$code" -eq 0 ] || [ "$code" -eq 5 ] || status=$code  # 5: the arguments chose no timing test
