@@ -74,8 +74,31 @@ status=0
 workers=${WORKERS:-3}
 parallel=()
 [ "$workers" -gt 1 ] && parallel=(-n "$workers" --dist loadfile)
+# A test that fails in the parallel run is run again alone, once: if it passes alone, it raced
+# under load, and is named as FLAKY (to be fixed: the run passes, the log says which); a test
+# that fails alone too fails the run, and so do more than 5 failures (not a race).
+failed_list=$(mktemp)
+trap 'rm -f "$failed_list"' EXIT
+run_tests() {  # label python pytest-args...
+  local label=$1 py=$2 code=0
+  shift 2
+  MINROS_FAILED_LIST=$failed_list "$py" -m pytest "$@" || code=$?
+  [ "$code" -eq 0 ] && return 0
+  local count
+  count=$(wc -l < "$failed_list")
+  if [ "$code" -eq 1 ] && [ "$count" -ge 1 ] && [ "$count" -le 5 ]; then
+    local ids
+    mapfile -t ids < "$failed_list"
+    echo "$label: $count test(s) failed in the parallel run; running them again alone:"
+    if "$py" -m pytest -q -p no:cacheprovider "${ids[@]}"; then
+      echo "$label: FLAKY (failed in the parallel run, passed alone): ${ids[*]}"
+      return 0
+    fi
+  fi
+  return "$code"
+}
 if [ "$workers" -gt 1 ]; then
-  .venv/bin/python -m pytest "${parallel[@]}" -m "not timing" --durations=30 "$@" || status=$?
+  run_tests "main run" .venv/bin/python "${parallel[@]}" -m "not timing" --durations=30 "$@" || status=$?
   code=0
   .venv/bin/python -m pytest -m timing "$@" || code=$?
   [ "$code" -eq 0 ] || [ "$code" -eq 5 ] || status=$code  # 5: the arguments chose no timing test
@@ -84,9 +107,10 @@ else
 fi
 for entry in "${pids[@]}"; do
   v=${entry%%:*}
-  if wait "${entry#*:}" && ".venv-$v/bin/python" -m pytest -q -p no:cacheprovider "${parallel[@]}" \
-      -m "not interop and not timing" tests/unit tests/integration >> ".venv-$v.log" 2>&1; then
-    echo "Python $v: $(tail -n 1 ".venv-$v.log")"
+  if wait "${entry#*:}" && run_tests "Python $v" ".venv-$v/bin/python" -q -p no:cacheprovider \
+      "${parallel[@]}" -m "not interop and not timing" tests/unit tests/integration \
+      >> ".venv-$v.log" 2>&1; then
+    echo "Python $v: $(grep -E ' passed| FLAKY' ".venv-$v.log" | tail -n 3)"
   else
     echo "Python $v: unit and integration tests FAILED; the end of .venv-$v.log:" >&2
     tail -n 60 ".venv-$v.log" >&2

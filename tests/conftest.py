@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -91,3 +92,19 @@ def pytest_collection_modifyitems(config, items) -> None:
     for item in items:
         if getattr(getattr(item, "obj", None), "is_hypothesis_test", False):
             item.add_marker(pytest.mark.fuzz)
+
+
+# scripts/test.sh runs again, alone, a test that failed in the parallel run (MINROS_FAILED_LIST
+# names the file that gets the failed tests' ids), to tell a race under load from a failure.
+_failed: list = []
+
+
+def pytest_runtest_logreport(report) -> None:
+    if report.failed and report.nodeid not in _failed:
+        _failed.append(report.nodeid)
+
+
+def pytest_sessionfinish(session) -> None:
+    path = os.environ.get("MINROS_FAILED_LIST")
+    if path and not hasattr(session.config, "workerinput"):  # the controller sees every report
+        Path(path).write_text("".join(f"{nodeid}\n" for nodeid in _failed))
