@@ -39,13 +39,18 @@ done_at = client.gh.comm_state_machine.latest_result.header.stamp.to_sec()
 gone = threading.Event()
 gone_at = []
 def on_status(msg):
-    if all(s.goal_id.id != last for s in msg.status_list) and not gone.is_set():
-        gone_at.append(rospy.get_time())
+    # server times throughout; status lists published before the result (still on their way
+    # through the client's own status subscription, which this one shares) do not count
+    stamp = msg.header.stamp.to_sec()
+    if stamp >= done_at and all(s.goal_id.id != last for s in msg.status_list) and not gone.is_set():
+        gone_at.append(stamp)
         gone.set()
 rospy.Subscriber("quick/status", GoalStatusArray, on_status)
 # forgotten after the 0.5 s set above, not at once nor at actionlib's default 5 s (slack for a
 # busy machine), counted from the result, not from when this subscriber came up
-print("forgotten", gone.wait(10), bool(gone_at) and 0.3 < gone_at[0] - done_at < 4.5, flush=True)
+forgotten = gone.wait(10)
+print(f"[forgotten after {gone_at[0] - done_at if gone_at else None} s]", flush=True)
+print("forgotten", forgotten, bool(gone_at) and 0.4 < gone_at[0] - done_at < 4.5, flush=True)
 
 # goal and preempt callbacks instead of an execute callback
 polled = actionlib.SimpleActionServer("polled", TwoIntsAction, auto_start=False)
