@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import functools
 import os
+import random
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 import xmlrpc.client
 from pathlib import Path
@@ -102,10 +104,35 @@ def run_python(code: str, env_extra: Dict[str, str]) -> subprocess.CompletedProc
                           timeout=60)
 
 
+# Ports for test servers come from below the kernel's ephemeral range (32768-60999 on Linux):
+# a port the kernel handed out with bind(0) can be taken, before the server binds it, by any
+# outgoing connection of any process (seen in CI: "Address already in use" under load). Each
+# pytest-xdist worker draws from its own share of the range, so workers never meet either.
+_PORT_RANGE = (20000, 32000)
+_PORT_SHARES = 8
+_port_lock = threading.Lock()
+_port_next: List[int] = []
+
+
 def free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A TCP port free on 127.0.0.1 now, not one the kernel gives to outgoing connections."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")  # gw0, gw1, ...
+    share = int(worker[2:]) + 1 if worker[2:].isdigit() else 0
+    span = (_PORT_RANGE[1] - _PORT_RANGE[0]) // _PORT_SHARES
+    low = _PORT_RANGE[0] + share % _PORT_SHARES * span
+    with _port_lock:
+        if not _port_next:
+            _port_next.append(random.randrange(span))  # another run's leftovers are elsewhere
+        for _ in range(span):
+            port = low + _port_next[0] % span
+            _port_next[0] += 1
+            with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+                try:
+                    s.bind(("127.0.0.1", port))  # no SO_REUSEADDR: a port in TIME_WAIT is skipped
+                except OSError:
+                    continue
+                return port
+    raise RuntimeError(f"no free port in {low}..{low + span - 1}")
 
 
 def ros_env(master_port: Optional[int], home: Path, extra: Optional[Dict[str, str]] = None) -> Dict[str, str]:
