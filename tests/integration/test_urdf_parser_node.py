@@ -1,10 +1,11 @@
 """urdf_parser_py's ``URDF.from_parameter_server()`` in a rospy node under ``minros core``: the
 description set on the master (as roslaunch's <param> sets it) is read through the node's
 parameter API, relative keys resolve in the node's namespace, and a missing key is rospy's
-KeyError."""
+KeyError. ``rosrun urdfdom_py display_urdf`` prints the parameter's robot."""
 
 from __future__ import annotations
 
+import subprocess
 import xmlrpc.client
 from pathlib import Path
 
@@ -51,3 +52,19 @@ def test_from_parameter_server_in_a_node(tmp_path: Path, minros_core: int, ros_h
     assert lines == ["default arm ['base', 'shoulder', 'upper', 'wrist', 'tool']",
                      "key -1.5 1.5",
                      "missing ('no_description',)"], out  # rospy's KeyError(key), as given
+
+
+def test_display_urdf_reads_robot_description(minros_core: int, ros_home: Path) -> None:
+    from minros.workspace import executables
+
+    env = ros_env(minros_core, ros_home)
+    argv = executables.resolve_executable("urdfdom_py", "display_urdf")
+    missing = subprocess.run(argv, capture_output=True, text=True, env=env, timeout=60)
+    assert (missing.returncode, missing.stdout) == (1, "")
+    assert missing.stderr.startswith("display_urdf: the parameter robot_description is not set")
+    master = xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])
+    assert master.setParam("/test", "/robot_description", ROBOT)[0] == 1
+    shown = subprocess.run(argv + ["-o", "-"], capture_output=True, text=True, env=env, timeout=60)
+    assert shown.returncode == 0 and shown.stderr == "", shown.stderr
+    assert "\nname: arm\n" in shown.stdout
+    assert '<limit effort="10.0" lower="-1.5" upper="1.5" velocity="2.0"/>' in shown.stdout

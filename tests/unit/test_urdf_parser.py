@@ -321,3 +321,33 @@ def test_versions_and_bad_xml() -> None:
         URDF.from_xml_string("<robot name='r'><link>")
     with pytest.raises(AssertionError, match="Multiple roots detected, invalid URDF: a, b"):
         URDF.from_xml_string('<robot name="r"><link name="a"/><link name="b"/></robot>').get_root()
+
+
+def test_display_urdf_prints_the_model_and_writes_xml(tmp_path, capsys) -> None:
+    from minros.nodes.urdfdom_py.display_urdf import main
+
+    source, out = tmp_path / "robot.urdf", tmp_path / "out.urdf"
+    source.write_text(ROBOT)
+    assert main([str(source), "-o", str(out), "__name:=display"]) == 0
+    printed = capsys.readouterr().out
+    assert "\nname: mobile_arm\n" in printed and "\n  name: shoulder_pan\n" in printed
+    assert out.read_text() == URDF.from_xml_string(ROBOT).to_xml_string()
+
+
+@pytest.mark.parametrize("text, message", [
+    (None, "cannot read {path}: No such file or directory"),
+    ("<robot name='r'><link>", "{path} is not XML: no element found: line 1, column 22"),
+    ('<robot name="r"><link/></robot>', "{path}: ParseError in /robot[@name='r']/link[1]:\n"
+                                        "Required attribute not set in XML: name"),
+    ('<robot name="r" version="2.0"/>', "{path}: Invalid version; only 1.0 is supported"),
+])
+def test_display_urdf_names_what_is_wrong(tmp_path, capsys, text, message) -> None:
+    from minros.nodes.urdfdom_py.display_urdf import main
+
+    path = tmp_path / "robot.urdf"
+    if text is not None:
+        path.write_text(text)
+    assert main([str(path)]) == 1
+    captured = capsys.readouterr()
+    assert captured.err == "display_urdf: " + message.format(path=path) + "\n"
+    assert captured.out == ""
