@@ -309,9 +309,16 @@ def test_roslaunch_scripting_api(minros_core: int, ros_home: Path, tmp_path: Pat
         "['/script_listener', '/script_talker'] True", "False")]
     assert lines == ["['/script_listener', '/script_talker'] True", "False"], run.stdout
     master = ServerProxy(f"http://localhost:{minros_core}/")
-    wait_until(lambda: not any(n.startswith("/script_") for section in
-                               master.getSystemState("/test")[2] for _t, ns in section for n in ns),
-               timeout=20, what="the launched nodes unregistered")
+
+    def left() -> list:
+        return sorted({n for section in master.getSystemState("/test")[2] for _t, ns in section
+                       for n in ns if n.startswith("/script_")})
+
+    try:
+        wait_until(lambda: not left(), timeout=20, what="the launched nodes unregistered")
+    except AssertionError:
+        raise AssertionError(f"still registered: {left()}; the script printed:\n{run.stdout}\n"
+                             f"{run.stderr}") from None
 
 
 OBJECT_MODEL = r'''

@@ -137,3 +137,47 @@ def test_connections_route_inbound_headers_and_start_no_server_before_init(monke
     assert conns.answer_protocol("/t", "TCPROS") is None  # not a list: not an offer
     assert conns.answer_protocol("/t", ["UDPROS"]) is None  # not spoken
     assert conns.local_transport("/t", object, {}) is None  # nothing published here
+
+
+class _SlowMaster:
+    """The few MasterClient calls Registration makes; register_service waits to be let go."""
+
+    caller_id = "/n"
+    uri = "http://m:1/"
+
+    def __init__(self) -> None:
+        self.entered, self.go, self.done = threading.Event(), threading.Event(), threading.Event()
+        self.multicalls: list = []
+
+    def register_service(self, service: str, rosrpc_uri: str, uri: str) -> None:
+        self.entered.set()
+        assert self.go.wait(5)
+        self.done.set()
+
+    def with_timeout(self, timeout: float) -> _SlowMaster:
+        return self
+
+    def multicall(self, calls: list) -> list:
+        self.multicalls.append(calls)
+        return []
+
+
+def test_shutdown_unregisters_a_service_whose_registration_was_in_flight():
+    """A Ctrl-C while rospy registers its first service (the logger services at init): the
+    services' URI is asked after that registration, so the multicall withdraws the service."""
+    from minros.node.registration import Registration
+
+    master, reg = _SlowMaster(), Registries()
+    registration = Registration(master, reg, Lifecycle(lambda: None), lambda: "http://h:1/",
+                                lambda: "rosrpc://h:2")
+    registration.started = True
+    reg.add_service("/n/get_loggers", lambda stream, header, conn: None)
+    announcing = threading.Thread(target=registration.announce_service, args=("/n/get_loggers",))
+    announcing.start()
+    assert master.entered.wait(5)
+    threading.Timer(0.05, master.go.set).start()  # the registration finishes during close
+    # the node serves a service once its registration is through (as close() asks the node)
+    registration.unregister_all(lambda: "rosrpc://h:2" if master.done.is_set() else None)
+    announcing.join(5)
+    assert master.multicalls == [[
+        {"methodName": "unregisterService", "params": ["/n", "/n/get_loggers", "rosrpc://h:2"]}]]

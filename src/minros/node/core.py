@@ -187,8 +187,8 @@ class Node:
         """Unregister everything with one multicall, close every connection, stop the servers."""
         if self.registration.closed.is_set():
             return
-        serving = self.connections.server is not None and self.registries.services
-        self.registration.unregister_all(self.rosrpc_uri() if serving else None)
+        self.registration.unregister_all(
+            lambda: self.rosrpc_uri() if self.connections.server is not None else None)
         if not self.registration.started:
             return
         pubs, subs = self.registries.endpoints()

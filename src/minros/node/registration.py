@@ -208,9 +208,12 @@ class Registration:
                 self._warned = True
                 self.register_all()
 
-    def unregister_all(self, rosrpc_uri: str | None) -> None:
+    def unregister_all(self, served_uri: Callable[[], str | None]) -> None:
         """close(): undo every registration with one multicall (after any registration in
-        flight, for at most CLOSE_REGISTRATION_WAIT seconds); nothing is registered after."""
+        flight, for at most CLOSE_REGISTRATION_WAIT seconds); nothing is registered after.
+        ``served_uri()`` is the services' URI, None when the node serves none; asked after the
+        registration in flight, which may be the first service's (seen: a Ctrl-C while rospy
+        registered the logger services left them registered)."""
         if self.closed.is_set():
             return
         self.closed.set()
@@ -221,7 +224,7 @@ class Registration:
         # Bounded: a registration stuck on a frozen master must not hold up the shutdown.
         locked = self.lock.acquire(timeout=CLOSE_REGISTRATION_WAIT)
         try:
-            calls = self._unregistration_calls(rosrpc_uri)
+            calls = self._unregistration_calls(served_uri())
             if calls:
                 # tried even when the probe lost the master: a master that was only slow for a
                 # moment would otherwise keep our registrations forever; one that is gone costs
