@@ -1,1 +1,0 @@
-"""urdfdom_py's program (the ROS package that installs urdf_parser_py)."""

@@ -1,1 +1,0 @@
-"""urdf_parser_py stand-in (see minros.urdf_parser)."""
