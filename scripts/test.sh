@@ -74,24 +74,31 @@ status=0
 workers=${WORKERS:-3}
 parallel=()
 [ "$workers" -gt 1 ] && parallel=(-n "$workers" --dist loadfile)
-# A test that fails in the parallel run is run again alone, once: if it passes alone, it raced
-# under load, and is named as FLAKY (to be fixed: the run passes, the log says which); a test
-# that fails alone too fails the run, and so do more than 5 failures (not a race).
+# A test that fails in a parallel run is run again alone, once: if it passes alone (passed,
+# not skipped), it raced under load and is named as FLAKY, here and again at the end (to be
+# fixed: the run passes, the log says which); a test that fails alone too fails the run, and
+# so do more than 5 failures (not a race). A run in one process is not rerun.
 failed_list=$(mktemp)
-trap 'rm -f "$failed_list"' EXIT
+flaky_log=$(mktemp)
+rerun_log=$(mktemp)
+trap 'rm -f "$failed_list" "$flaky_log" "$rerun_log"' EXIT
 run_tests() {  # label python pytest-args...
   local label=$1 py=$2 code=0
   shift 2
+  : > "$failed_list"
   MINROS_FAILED_LIST=$failed_list "$py" -m pytest "$@" || code=$?
   [ "$code" -eq 0 ] && return 0
+  [ "${#parallel[@]}" -gt 0 ] || return "$code"
   local count
   count=$(wc -l < "$failed_list")
   if [ "$code" -eq 1 ] && [ "$count" -ge 1 ] && [ "$count" -le 5 ]; then
     local ids
     mapfile -t ids < "$failed_list"
     echo "$label: $count test(s) failed in the parallel run; running them again alone:"
-    if "$py" -m pytest -q -p no:cacheprovider "${ids[@]}"; then
-      echo "$label: FLAKY (failed in the parallel run, passed alone): ${ids[*]}"
+    "$py" -m pytest -q -p no:cacheprovider "${ids[@]}" > "$rerun_log" 2>&1 || true
+    cat "$rerun_log"
+    if tail -n 1 "$rerun_log" | grep -Eq "^(=+ )?$count passed(, [0-9]+ warnings?)? in "; then
+      echo "$label: FLAKY (failed in the parallel run, passed alone): ${ids[*]}" | tee -a "$flaky_log"
       return 0
     fi
   fi
@@ -117,4 +124,8 @@ for entry in "${pids[@]}"; do
     status=1
   fi
 done
+if [ -s "$flaky_log" ]; then
+  echo "Tests that failed in a parallel run and passed alone (races under load, to fix):"
+  cat "$flaky_log"
+fi
 exit $status

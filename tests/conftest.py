@@ -96,7 +96,7 @@ def pytest_collection_modifyitems(config, items) -> None:
 
 # scripts/test.sh runs again, alone, a test that failed in the parallel run (MINROS_FAILED_LIST
 # names the file that gets the failed tests' ids), to tell a race under load from a failure.
-_failed: list = []
+_failed: list[str] = []
 
 
 def pytest_runtest_logreport(report) -> None:

@@ -104,25 +104,37 @@ def run_python(code: str, env_extra: Dict[str, str]) -> subprocess.CompletedProc
                           timeout=60)
 
 
-# Ports for test servers come from below the kernel's ephemeral range (32768-60999 on Linux):
-# a port the kernel handed out with bind(0) can be taken, before the server binds it, by any
-# outgoing connection of any process (seen in CI: "Address already in use" under load). Each
-# pytest-xdist worker draws from its own share of the range, so workers never meet either.
-_PORT_RANGE = (20000, 32000)
+# Ports for test servers come from below the kernel's ephemeral range (32768-60999 on Linux,
+# read from /proc): a port the kernel handed out with bind(0) can be taken, before the server
+# binds it, by any outgoing connection of any process (seen in CI: "Address already in use"
+# under load). Each pytest-xdist worker draws from its own share, so workers never meet either.
 _PORT_SHARES = 8
 _port_lock = threading.Lock()
 _port_next: List[int] = []
 
 
+def _port_range() -> tuple:
+    try:
+        ephemeral_low = int(Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        ephemeral_low = 32768
+    return 20000, min(32000, ephemeral_low)
+
+
 def free_port() -> int:
     """A TCP port free on 127.0.0.1 now, not one the kernel gives to outgoing connections."""
+    low, high = _port_range()
+    span = (high - low) // _PORT_SHARES
+    if span < 100:  # an unusual ephemeral range: the kernel's choice, as before
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+            s.bind(("127.0.0.1", 0))
+            return s.getsockname()[1]
     worker = os.environ.get("PYTEST_XDIST_WORKER", "")  # gw0, gw1, ...
-    share = int(worker[2:]) + 1 if worker[2:].isdigit() else 0
-    span = (_PORT_RANGE[1] - _PORT_RANGE[0]) // _PORT_SHARES
-    low = _PORT_RANGE[0] + share % _PORT_SHARES * span
+    share = int(worker[2:]) % (_PORT_SHARES - 1) + 1 if worker[2:].isdigit() else 0
+    low += share * span
     with _port_lock:
-        if not _port_next:
-            _port_next.append(random.randrange(span))  # another run's leftovers are elsewhere
+        if not _port_next:  # another run's leftovers are elsewhere
+            _port_next.append(random.SystemRandom().randrange(span))
         for _ in range(span):
             port = low + _port_next[0] % span
             _port_next[0] += 1

@@ -4,6 +4,7 @@ Node composing them with registration and servers is test_node_runtime.py."""
 from __future__ import annotations
 
 import threading
+from typing import Any
 
 import pytest
 
@@ -162,6 +163,26 @@ class _SlowMaster:
         return []
 
 
+class _LetsGoOnAcquire:
+    """A lock that sets ``go`` when acquire() is called (close() waiting for it)."""
+
+    def __init__(self, lock: Any, go: threading.Event) -> None:
+        self._lock, self._go = lock, go
+
+    def __enter__(self) -> Any:
+        return self._lock.__enter__()
+
+    def __exit__(self, *exc: Any) -> Any:
+        return self._lock.__exit__(*exc)
+
+    def acquire(self, timeout: float = -1) -> bool:
+        self._go.set()
+        return self._lock.acquire(timeout=timeout)
+
+    def release(self) -> None:
+        self._lock.release()
+
+
 def test_shutdown_unregisters_a_service_whose_registration_was_in_flight():
     """A Ctrl-C while rospy registers its first service (the logger services at init): the
     services' URI is asked after that registration, so the multicall withdraws the service."""
@@ -171,13 +192,15 @@ def test_shutdown_unregisters_a_service_whose_registration_was_in_flight():
     registration = Registration(master, reg, Lifecycle(lambda: None), lambda: "http://h:1/",
                                 lambda: "rosrpc://h:2")
     registration.started = True
+    # the registration in flight finishes once close() waits for the lock
+    registration.lock = _LetsGoOnAcquire(registration.lock, master.go)  # type: ignore[assignment]
     reg.add_service("/n/get_loggers", lambda stream, header, conn: None)
     announcing = threading.Thread(target=registration.announce_service, args=("/n/get_loggers",))
     announcing.start()
     assert master.entered.wait(5)
-    threading.Timer(0.05, master.go.set).start()  # the registration finishes during close
     # the node serves a service once its registration is through (as close() asks the node)
     registration.unregister_all(lambda: "rosrpc://h:2" if master.done.is_set() else None)
     announcing.join(5)
+    assert not announcing.is_alive()
     assert master.multicalls == [[
         {"methodName": "unregisterService", "params": ["/n", "/n/get_loggers", "rosrpc://h:2"]}]]

@@ -14,7 +14,9 @@ concern (goroslib keeps a file per concern of its Node; here each is an object):
 
 The Node wires them together and is their façade: its methods are the node's API, each one
 the concern's. Lock order where locks nest: ``registration.lock`` (held across one exchange
-with the master) -> ``registries.lock`` (a leaf); the lifecycle's lock is a leaf too.
+with the master) -> ``registries.lock`` (a leaf), and ``registration.lock`` -> the lock of
+``connections`` (a service's registration starts the TCPROS server); the lifecycle's lock is
+a leaf too.
 """
 
 from __future__ import annotations
