@@ -2,14 +2,14 @@
 """Run ROS's own Python unit suites against minros and against Debian's ROS 1; print both counts.
 
     .venv/bin/python scripts/upstream_suites.py --ros-comm DIR --genpy DIR --genmsg DIR \\
-        [--geometry DIR] [--diagnostics DIR] [--only SUITE ...] [--side minros|debian|both] \\
-        [--diff] [--keep DIR]
+        [--geometry DIR] [--diagnostics DIR] [--urdf-parser-py DIR] [--only SUITE ...] \\
+        [--side minros|debian|both] [--diff] [--keep DIR]
 
 Each DIR is a checkout of the public repository (ros/ros_comm, ros/genpy, ros/genmsg,
-ros/geometry, ros/diagnostics; the fetch tool or git clone gives one; the tags of Debian's
-versions are 1.15.15, 0.6.16, 0.6.0, 1.13.2 and 1.11.0). The tests are run where they are,
-unedited; nothing of them is copied into this repository. A suite whose checkout is not given
-is left out.
+ros/geometry, ros/diagnostics, ros/urdf_parser_py; the fetch tool or git clone gives one; the
+tags of Debian's versions are 1.15.15, 0.6.16, 0.6.0, 1.13.2 and 1.11.0; urdf_parser_py, which
+Debian lacks, at noetic's 0.4.6). The tests are run where they are, unedited; nothing of them is
+copied into this repository. A suite whose checkout is not given is left out.
 
 Both sides run the same files through pytest, each in a fresh process:
 - minros: this interpreter (the venv), whose rospy, genpy, roslib, ... are minros's. The test
@@ -19,6 +19,9 @@ Both sides run the same files through pytest, each in a fresh process:
   pytest only (Debian's interpreter has none; --debian-python names another). The test
   packages' messages are generated first by Debian's own genpy into a scratch folder.
 Both get a two-line ``nose.tools`` (``nottest``), which genpy's test_genpy_message imports.
+A library Debian lacks (urdf_parser_py) is upstream's own code from the checkout on the Debian
+side; on the minros side minros's package is put ahead of the checkout's copy, which the tests
+add to sys.path themselves.
 
 The table counts passed tests per suite (pytest's junit report: tests - failures - errors -
 skipped); ``--diff`` lists the tests Debian passes and minros does not, and the reverse.
@@ -55,6 +58,12 @@ class Suite:
     messages: Sequence[Tuple[str, str]] = ()
     target: bool = True  # counted in the issue's targets; other suites are informational
     note: str = ""
+    #: packages the tests find in the checkout itself (test_urdf.py appends ../src to sys.path):
+    #: the minros side gets minros's own ahead of them on PYTHONPATH
+    shadowed: Sequence[str] = ()
+    #: folders of the checkout on the Debian side's PYTHONPATH: a library Debian has no package
+    #: of, run as upstream's own code
+    debian_pythonpath: Sequence[str] = ()
 
 
 SUITES: List[Suite] = [
@@ -88,6 +97,9 @@ SUITES: List[Suite] = [
     Suite("rostopic-offline", "ros_comm", ["tools/rostopic/test/test_rostopic_command_line_offline.py"],
           target=False),
     Suite("topic_tools-args", "ros_comm", ["tools/topic_tools/test/args.py"], target=False),
+    # a library Debian lacks: its "Debian" column is upstream's own code under Debian's Python
+    Suite("urdf_parser_py", "urdf_parser_py", ["test"], target=False,
+          shadowed=["urdf_parser_py"], debian_pythonpath=["src"]),
 ]
 
 #: Test-only modules the upstream tests import that neither side installs, on both sides'
@@ -225,6 +237,21 @@ def message_overlays(suite: Suite, root: Path, out: Path) -> None:
                 (pkg / kind).symlink_to(src / kind)
 
 
+#: For minros: the folder holding minros's own copy of each named package (a link to it, so
+#: nothing else of that folder comes first).
+SHADOW = r"""
+import importlib.util, os, sys
+out = sys.argv[1]
+for name in sys.argv[2:]:
+    spec = importlib.util.find_spec(name)
+    if spec is None or not spec.submodule_search_locations:
+        sys.exit(name + ': not a package of this interpreter')
+    link = os.path.join(out, name)
+    if not os.path.lexists(link):
+        os.symlink(list(spec.submodule_search_locations)[0], link)
+"""
+
+
 def debian_python(path: Optional[str]) -> str:
     """An interpreter that sees Debian's packages and has pytest (a venv made once if needed)."""
     if path:
@@ -262,7 +289,7 @@ def count(outcomes: Optional[Dict[str, str]]) -> str:
 def main(argv: Optional[Sequence[str]] = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    for repo in ("ros-comm", "genpy", "genmsg", "geometry", "diagnostics"):
+    for repo in ("ros-comm", "genpy", "genmsg", "geometry", "diagnostics", "urdf-parser-py"):
         parser.add_argument(f"--{repo}", metavar="DIR", type=Path,
                             help=f"checkout of ros/{repo.replace('-', '_')}")
     parser.add_argument("--only", nargs="+", metavar="SUITE",
@@ -282,7 +309,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = parser.parse_args(argv)
 
     roots = {"ros_comm": args.ros_comm, "genpy": args.genpy, "genmsg": args.genmsg,
-             "geometry": args.geometry, "diagnostics": args.diagnostics}
+             "geometry": args.geometry, "diagnostics": args.diagnostics,
+             "urdf_parser_py": args.urdf_parser_py}
     for key, root in roots.items():
         if root is not None and not root.is_dir():
             parser.error(f"--{key.replace('_', '-')} {root}: no such folder")
@@ -305,6 +333,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         generated = scratch / "debian-gen"
         overlays = scratch / "minros-packages"
         devel = scratch / "minros-devel"
+        shadows = scratch / "minros-first"
+        shadows.mkdir()
         rows = []
         for suite in suites:
             root = roots[suite.repo].resolve()
@@ -312,15 +342,19 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             for side in sides:
                 if side == "minros":
                     message_overlays(suite, root, overlays)
-                    env = base_env(scratch, [shim, devel], [overlays, root])
+                    env = base_env(scratch, [shadows, shim, devel], [overlays, root])
                     python = args.minros_python
+                    if suite.shadowed:
+                        subprocess.run([python, "-c", SHADOW, str(shadows), *suite.shadowed],
+                                       env=env, check=True, timeout=120)
                     if suite.messages:
                         subprocess.run([python, "-c", WRITE_STUBS, str(devel),
                                         *[name for name, _ in suite.messages]],
                                        env=env, check=True, timeout=120)
                 else:
                     generate_debian_messages(deb_python, suite, root, generated)
-                    env = base_env(scratch, [shim, generated], [root, Path("/usr/share")])
+                    env = base_env(scratch, [shim, generated, *[root / p for p in suite.debian_pythonpath]],
+                                   [root, Path("/usr/share")])
                     python = deb_python
                 print(f"{suite.name}: {side} ...", file=sys.stderr, flush=True)
                 outcomes, output = run_pytest(python, suite, root, env, scratch, side)

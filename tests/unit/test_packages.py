@@ -25,10 +25,10 @@ def test_every_bundled_manifest_reads_as_rospkg_reads_it(folder) -> None:
 
 
 #: Python packages minros installs whose name is no ROS package's, as on a real install:
-#: PyKDL is the module of the package python_orocos_kdl; ament_index_python is ROS 2's (PyPI's
-#: xacro looks packages up through it); catkin's package.xml would make CMake users believe
-#: minros builds C++ packages
-NOT_ROS_PACKAGES = frozenset({"PyKDL", "ament_index_python", "catkin"})
+#: PyKDL is the module of the package python_orocos_kdl, urdf_parser_py of urdfdom_py;
+#: ament_index_python is ROS 2's (PyPI's xacro looks packages up through it); catkin's
+#: package.xml would make CMake users believe minros builds C++ packages
+NOT_ROS_PACKAGES = frozenset({"PyKDL", "ament_index_python", "catkin", "urdf_parser_py"})
 
 
 def test_every_python_package_minros_ships_is_a_ros_package(monkeypatch) -> None:

@@ -100,6 +100,8 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "xacro": {"xacro": "minros.nodes.xacro.xacro", "xacro.py": "minros.nodes.xacro.xacro"},
     "tf2_web_republisher": {
         "tf2_web_republisher": "minros.nodes.tf2_web_republisher.tf2_web_republisher"},
+    # urdf_parser_py's package (minros.urdf_parser)
+    "urdfdom_py": {"display_urdf": "minros.nodes.urdfdom_py.display_urdf"},
     # headless: ROS's axclient is a wxPython window
     "actionlib_tools": {"axclient.py": "minros.nodes.actionlib_tools.axclient",
                         "axclient": "minros.nodes.actionlib_tools.axclient"},

@@ -1,0 +1,1 @@
+"""urdf_parser_py stand-in (see minros.urdf_parser)."""
