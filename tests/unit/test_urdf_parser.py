@@ -351,3 +351,53 @@ def test_display_urdf_names_what_is_wrong(tmp_path, capsys, text, message) -> No
     captured = capsys.readouterr()
     assert captured.err == "display_urdf: " + message.format(path=path) + "\n"
     assert captured.out == ""
+
+
+def test_display_urdf_reads_a_file_whose_name_starts_with_two_underscores(tmp_path, capsys,
+                                                                            monkeypatch) -> None:
+    from minros.nodes.urdfdom_py.display_urdf import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "__robot.urdf").write_text(ROBOT)
+    # only `__name:=value` remappings are roslaunch's; `__robot.urdf` is the file to read
+    assert main(["__robot.urdf", "__log:=/tmp/x.log"]) == 0
+    assert "\nname: mobile_arm\n" in capsys.readouterr().out
+
+
+def test_aggregates_keep_their_order_and_can_be_removed_or_lumped() -> None:
+    robot = URDF.from_xml_string('<robot name="r"><link name="a"/><joint name="j" type="fixed">'
+                                 '<parent link="a"/><child link="b"/></joint><link name="b"/>'
+                                 '</robot>')
+    tags = [child.tag for child in robot.to_xml()]
+    assert tags == ["link", "joint", "link"]
+    robot.lump_aggregates()
+    assert [child.tag for child in robot.to_xml()] == ["link", "link", "joint"]
+    robot.remove_aggregate(robot.links[0])
+    assert [link.name for link in robot.links] == ["b"]
+    assert [child.get("name") for child in robot.to_xml()] == ["b", "j"]
+    with pytest.raises(ValueError, match="is not one of Robot's aggregates"):
+        robot.remove_aggregate(urdf.Link(name="c"))
+
+
+def test_reflect_with_a_parent_class_reads_and_writes_its_fields_first(capsys) -> None:
+    class Base(xmlr.Object):
+        pass
+
+    class Derived(Base):
+        pass
+
+    xmlr.reflect(Base, tag="base", params=[xmlr.Attribute("name", str),
+                                           xmlr.Element("size", float, False, default=1.0)])
+    xmlr.reflect(Derived, tag="derived", parent_cls=Base, params=[
+        xmlr.Attribute("color", str, False), xmlr.AggregateElement("item", str)])
+    Derived.__init__ = lambda self: (self.aggregate_init(), setattr(self, "items", []))[0]
+    obj = Derived.from_xml_string('<derived color="red" name="d" odd="1"><item>x</item>'
+                                  '<size>2</size><size>3</size><item>y</item><what/></derived>')
+    assert (obj.name, obj.color, obj.size, obj.items) == ("d", "red", 2.0, ["x", "y"])
+    assert capsys.readouterr().err == (
+        "Scalar element defined multiple times: size\n"
+        "Unknown attribute \"odd\" in /derived[@name='d']\n"
+        "Unknown tag \"what\" in /derived[@name='d']\n")
+    assert obj.get_refl_vars() == ["name", "size", "color", "items"]
+    assert ET.tostring(obj.to_xml()) == (b'<derived name="d" color="red"><size>2.0</size>'
+                                         b'<item>x</item><item>y</item></derived>')

@@ -28,6 +28,12 @@ xmlr.add_type("element_xyz", xmlr.SimpleElementType("xyz", "vector3"))
 verbose = True
 
 
+def _alias(attribute: str, doc: str) -> Any:
+    """A property that is another name of ``attribute`` (an older API's name)."""
+    return property(lambda self: getattr(self, attribute),
+                    lambda self, value: setattr(self, attribute, value), doc=doc)
+
+
 class Pose(xmlr.Object):
     """``<origin xyz="..." rpy="..."/>``; ``position``/``rotation`` are older names."""
 
@@ -41,21 +47,8 @@ class Pose(xmlr.Object):
             if value is not None and len(value) != 3:
                 raise ValueError(f"origin {name} needs 3 numbers, not {list(value)}")
 
-    @property
-    def position(self) -> Optional[List[float]]:
-        return self.xyz
-
-    @position.setter
-    def position(self, value: Optional[List[float]]) -> None:
-        self.xyz = value
-
-    @property
-    def rotation(self) -> Optional[List[float]]:
-        return self.rpy
-
-    @rotation.setter
-    def rotation(self, value: Optional[List[float]]) -> None:
-        self.rpy = value
+    position = _alias("xyz", "``xyz`` under its older name.")
+    rotation = _alias("rpy", "``rpy`` under its older name.")
 
 
 xmlr.reflect(Pose, tag="origin", params=[
@@ -358,13 +351,7 @@ class Joint(xmlr.Object):
         if self.type not in self.TYPES:
             raise ValueError(f"Invalid joint type: {self.type} (one of: {', '.join(self.TYPES[1:])})")
 
-    @property
-    def joint_type(self) -> Optional[str]:
-        return self.type
-
-    @joint_type.setter
-    def joint_type(self, value: Optional[str]) -> None:
-        self.type = value
+    joint_type = _alias("type", "``type``, under the constructor keyword's name.")
 
 
 xmlr.reflect(Joint, tag="joint", params=[
@@ -401,32 +388,21 @@ class Link(xmlr.Object):
         if collision:
             self.collision = collision
 
-    def _set_first(self, xml_var: str, value: Any) -> None:
-        # As in upstream: the first of the list becomes ``value``, and ``value`` is written
-        # after what was written before (so setting it twice writes both).
+    def _replace_first(self, xml_var: str, value: Any) -> None:
+        # The first of the list becomes ``value``, and ``value`` joins the write order, while
+        # whatever it replaced stays there: setting ``link.visual`` twice writes two visuals,
+        # which upstream's own tests expect.
         values = self.get_aggregate_list(xml_var)
-        if values:
-            values[0] = value
-        else:
-            values.append(value)
-        if value:
-            self._order(xml_var, value)
+        values[:1] = [value]
+        if value is not None:
+            self._aggregate_record().append((xml_var, value))
 
-    @property
-    def visual(self) -> Any:
-        return self.visuals[0] if self.visuals else None
-
-    @visual.setter
-    def visual(self, value: Any) -> None:
-        self._set_first("visual", value)
-
-    @property
-    def collision(self) -> Any:
-        return self.collisions[0] if self.collisions else None
-
-    @collision.setter
-    def collision(self, value: Any) -> None:
-        self._set_first("collision", value)
+    visual = property(lambda self: self.visuals[0] if self.visuals else None,
+                      lambda self, value: self._replace_first("visual", value),
+                      doc="The first of ``visuals`` (None if there is none).")
+    collision = property(lambda self: self.collisions[0] if self.collisions else None,
+                         lambda self, value: self._replace_first("collision", value),
+                         doc="The first of ``collisions`` (None if there is none).")
 
 
 xmlr.reflect(Link, tag="link", params=[
@@ -545,13 +521,18 @@ class Robot(xmlr.Object):
         self.child_map: Dict[str, List[Tuple[str, str]]] = {}
 
     def add_aggregate(self, typeName: str, elem: Any) -> None:
+        """Add a link, joint, ... (``typeName`` is its tag), keeping the maps up to date."""
         super().add_aggregate(typeName, elem)
-        if typeName == "joint":
-            self.joint_map[elem.name] = elem
-            self.parent_map[elem.child] = (elem.name, elem.parent)
-            self.child_map.setdefault(elem.parent, []).append((elem.name, elem.child))
-        elif typeName == "link":
+        if typeName == "link":
             self.link_map[elem.name] = elem
+        if typeName != "joint":
+            return
+        name, parent, child = elem.name, elem.parent, elem.child
+        self.joint_map[name] = elem
+        self.parent_map[child] = (name, parent)
+        if parent not in self.child_map:
+            self.child_map[parent] = []
+        self.child_map[parent].append((name, child))
 
     def add_link(self, link: Link) -> None:
         self.add_aggregate("link", link)
@@ -563,29 +544,33 @@ class Robot(xmlr.Object):
                   fixed: bool = True) -> List[str]:
         """The names from ``root`` down to ``tip``: links and joints alternating (as chosen;
         ``fixed=False`` leaves fixed joints out)."""
-        chain = [tip] if links else []
+        steps: List[Tuple[str, str]] = []  # (joint, its child link), from tip upwards
         link = tip
         while link != root:
-            if link not in self.parent_map:
-                raise KeyError(f"no chain from link '{root}' to '{tip}': '{link}' has no parent "
-                               f"joint" + ("" if tip in self.link_map else f" ('{tip}' is not a link)"))
-            joint, parent = self.parent_map[link]
+            above = self.parent_map.get(link)
+            if above is None:
+                why = "" if tip in self.link_map else f" ('{tip}' is not a link)"
+                raise KeyError(f"no chain from link '{root}' to '{tip}': '{link}' has no "
+                               f"parent joint{why}")
+            steps.append((above[0], link))
+            link = above[1]
+        names = [root] if links else []
+        for joint, child in reversed(steps):
             if joints and (fixed or self.joint_map[joint].type != "fixed"):
-                chain.append(joint)
+                names.append(joint)
             if links:
-                chain.append(parent)
-            link = parent
-        chain.reverse()
-        return chain
+                names.append(child)
+        return names
 
     def get_root(self) -> str:
         """The one link that is no joint's child."""
-        roots = [link for link in self.link_map if link not in self.parent_map]
-        if len(roots) > 1:
-            raise AssertionError(f"Multiple roots detected, invalid URDF: {', '.join(roots)}")
+        roots = set(self.link_map) - set(self.parent_map)
         if not roots:
             raise AssertionError("No roots detected, invalid URDF.")
-        return roots[0]
+        if len(roots) > 1:
+            names = ", ".join(name for name in self.link_map if name in roots)
+            raise AssertionError(f"Multiple roots detected, invalid URDF: {names}")
+        return roots.pop()
 
     def post_read_xml(self) -> None:
         if self.version is None:

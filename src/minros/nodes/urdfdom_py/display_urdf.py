@@ -25,7 +25,7 @@ def main(argv: Optional[List[str]] = None) -> int:
                              "parameter)")
     parser.add_argument("-o", "--output", metavar="FILE", help="write the model as URDF XML")
     # roslaunch passes __name:= and __log:= to nodes
-    args = parser.parse_args([a for a in args_in if not a.startswith("__")])
+    args = parser.parse_args([a for a in args_in if not (a.startswith("__") and ":=" in a)])
     where = args.file or "parameter robot_description"
     try:
         if args.file is None:

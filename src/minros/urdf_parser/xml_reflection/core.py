@@ -12,6 +12,12 @@ Errors: a value that cannot be read, a required attribute or element that is mis
 (``/robot[@name='r2']/link[@name='base']/inertial/origin[@xyz]``). Unknown attributes and
 tags, and a scalar element given twice, go to ``on_error`` (stderr; tests and tools replace
 it, e.g. with one that raises), and reading goes on.
+
+How it works: ``reflect`` computes once per class a table of its fields (a ``parent_cls``'s
+first). Reading an element sets its declared attributes (``name`` first, so that errors
+after it name the element), walks its children once in document order dispatching by tag
+through the table, then gives what was not there its default (or fails if it was required),
+and last reports what the table does not know. Writing walks the same table.
 """
 
 from __future__ import annotations
@@ -19,15 +25,14 @@ from __future__ import annotations
 import copy
 import sys
 import xml.etree.ElementTree as ET
-from typing import Any, Callable, Dict, List, Optional, Sequence
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 from xml.dom import minidom
 
 __all__ = [
     "AggregateElement", "Attribute", "BasicType", "DuckTypedFactory", "Element", "FactoryType",
-    "ListType", "Object", "ObjectType", "Param", "ParseError", "Path", "RawType", "Reflection",
-    "SimpleElementType", "ValueType", "VectorType", "add_type", "end_namespace", "get_type",
-    "node_add", "on_error", "on_error_stderr", "reflect", "start_namespace", "to_yaml",
-    "xml_children", "xml_string",
+    "ListType", "Object", "ObjectType", "ParseError", "Path", "RawType", "SimpleElementType",
+    "ValueType", "VectorType", "add_type", "end_namespace", "get_type", "node_add", "on_error",
+    "on_error_stderr", "reflect", "start_namespace", "to_yaml", "xml_children", "xml_string",
 ]
 
 
@@ -119,16 +124,18 @@ class ParseError(Exception):
         super().__init__(f"ParseError in {path}:\n{e}")
 
 
-# -- value types -----------------------------------------------------------------------------
+# -- value types: how one value looks in XML --------------------------------------------------
 
 class ValueType:
-    """How one value is read from and written to XML (by default: an element's text)."""
+    """How one value is read from and written to XML. A subclass either converts text
+    (``from_string``/``to_string``: the element's text, or an attribute's value) or reads and
+    fills a whole element (``from_xml``/``write_xml``)."""
 
     def from_string(self, text: str) -> Any:
-        raise NotImplementedError
+        raise NotImplementedError(f"{type(self).__name__} is not read from text")
 
     def to_string(self, value: Any) -> str:
-        raise NotImplementedError
+        raise NotImplementedError(f"{type(self).__name__} is not written as text")
 
     def from_xml(self, node: ET.Element, path: Path) -> Any:
         return self.from_string(node.text or "")
@@ -136,30 +143,27 @@ class ValueType:
     def write_xml(self, node: ET.Element, value: Any) -> None:
         node.text = self.to_string(value)
 
-    def equals(self, a: Any, b: Any) -> bool:
-        return bool(a == b)
-
 
 class BasicType(ValueType):
-    """``str`` or ``float``: the value is the text, written back with ``str``."""
+    """``str`` or ``float``."""
 
     def __init__(self, cur_type: type) -> None:
         self.type = cur_type
 
     def from_string(self, text: str) -> Any:
-        if self.type is float:
-            try:
-                return float(text)
-            except (TypeError, ValueError):
+        try:
+            return self.type(text)
+        except (TypeError, ValueError):
+            if self.type is float:
                 raise ValueError(f"'{text}' is not a number") from None
-        return self.type(text)
+            raise
 
     def to_string(self, value: Any) -> str:
         return str(value)
 
 
 class ListType(ValueType):
-    """Whitespace-separated words."""
+    """Words separated by whitespace."""
 
     def from_string(self, text: str) -> Any:
         return text.split()
@@ -167,379 +171,362 @@ class ListType(ValueType):
     def to_string(self, values: Any) -> str:
         return " ".join(values)
 
-    def equals(self, a: Any, b: Any) -> bool:
-        return len(a) == len(b) and all(x == y for x, y in zip(a, b))
-
 
 class VectorType(ListType):
-    """Whitespace-separated numbers, ``count`` of them if given (``'vector3'``)."""
+    """Numbers separated by whitespace; exactly ``count`` of them when ``count`` is given."""
 
     def __init__(self, count: Optional[int] = None) -> None:
         self.count = count
 
     def check(self, values: Sequence[Any]) -> None:
-        if self.count is not None and len(values) != self.count:
-            raise ValueError(f"expected {self.count} numbers, got {len(values)}: "
-                             f"'{' '.join(map(str, values))}'")
+        if self.count is None or len(values) == self.count:
+            return
+        shown = " ".join(str(v) for v in values)
+        raise ValueError(f"expected {self.count} numbers, got {len(values)}: '{shown}'")
 
     def from_string(self, text: str) -> Any:
         words = text.split()
         self.check(words)
-        try:
-            return [float(word) for word in words]
-        except ValueError:
-            raise ValueError(f"'{text}' is not {self.count or 'a list of'} numbers") from None
+        numbers = []
+        for word in words:
+            try:
+                numbers.append(float(word))
+            except ValueError:
+                raise ValueError(f"'{text}' is not {self.count or 'a list of'} numbers") from None
+        return numbers
 
     def to_string(self, values: Any) -> str:
         self.check(values)
-        return " ".join(str(value) for value in values)
+        return " ".join(map(str, values))
 
 
 class RawType(ValueType):
-    """The element itself (``<gazebo>`` blocks): kept as read, written back whole."""
+    """The element as it is (``<gazebo>`` blocks), copied back whole on writing."""
 
     def from_xml(self, node: ET.Element, path: Path) -> Any:
         return node
 
     def write_xml(self, node: ET.Element, value: Any) -> None:
-        for key, text in value.attrib.items():
-            node.set(key, text)
+        node.attrib.update(value.attrib)
         node.text = value.text
-        for child in value:
-            node.append(child)
+        node.extend(list(value))
 
 
 class SimpleElementType(ValueType):
-    """A value held by one attribute of an element of its own: ``<parent link="base"/>``."""
+    """A value kept in one attribute of an element of its own: ``<parent link="base"/>``."""
 
     def __init__(self, attribute: str, value_type: Any) -> None:
         self.attribute = attribute
         self.value_type = get_type(value_type)
 
     def from_xml(self, node: ET.Element, path: Path) -> Any:
-        text = node.get(self.attribute)
-        if text is None:
+        if self.attribute not in node.attrib:
             raise ParseError(ValueError(f"<{node.tag}> has no '{self.attribute}' attribute"), path)
         try:
-            return self.value_type.from_string(text)
+            return self.value_type.from_string(node.attrib[self.attribute])
         except Exception as exc:
-            raise ParseError(exc, Path(path.tag, path.parent, f"{path.suffix}[@{self.attribute}]")) from None
+            raise ParseError(exc, _attribute_path(path, self.attribute)) from None
 
     def write_xml(self, node: ET.Element, value: Any) -> None:
         node.set(self.attribute, self.value_type.to_string(value))
 
 
 class ObjectType(ValueType):
-    """A nested element read into a new instance of a reflected class."""
+    """An element read into a new instance of a reflected class."""
 
     def __init__(self, cur_type: type) -> None:
         self.type = cur_type
 
     def from_xml(self, node: ET.Element, path: Path) -> Any:
-        obj = self.type()
-        obj.read_xml(node, path)
-        return obj
+        instance = self.type()
+        instance.read_xml(node, path)
+        return instance
 
     def write_xml(self, node: ET.Element, obj: Any) -> None:
         obj.write_xml(node)
 
 
 class FactoryType(ValueType):
-    """One of several classes, chosen by the element's tag (``typeMap``: tag -> class)."""
+    """One of several classes, picked by the element's tag (``typeMap``: tag -> class)."""
 
     def __init__(self, name: str, typeMap: Dict[str, Any]) -> None:
         self.name = name
         self.typeMap = typeMap
-        self.nameMap = {cls: tag for tag, cls in typeMap.items()}
 
     def from_xml(self, node: ET.Element, path: Path) -> Any:
-        cur_type = self.typeMap.get(node.tag)
-        if cur_type is None:
+        if node.tag not in self.typeMap:
+            choices = ", ".join(sorted(self.typeMap))
             raise ParseError(ValueError(f"Invalid {self.name} tag: <{node.tag}> (one of: "
-                                        f"{', '.join(sorted(self.typeMap))})"), path)
-        return get_type(cur_type).from_xml(node, path)
+                                        f"{choices})"), path)
+        return get_type(self.typeMap[node.tag]).from_xml(node, path)
 
     def get_name(self, obj: Any) -> str:
-        name = self.nameMap.get(type(obj))
-        if name is None:
-            raise TypeError(f"Invalid {self.name} type: {type(obj)}")
-        return name
+        for tag, cls in self.typeMap.items():
+            if type(obj) is cls:
+                return tag
+        raise TypeError(f"Invalid {self.name} type: {type(obj)}")
 
     def write_xml(self, node: ET.Element, obj: Any) -> None:
         obj.write_xml(node)
 
 
 class DuckTypedFactory(ValueType):
-    """The first of ``typeOrder`` that reads the element without an error."""
+    """Whichever of ``typeOrder`` reads the element first without an error."""
 
     def __init__(self, name: str, typeOrder: Sequence[Any]) -> None:
-        if not typeOrder:
+        if len(typeOrder) == 0:
             raise ValueError("DuckTypedFactory needs at least one type")
         self.name = name
         self.type_order = list(typeOrder)
 
     def from_xml(self, node: ET.Element, path: Path) -> Any:
-        errors = []
-        for value_type in self.type_order:
+        failures = ""
+        for candidate in self.type_order:
             try:
-                return value_type.from_xml(node, path)
-            except Exception as exc:  # the next type may fit
-                errors.append(f"\nValue Type: {value_type}\nException: {exc}\n")
-        raise ParseError(Exception("Could not perform duck-typed parsing." + "".join(errors)), path)
+                return candidate.from_xml(node, path)
+            except Exception as exc:  # try the next one
+                failures += f"\nValue Type: {candidate}\nException: {exc}\n"
+        raise ParseError(Exception("Could not perform duck-typed parsing." + failures), path)
 
     def write_xml(self, node: ET.Element, obj: Any) -> None:
         obj.write_xml(node)
 
 
-# -- the registry of named value types -------------------------------------------------------
+# -- named value types -------------------------------------------------------------------------
 
+#: Registered value types: a name (``'urdf.geometric'``, ``'vector3'``), or a class/type.
 value_types: Dict[Any, ValueType] = {}
-value_type_prefix = ""
+_namespace: List[str] = []  # the current namespace, if any (one at a time)
 
 
 def start_namespace(namespace: str) -> None:
-    """Type names added from here on are ``namespace.name`` (urdf and sdf keep theirs apart)."""
-    global value_type_prefix
-    value_type_prefix = namespace + "."
+    """Names registered from here on are ``namespace.name`` and found first in lookups
+    (urdf and sdf each keep their own ``'pose'``)."""
+    _namespace[:] = [namespace]
 
 
 def end_namespace() -> None:
-    global value_type_prefix
-    value_type_prefix = ""
+    _namespace.clear()
+
+
+def _qualified(name: str) -> str:
+    return f"{_namespace[0]}.{name}" if _namespace else name
 
 
 def add_type(key: Any, value: ValueType) -> None:
+    """Register ``value`` under ``key`` (a name, in the current namespace, or a type)."""
     if isinstance(key, str):
-        key = value_type_prefix + key
+        key = _qualified(key)
     if key in value_types:
         raise ValueError(f"value type {key!r} is registered already")
     value_types[key] = value
 
 
 def get_type(cur_type: Any) -> ValueType:
-    """The ValueType for ``cur_type``: a registered name, ``'vectorN'``, ``str``, ``float``,
-    ``list``, a reflected class, or a ValueType (made and registered on first use)."""
-    if isinstance(cur_type, ValueType):
-        return cur_type
-    found = None
-    if value_type_prefix and isinstance(cur_type, str):
-        found = value_types.get(value_type_prefix + cur_type)
-    if found is None:
-        found = value_types.get(cur_type)
-    if found is None:
-        found = make_type(cur_type)
-        add_type(cur_type, found)
-    return found
-
-
-def make_type(cur_type: Any) -> ValueType:
+    """The ValueType for ``cur_type``: a ValueType itself, a registered name (the current
+    namespace's first), ``'vectorN'``/``'vector'``, ``str``, ``float``, ``list`` or a reflected
+    class; the ones made here are registered for next time."""
     if isinstance(cur_type, ValueType):
         return cur_type
     if isinstance(cur_type, str):
-        if cur_type.startswith("vector"):
-            count = cur_type[len("vector"):]
-            return VectorType(int(count) if count else None)
-        raise ValueError(f"Invalid value type: {cur_type}")
-    if cur_type is list:
-        return ListType()
+        for key in (_qualified(cur_type), cur_type):
+            if key in value_types:
+                return value_types[key]
+    elif cur_type in value_types:
+        return value_types[cur_type]
+    made = _new_type(cur_type)
+    add_type(cur_type, made)
+    return made
+
+
+def _new_type(cur_type: Any) -> ValueType:
+    if isinstance(cur_type, str):
+        if not cur_type.startswith("vector"):
+            raise ValueError(f"Invalid value type: {cur_type}")
+        digits = cur_type[len("vector"):]
+        return VectorType(int(digits) if digits else None)
     if cur_type in (str, float):
         return BasicType(cur_type)
+    if cur_type is list:
+        return ListType()
     if isinstance(cur_type, type) and issubclass(cur_type, Object):
         return ObjectType(cur_type)
     raise ValueError(f"Invalid type: {cur_type}")
 
 
-# -- parameters: what a class has in XML -----------------------------------------------------
+# -- fields: the attributes and elements a class declares --------------------------------------
 
-class Param:
-    """One attribute or element: ``xml_var`` in XML, ``var`` (the same by default) in Python."""
+class Attribute:
+    """An XML attribute ``xml_var``, held in the Python attribute ``var`` (the same name unless
+    given). A required one must be in the XML; an optional one missing gets ``default``."""
 
-    type = "param"
-    is_aggregate = False
+    kind = "attribute"
+    repeats = False
 
     def __init__(self, xml_var: str, value_type: Any, required: bool = True,
                  default: Any = None, var: Optional[str] = None) -> None:
         if required and default is not None:
-            raise ValueError(f"{xml_var}: a default does not make sense for a required field")
+            raise ValueError(f"{xml_var}: a required {self.kind} has no default")
         self.xml_var = xml_var
-        self.var = xml_var if var is None else var
+        self.var = var or xml_var
         self.value_type = get_type(value_type)
         self.required = required
         self.default = default
 
-    def set_default(self, obj: Any) -> None:
+    def fill_default(self, obj: Any) -> None:
+        """What to do when the XML lacks this field."""
         if self.required:
-            raise ValueError(f"Required {self.type} not set in XML: {self.xml_var}")
+            raise ValueError(f"Required {self.kind} not set in XML: {self.xml_var}")
         if not skip_default:
             setattr(obj, self.var, copy.copy(self.default))
 
-
-class Attribute(Param):
-    type = "attribute"
-
-    def set_from_string(self, obj: Any, value: str) -> None:
-        setattr(obj, self.var, self.value_type.from_string(value))
-
-    def get_value(self, obj: Any) -> Any:
-        return getattr(obj, self.var)
-
-    def add_to_xml(self, obj: Any, node: ET.Element) -> None:
+    def value_to_write(self, obj: Any) -> Any:
+        """The value to write (None: nothing to write)."""
         value = getattr(obj, self.var, None)
-        if value is None:
-            if self.required:
-                raise ValueError(f"Required attribute not set in object: {self.var}")
-            if not skip_default:
-                value = self.default
         if value is not None:
-            node.set(self.xml_var, self.value_type.to_string(value))
+            return value
+        if self.required:
+            noun = "attribute not set" if self.kind == "attribute" else "element not defined"
+            raise ValueError(f"Required {noun} in object: {self.var}")
+        return None if skip_default else self.default
 
 
-class Element(Param):
-    type = "element"
+class Element(Attribute):
+    """A child element ``<xml_var>`` that appears at most once. ``is_raw``: the value is
+    written into the parent element itself rather than a child of its own."""
+
+    kind = "element"
 
     def __init__(self, xml_var: str, value_type: Any, required: bool = True,
                  default: Any = None, var: Optional[str] = None, is_raw: bool = False) -> None:
         super().__init__(xml_var, value_type, required, default, var)
         self.is_raw = is_raw
 
-    def set_from_xml(self, obj: Any, node: ET.Element, path: Path) -> None:
-        setattr(obj, self.var, read_value(self.value_type, node, path))
-
-    def add_to_xml(self, obj: Any, parent: ET.Element) -> None:
-        value = getattr(obj, self.var, None)
-        if value is None:
-            if self.required:
-                raise ValueError(f"Required element not defined in object: {self.var}")
-            if not skip_default:
-                value = self.default
-        if value is not None:
-            self.add_scalar_to_xml(parent, value)
-
-    def add_scalar_to_xml(self, parent: ET.Element, value: Any) -> None:
-        node = parent if self.is_raw else ET.SubElement(parent, self.xml_var)
-        self.value_type.write_xml(node, value)
+    def emit(self, parent: ET.Element, value: Any) -> None:
+        """Write ``value`` as this element under ``parent``."""
+        target = parent if self.is_raw else ET.SubElement(parent, self.xml_var)
+        self.value_type.write_xml(target, value)
 
 
 class AggregateElement(Element):
-    """An element that may repeat: collected in the list ``var`` (``xml_var + 's'``)."""
+    """A child element that may repeat; its values go, in document order, to the list ``var``
+    (``xml_var + 's'`` unless given) through ``Object.add_aggregate``."""
 
-    is_aggregate = True
+    repeats = True
 
     def __init__(self, xml_var: str, value_type: Any, var: Optional[str] = None,
                  is_raw: bool = False) -> None:
-        super().__init__(xml_var, value_type, required=False,
-                         var=xml_var + "s" if var is None else var, is_raw=is_raw)
+        super().__init__(xml_var, value_type, required=False, var=var or xml_var + "s",
+                         is_raw=is_raw)
 
-    def add_from_xml(self, obj: Any, node: ET.Element, path: Path) -> None:
-        obj.add_aggregate(self.xml_var, read_value(self.value_type, node, path))
-
-    def set_default(self, obj: Any) -> None:
-        pass
+    def fill_default(self, obj: Any) -> None:
+        pass  # the list stays as the constructor made it
 
 
-def read_value(value_type: ValueType, node: ET.Element, path: Path) -> Any:
-    """``value_type`` read from ``node``; an error that is not a ParseError yet gets the path."""
-    try:
-        return value_type.from_xml(node, path)
-    except ParseError:
-        raise
-    except Exception as exc:
-        raise ParseError(exc, path) from None
+class _Schema:
+    """What ``reflect`` computes once per class: its fields, its base class's first, split
+    into lookups by XML name. Reading and writing walk these tables only."""
 
-
-class Reflection:
-    """The attributes and elements of one class (``parent_cls``'s first, if given)."""
-
-    def __init__(self, params: Sequence[Param] = (), parent_cls: Any = None,
-                 tag: Optional[str] = None) -> None:
-        self.parent = parent_cls.XML_REFL if parent_cls is not None else None
+    def __init__(self, tag: Optional[str], fields: Sequence[Attribute]) -> None:
         self.tag = tag
-        self.attributes: List[Any] = [p for p in params if not isinstance(p, Element)]
-        self.elements: List[Any] = [p for p in params if isinstance(p, Element)]
-        self.scalars = [e for e in self.elements if not e.is_aggregate]
-        self.aggregates = [e for e in self.elements if e.is_aggregate]
-        self.attribute_map = {a.xml_var: a for a in self.attributes}
-        self.element_map = {e.xml_var: e for e in self.elements}
-        self.paramMap: Dict[str, Param] = {**self.attribute_map, **self.element_map}
-        self.vars = [p.var for p in self.attributes] + [e.var for e in self.elements]
-        self.scalarNames = [e.xml_var for e in self.scalars]
+        self.fields = list(fields)
+        self.attributes = {f.xml_var: f for f in self.fields if not isinstance(f, Element)}
+        self.children = {f.xml_var: f for f in self.fields if isinstance(f, Element)}
+        self.scalars = [f for f in self.children.values() if not f.repeats]
+        self.aggregates = [f for f in self.children.values() if f.repeats]
 
-    def set_from_xml(self, obj: Any, node: ET.Element, path: Path,
-                     info: Optional[Dict[str, list]] = None) -> Path:
-        """Read ``node`` into ``obj``; returns the path, named once the name is read."""
-        outermost = info is None
-        if info is None:  # what is left unread, for the unknown-attribute/tag report
-            info = {"attributes": list(node.attrib), "children": list(node)}
-        if self.parent is not None:
-            path = self.parent.set_from_xml(obj, node, path, info)
-
-        for key in list(info["attributes"]):
-            attribute = self.attribute_map.get(key)
-            if attribute is None:
+    def read(self, obj: Any, node: ET.Element, path: Path) -> None:
+        """Fill ``obj`` from ``node``; names ``path`` after the ``name`` attribute."""
+        # `name` first: errors in the other attributes and in children then name the element
+        keys = sorted(node.attrib, key=lambda key: key != "name")
+        unknown_attributes = []
+        for key in keys:
+            field = self.attributes.get(key)
+            if field is None:
+                unknown_attributes.append(key)
                 continue
             try:
-                attribute.set_from_string(obj, node.attrib[key])
+                value = field.value_type.from_string(node.attrib[key])
             except Exception as exc:
-                raise ParseError(exc, Path(path.tag, path.parent, f"{path.suffix}[@{key}]")) from None
-            if key == "name":  # the path names the element from here on (children see it too)
-                path.suffix = f"[@name='{attribute.get_value(obj)}']"
-            info["attributes"].remove(key)
+                raise ParseError(exc, _attribute_path(path, key)) from None
+            setattr(obj, field.var, value)
+            if key == "name":
+                path.suffix = f"[@name='{value}']"
 
-        unset = set(self.scalarNames)
-        for child in list(info["children"]):
-            element = self.element_map.get(child.tag)
-            if element is None:
-                continue
-            if element.is_aggregate:
-                index = len(obj.get_aggregate_list(element.xml_var)) + 1  # XPath counts from 1
-                element.add_from_xml(obj, child, Path(child.tag, path, f"[{index}]"))
-            elif child.tag in unset:
-                element.set_from_xml(obj, child, Path(child.tag, path))
-                unset.discard(child.tag)
-            else:
+        seen = set()
+        counts: Dict[str, int] = {}
+        unknown_tags = []
+        for child in node:
+            field = self.children.get(child.tag)
+            if field is None:
+                unknown_tags.append(child.tag)
+            elif field.repeats:
+                counts[child.tag] = counts.get(child.tag, 0) + 1  # XPath counts from 1
+                where = Path(child.tag, path, f"[{counts[child.tag]}]")
+                obj.add_aggregate(child.tag, _read_value(field.value_type, child, where))
+            elif child.tag in seen:
                 on_error(f"Scalar element defined multiple times: {child.tag}")
-            info["children"].remove(child)
+            else:
+                seen.add(child.tag)
+                setattr(obj, field.var, _read_value(field.value_type, child, Path(child.tag, path)))
 
-        missing: List[Param] = [a for a in self.attributes if a.xml_var not in node.attrib]
-        missing += [e for e in self.scalars if e.xml_var in unset]
-        for param in missing:
+        absent = [f for f in self.attributes.values() if f.xml_var not in node.attrib]
+        absent += [f for f in self.scalars if f.xml_var not in seen]
+        for field in absent:
             try:
-                param.set_default(obj)
+                field.fill_default(obj)
             except Exception as exc:
                 raise ParseError(exc, path) from None
 
-        if outermost:
-            for key in info["attributes"]:
-                on_error(f'Unknown attribute "{key}" in {path}')
-            for child in info["children"]:
-                on_error(f'Unknown tag "{child.tag}" in {path}')
-        return path
+        for key in unknown_attributes:
+            on_error(f'Unknown attribute "{key}" in {path}')
+        for tag in unknown_tags:
+            on_error(f'Unknown tag "{tag}" in {path}')
 
-    def add_to_xml(self, obj: Any, node: ET.Element) -> None:
-        if self.parent is not None:
-            self.parent.add_to_xml(obj, node)
-        for attribute in self.attributes:
-            attribute.add_to_xml(obj, node)
-        for element in self.scalars:
-            element.add_to_xml(obj, node)
+    def write(self, obj: Any, node: ET.Element) -> None:
+        for field in self.attributes.values():
+            value = field.value_to_write(obj)
+            if value is not None:
+                node.set(field.xml_var, field.value_type.to_string(value))
+        for field in self.scalars:
+            value = field.value_to_write(obj)
+            if value is not None:
+                field.emit(node, value)
         if self.aggregates:
             obj.add_aggregates_to_xml(node)
 
 
-def reflect(cls: type, *args: Any, **kwargs: Any) -> None:
-    """Give ``cls`` its XML form: ``reflect(Cls, tag='x', params=[...])``."""
-    cls.XML_REFL = Reflection(*args, **kwargs)  # type: ignore[attr-defined]
+def _attribute_path(path: Path, key: str) -> Path:
+    """``path`` narrowed to one of its element's attributes: ``.../origin[@xyz]``."""
+    return Path(path.tag, path.parent, f"{path.suffix}[@{key}]")
+
+
+def _read_value(value_type: ValueType, node: ET.Element, path: Path) -> Any:
+    try:
+        return value_type.from_xml(node, path)
+    except ParseError:
+        raise
+    except Exception as exc:  # give it the path
+        raise ParseError(exc, path) from None
+
+
+def reflect(cls: type, tag: Optional[str] = None, params: Sequence[Attribute] = (),
+            parent_cls: Optional[type] = None) -> None:
+    """Declare ``cls``'s XML form: ``reflect(Cls, tag='x', params=[Attribute(...),
+    Element(...), AggregateElement(...)], parent_cls=Base)`` (``Base``'s fields come first)."""
+    inherited = parent_cls.XML_REFL.fields if parent_cls is not None else []  # type: ignore[attr-defined]
+    cls.XML_REFL = _Schema(tag, [*inherited, *params])  # type: ignore[attr-defined]
 
 
 class Object:
-    """A value read from and written to XML as its class's ``XML_REFL`` says.
+    """A value read from and written to XML as its class's ``reflect`` declared.
 
-    Repeated elements (aggregates) are kept in their lists (``links``, ``joints``, ...) and, for
-    writing them back in the order read, in ``aggregate_order``: add them with
-    ``add_aggregate(xml_var, obj)``.
+    Repeated elements (aggregates) live in their lists (``links``, ``joints``, ...); the order
+    they were read or added in (``add_aggregate``) is kept too, so that they are written back
+    in it. A class with aggregates calls ``aggregate_init()`` in its ``__init__``.
     """
 
-    XML_REFL: Reflection = Reflection()
+    XML_REFL = _Schema(None, [])
 
     # -- reading ---------------------------------------------------------------------------
     @classmethod
@@ -548,9 +535,9 @@ class Object:
 
     @classmethod
     def from_xml_string(cls, xml_string: Any) -> Any:
-        """Read a document whose root element is this class's (``str`` or ``bytes``)."""
-        node = ET.fromstring(xml_string)
-        return cls.from_xml(node, Path(cls.XML_REFL.tag, tree=ET.ElementTree(node)))
+        """Read a document (``str`` or ``bytes``) whose root element is this class's."""
+        root = ET.fromstring(xml_string)
+        return cls.from_xml(root, Path(cls.XML_REFL.tag, tree=ET.ElementTree(root)))
 
     @classmethod
     def from_xml_file(cls, file_path: str) -> Any:
@@ -558,13 +545,13 @@ class Object:
             return cls.from_xml_string(f.read())
 
     def parse(self, xml_string: Any) -> Any:
-        """Read a document into this object (older API than ``from_xml_string``)."""
-        node = ET.fromstring(xml_string)
-        self.read_xml(node, Path(self.XML_REFL.tag, tree=ET.ElementTree(node)))
+        """Read a document into this object (the API before ``from_xml_string``)."""
+        root = ET.fromstring(xml_string)
+        self.read_xml(root, Path(self.XML_REFL.tag, tree=ET.ElementTree(root)))
         return self
 
     def read_xml(self, node: ET.Element, path: Path) -> None:
-        self.XML_REFL.set_from_xml(self, node, path)
+        self.XML_REFL.read(self, node, path)
         self.post_read_xml()
         try:
             self.check_valid()
@@ -577,23 +564,22 @@ class Object:
         """Hook: after the element is read, before ``check_valid``."""
 
     def check_valid(self) -> None:
-        """Hook: raise if the object is not valid (on reading and before writing)."""
+        """Hook: raise if the object is not valid (after reading, before writing)."""
 
     # -- writing ---------------------------------------------------------------------------
     def pre_write_xml(self) -> None:
         """Hook: before writing."""
 
     def write_xml(self, node: ET.Element) -> None:
-        """Add this object's attributes and children to ``node``."""
+        """Put this object's attributes and children into ``node``."""
         self.check_valid()
         self.pre_write_xml()
-        self.XML_REFL.add_to_xml(self, node)
+        self.XML_REFL.write(self, node)
 
     def to_xml(self) -> ET.Element:
-        tag = self.XML_REFL.tag
-        if tag is None:
+        if self.XML_REFL.tag is None:
             raise TypeError(f"{type(self).__name__} has no tag of its own to write")
-        root = ET.Element(tag)
+        root = ET.Element(self.XML_REFL.tag)
         self.write_xml(root)
         return root
 
@@ -602,51 +588,59 @@ class Object:
 
     # -- repeated elements -----------------------------------------------------------------
     def aggregate_init(self) -> None:
-        """Call in ``__init__`` of a class with aggregates."""
-        self.aggregate_order: List[Any] = []
-        self.aggregate_type: Dict[Any, str] = {}
+        """Start the record of aggregates: (xml_var, value) pairs in the order added."""
+        self._aggregates: List[Tuple[str, Any]] = []
+
+    def _aggregate_record(self) -> List[Tuple[str, Any]]:
+        if "_aggregates" not in self.__dict__:
+            self.aggregate_init()
+        return self._aggregates
 
     def get_aggregate_list(self, xml_var: str) -> List[Any]:
-        values = getattr(self, self.XML_REFL.paramMap[xml_var].var)
+        field = self.XML_REFL.children.get(xml_var)
+        if field is None or not field.repeats:
+            raise KeyError(f"{type(self).__name__} has no repeated element <{xml_var}>")
+        values = getattr(self, field.var)
         if not isinstance(values, list):
-            raise TypeError(f"{type(self).__name__}.{xml_var}: not a list")
+            raise TypeError(f"{type(self).__name__}.{field.var}: not a list")
         return values
 
     def add_aggregate(self, xml_var: str, obj: Any) -> None:
         self.get_aggregate_list(xml_var).append(obj)
-        self._order(xml_var, obj)
-
-    def _order(self, xml_var: str, obj: Any) -> None:
-        self.aggregate_order.append(obj)
-        self.aggregate_type[_key(obj)] = xml_var
+        self._aggregate_record().append((xml_var, obj))
 
     def remove_aggregate(self, obj: Any) -> None:
-        self.aggregate_order.remove(obj)
-        xml_var = self.aggregate_type.pop(_key(obj))
-        self.get_aggregate_list(xml_var).remove(obj)
+        record = self._aggregate_record()
+        for i, (xml_var, value) in enumerate(record):
+            if value is obj:
+                del record[i]
+                values = self.get_aggregate_list(xml_var)
+                del values[next(j for j, v in enumerate(values) if v is obj)]
+                return
+        raise ValueError(f"{obj!r} is not one of {type(self).__name__}'s aggregates")
 
     def lump_aggregates(self) -> None:
         """Order the aggregates by kind (all links, then all joints, ...)."""
-        self.aggregate_init()
-        for element in self.XML_REFL.aggregates:
-            for obj in self.get_aggregate_list(element.xml_var):
-                self._order(element.xml_var, obj)
+        self._aggregates = [(field.xml_var, value) for field in self.XML_REFL.aggregates
+                            for value in self.get_aggregate_list(field.xml_var)]
 
     def add_aggregates_to_xml(self, node: ET.Element) -> None:
-        written = set()
-        for obj in self.aggregate_order:
-            self.XML_REFL.element_map[self.aggregate_type[_key(obj)]].add_scalar_to_xml(node, obj)
-            written.add(id(obj))
-        # what code appended to the lists directly (robot.links.append(...)) is written too
-        for element in self.XML_REFL.aggregates:
-            for obj in self.get_aggregate_list(element.xml_var):
-                if id(obj) not in written:
-                    element.add_scalar_to_xml(node, obj)
-                    written.add(id(obj))
+        """Write the aggregates in the order added; then those put into the lists directly
+        (``robot.links.append(...)``), kind by kind."""
+        children = self.XML_REFL.children
+        done = set()
+        for xml_var, value in self._aggregate_record():
+            children[xml_var].emit(node, value)
+            done.add(id(value))
+        for field in self.XML_REFL.aggregates:
+            for value in self.get_aggregate_list(field.xml_var):
+                if id(value) not in done:
+                    field.emit(node, value)
+                    done.add(id(value))
 
     # -- printing --------------------------------------------------------------------------
     def get_refl_vars(self) -> List[str]:
-        return list(self.XML_REFL.vars)
+        return [field.var for field in self.XML_REFL.fields]
 
     def to_yaml(self) -> Any:
         return to_yaml({var: getattr(self, var, None) for var in self.get_refl_vars()})
@@ -657,17 +651,8 @@ class Object:
         return str(yaml.dump(self.to_yaml())).rstrip()
 
 
-def _key(obj: Any) -> Any:
-    """The key of ``aggregate_type``: the object, or its id when it cannot be hashed."""
-    try:
-        hash(obj)
-    except TypeError:
-        return id(obj)
-    return obj
-
-
-# Common named types: an element holding a name or a number in one attribute
+# Named types that every description can use: an element holding a name or a number
 add_type("element_name", SimpleElementType("name", str))
 add_type("element_value", SimpleElementType("value", float))
-for _vector in ("vector3", "vector4", "vector6"):  # global, not in a namespace
+for _vector in ("vector3", "vector4", "vector6"):  # registered outside any namespace
     get_type(_vector)
