@@ -113,6 +113,7 @@ _port_lock = threading.Lock()
 _port_next: List[int] = []
 
 
+@functools.cache  # the kernel's range is read once per process
 def _port_range() -> tuple:
     try:
         ephemeral_low = int(Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()[0])
