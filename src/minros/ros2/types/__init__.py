@@ -66,8 +66,19 @@ def type_description(name: str, distro: str = DEFAULT_DISTRO) -> Any:
     return registry(distro).type_description(name)
 
 
+def cdr_serialize(name: str, value: Any, distro: str = DEFAULT_DISTRO) -> bytes:
+    """CDR bytes (header included) of ``value`` (an object with the fields, or a dict)."""
+    return registry(distro).codec(name).serialize(value)  # type: ignore[no-any-return]
+
+
+def cdr_deserialize(name: str, data: Any, distro: str = DEFAULT_DISTRO) -> Any:
+    """An object of the generated class of ``name`` from CDR bytes."""
+    return registry(distro).codec(name).deserialize(data)
+
+
 __all__ = [
     "ActionType", "Constant", "DEFAULT_DISTRO", "DISTROS", "Field", "FieldType", "MessageType",
-    "ServiceType", "TypeRegistry", "dds_type_name", "from_dds_type_name", "parse_action",
-    "parse_msg", "parse_srv", "registry", "type_description", "type_hash",
+    "ServiceType", "TypeRegistry", "cdr_deserialize", "cdr_serialize", "dds_type_name",
+    "from_dds_type_name", "parse_action", "parse_msg", "parse_srv", "registry",
+    "type_description", "type_hash",
 ]
