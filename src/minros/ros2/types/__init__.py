@@ -42,6 +42,17 @@ from __future__ import annotations
 
 from typing import Any
 
+from .mapping import (
+    ACTION_STATUS_1_TO_2,
+    ACTION_STATUS_2_TO_1,
+    ActionMapping,
+    Mapper,
+    MessageMapping,
+    NoMappingError,
+    ServiceMapping,
+    mapper,
+    ros2_type_for,
+)
 from .model import (
     ActionType,
     Constant,
@@ -54,6 +65,7 @@ from .model import (
 )
 from .parse import parse_action, parse_msg, parse_srv
 from .registry import DEFAULT_DISTRO, DISTROS, TypeRegistry, registry
+from .transcode import Transcoder
 
 
 def type_hash(name: str, distro: str = DEFAULT_DISTRO) -> str:
@@ -76,9 +88,17 @@ def cdr_deserialize(name: str, data: Any, distro: str = DEFAULT_DISTRO) -> Any:
     return registry(distro).codec(name).deserialize(data)
 
 
+def transcoder(ros1_type: str, distro: str = DEFAULT_DISTRO) -> Transcoder:
+    """The ROS 1 <-> CDR byte converter of an installed ROS 1 type (shared mapper)."""
+    result: Transcoder = mapper(distro).message(ros1_type).transcoder
+    return result
+
+
 __all__ = [
-    "ActionType", "Constant", "DEFAULT_DISTRO", "DISTROS", "Field", "FieldType", "MessageType",
-    "ServiceType", "TypeRegistry", "cdr_deserialize", "cdr_serialize", "dds_type_name",
-    "from_dds_type_name", "parse_action", "parse_msg", "parse_srv", "registry",
-    "type_description", "type_hash",
+    "ACTION_STATUS_1_TO_2", "ACTION_STATUS_2_TO_1", "ActionMapping", "ActionType", "Constant",
+    "DEFAULT_DISTRO", "DISTROS", "Field", "FieldType", "Mapper", "MessageMapping",
+    "MessageType", "NoMappingError", "ServiceMapping", "ServiceType", "Transcoder",
+    "TypeRegistry", "cdr_deserialize", "cdr_serialize", "dds_type_name", "from_dds_type_name",
+    "mapper", "parse_action", "parse_msg", "parse_srv", "registry", "ros2_type_for",
+    "transcoder", "type_description", "type_hash",
 ]

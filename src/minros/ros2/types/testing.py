@@ -273,3 +273,56 @@ def rosidl_hashes(distro: str, packages: Mapping[str, Iterable[Tuple[str, str, s
         raise RuntimeError(f"the rosidl oracle ({distro}) failed: {run.stderr[-3000:]}")
     result: Dict[str, Any] = json.loads(run.stdout)
     return result
+
+
+# -- what a ROS 1 message becomes ----------------------------------------------------------------
+
+_ROS1_CODES = {"int8": "b", "byte": "b", "uint8": "B", "char": "B", "int16": "h",
+               "uint16": "H", "int32": "i", "uint32": "I", "int64": "q", "uint64": "Q"}
+
+
+def ros2_plain_of_ros1(mapping: Any, obj: Any) -> Any:
+    """The plain ROS 2 value a ROS 1 message object becomes under ``mapping`` (a
+    :class:`~minros.ros2.types.mapping.MessageMapping`): what the converters must produce."""
+    import struct
+
+    from minros.msgs.codegen import python_name as ros1_attr
+
+    reg = mapping.mapper.ros2
+    struct_ = reg.message(mapping.ros2_type)
+    if struct_.is_empty:
+        return {}
+    defaults = reg.codec(mapping.ros2_type).cls()
+    out: Dict[str, Any] = {}
+
+    def scalar(f1_base: str, t: FieldType, value: Any) -> Any:
+        if t.base == "bool":
+            return bool(value)
+        if t.base in ("float32", "float64"):
+            return float(value)
+        if t.is_string:
+            return value if isinstance(value, str) else bytes(value).decode()
+        code1 = _ROS1_CODES.get(f1_base, "I")
+        code2 = "B" if t.base == "byte" else _ROS1_CODES[t.base]  # ROS 2's byte: an octet
+        return struct.unpack("<" + code2, struct.pack("<" + code1, value))[0]
+
+    for link in mapping.links:
+        f2 = link.ros2
+        if link.ros1_path is None:
+            out[f2.name] = _plain_field(reg, f2.type, getattr(defaults, python_name(f2.name)))
+            continue
+        value = obj
+        for part in link.ros1_path:
+            value = getattr(value, ros1_attr(part))
+        f1 = link.ros1_field
+        t = f2.type
+        if link.nested is not None:
+            out[f2.name] = [ros2_plain_of_ros1(link.nested, e) for e in value] if t.is_array \
+                else ros2_plain_of_ros1(link.nested, value)
+        elif t.is_array:
+            if isinstance(value, (bytes, bytearray)):
+                value = list(value)
+            out[f2.name] = [scalar(f1.base_type, t.element(), v) for v in value]
+        else:
+            out[f2.name] = scalar(f1.base_type, t, value)
+    return out
