@@ -172,3 +172,23 @@ def test_ros2_msg_text_is_what_rosidl_reads_back():
     again = parse_msg(struct.text, struct.name)
     assert [(f.name, f.type) for f in again.fields] == [(f.name, f.type) for f in struct.fields]
     assert ros2_msg_text(struct.fields, []).startswith("std_msgs/Header header\n")
+
+
+def test_ros2_types_without_ros1_counterpart_get_a_ros1_type():
+    mapper = Mapper("jazzy")
+    m = mapper.message_from_ros2("rcl_interfaces/msg/ParameterEvent")
+    assert m.ros1_type == "rcl_interfaces/ParameterEvent"
+    assert m.ros1.text.startswith("time stamp\nstring node\nrcl_interfaces/Parameter[] ")
+    assert len(mapper.ros1_context.md5sum("rcl_interfaces/ParameterEvent")) == 32
+    assert "MSG: rcl_interfaces/ParameterValue" in \
+        mapper.ros1_context.full_text("rcl_interfaces/ParameterEvent")
+    # a counterpart is used where there is one
+    assert mapper.message_from_ros2("sensor_msgs/msg/Image").ros1_type == "sensor_msgs/Image"
+    # Header becomes ROS 1's, with its seq
+    made = mapper.message_from_ros2("action_msgs/msg/GoalStatusArray")
+    assert made.ros1_type == "action_msgs/GoalStatusArray"
+    reg = mapper.ros2.child()
+    reg.add_definition("msg", "w_msgs/msg/Wide", "wstring text\n")
+    wide = Mapper("jazzy", ros2=reg)
+    with pytest.raises(NoMappingError, match="wstring, which ROS 1 has no type for"):
+        wide.message_from_ros2("w_msgs/msg/Wide")

@@ -651,6 +651,60 @@ class Mapper:
         raise NoMappingError(full, "no ROS 1 type maps to it (no ROS 1 package of that name "
                                    "has the type, and no mapping rule names it)")
 
+    def message_from_ros2(self, ros2_type: str) -> MessageMapping:
+        """The mapping for ROS 2 message type ``ros2_type``, seen from ROS 2: its ROS 1
+        counterpart (:meth:`ros1_type_for`), or, when none exists, a ROS 1 type made from the
+        ROS 2 definition (``pkg/Name``: ``builtin_interfaces`` Time/Duration become
+        ``time``/``duration``, ``std_msgs/Header`` ``Header``, bounds are dropped, nested types
+        become their ROS 1 counterparts; a ``wstring`` cannot map). The made type is added to
+        this mapper's ROS 1 types, md5 sum and message_definition included."""
+        from .model import split_type_name
+
+        try:
+            return self.message(self.ros1_type_for(ros2_type))
+        except NoMappingError:
+            pass
+        package, ns, short = split_type_name(ros2_type)
+        if ns != "msg":
+            raise NoMappingError(ros2_type, "only messages (pkg/msg/Name) get ROS 1 types made")
+        with self._lock:
+            name = f"{package}/{short}"
+            self._own_ros1.add_spec(parse_msg(self._ros1_text(f"{package}/msg/{short}"), name,
+                                              f"made by minros from ROS 2's {ros2_type}"))
+            self._forget()
+            mapping = self.message(name)
+            if mapping.ros2_type != f"{package}/msg/{short}":
+                raise NoMappingError(ros2_type, f"the ROS 1 type made for it maps to "
+                                                f"{mapping.ros2_type}")
+            return mapping
+
+    def _ros1_text(self, ros2_type: str) -> str:
+        struct = self.ros2.message(ros2_type)
+        lines = []
+        for c in struct.constants:
+            value = ("1" if c.value else "0") if c.type == "bool" else str(c.value)
+            lines.append(f"{c.type} {c.name}={value}")
+        for f in struct.fields:
+            if f.name == EMPTY_MEMBER and struct.is_empty:
+                continue
+            t = f.type
+            if t.base == "wstring":
+                raise NoMappingError(ros2_type, f"field {f.name} is a wstring, which ROS 1 "
+                                                f"has no type for")
+            if t.base == TIME:
+                base = "time"
+            elif t.base == DURATION:
+                base = "duration"
+            elif t.is_nested:
+                base = self.message_from_ros2(t.base).ros1_type
+                if base == "std_msgs/Header":
+                    base = "Header"
+            else:
+                base = t.base
+            suffix = "" if not t.is_array else f"[{t.size}]" if t.kind == ARRAY else "[]"
+            lines.append(f"{base}{suffix} {f.name}")
+        return "\n".join(lines) + ("\n" if lines else "")
+
 
 def ros2_msg_text(fields: Sequence[Field], constants: Sequence[Constant]) -> str:
     """A ROS 2 ``.msg`` text for fields and constants (what rosidl would read them as).
