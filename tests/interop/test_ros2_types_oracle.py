@@ -25,6 +25,8 @@ from minros.ros2.types.testing import (
 )
 from support import need
 
+pytestmark = pytest.mark.interop
+
 FIXTURES = Path(__file__).resolve().parent.parent / "unit" / "ros2_fixtures"
 #: a bag's own ROS 1 definitions (the types of tests/unit/test_ros2_types_mapping.py)
 BAG_DEFINITION = (Path(__file__).resolve().parent.parent / "unit" / "ros2_fixtures"
