@@ -6,6 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "$(id -u)" -eq 0 ] || sudo -n true 2>/dev/null; then
   bash scripts/install-ros-reference.sh
+  bash scripts/install-ros2-reference.sh  # the pip ROS 2 (rclpy Jazzy, Kilted) the ROS 2 tests use
 else
   echo "note: not root, Debian's ROS 1 reference not installed; interop tests will skip" >&2
 fi

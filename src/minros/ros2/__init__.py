@@ -1,0 +1,22 @@
+"""minros and ROS 2: the types both worlds share, the DDS wire, a ROS 2 node, the bridge.
+
+The package, bottom up (each part imports only from the parts below it and from minros's
+layers under it):
+
+``types/``
+    ROS 2 interface types as pure code: the definitions of the common ROS 2 packages bundled
+    per distro (Jazzy, Kilted, Humble; verbatim from upstream, ``types/share/<distro>/
+    SOURCES.md``), the ``.msg``/``.srv``/``.action`` parser, type descriptions and RIHS01 hashes
+    (REP-2011), plain CDR codecs generated per type, the ROS 1 <-> ROS 2 type mapping by
+    ros1_bridge's rules (with ROS 2 types made from ROS 1 definitions that have none), and the
+    generated ROS 1 <-> CDR byte converters the bridge and bag conversion run per message.
+    Sits on :mod:`minros.msgs` (the ROS 1 message system) and nothing else of minros.
+``rtps/``
+    DDSI-RTPS, sans-IO: discovery (SPDP, SEDP), reliable writers and readers, fragments.
+    (Written in its own session.)
+the ROS 2 node and the bridge
+    A ROS 2 participant on the RTPS layer, and ``minros ros2``, joining a ROS 1 graph to a
+    ROS 2 domain. (Written in their own sessions.)
+
+Importing this package imports nothing.
+"""
