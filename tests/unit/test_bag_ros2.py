@@ -439,3 +439,47 @@ def test_a_recording_converted_twice_is_the_same(bag, tmp_path):
     assert load_metadata(a)["topics_with_message_count"] == \
         load_metadata(b)["topics_with_message_count"]
     assert rosbag2_messages(a) == rosbag2_messages(b)
+
+
+def test_the_mcap_file_reads_with_the_mcap_library_and_rosbags(tmp_path):
+    """minros's MCAP storage writer (one copy per message): several chunks, message indexes,
+    the summary and rosbag2's metadata record, read by foxglove's mcap library (indexed, in
+    time order, by topic) and by rosbags (a time window)."""
+    from mcap.reader import make_reader
+    from rosbags.rosbag2 import Reader
+
+    import minros
+    from sensor_msgs.msg import Image
+    from std_msgs.msg import String
+
+    path = tmp_path / "big.bag"
+    with Bag(str(path), "w") as b:
+        for i in range(12):  # 12 x 400 KB images: five chunks
+            img = Image(height=400, width=1000, encoding="mono8", step=1000,
+                        data=bytes([i]) * 400_000)
+            b.write("/image", img, minros.Time(100 + i, 0))
+            b.write("/words", String(f"w{i}"), minros.Time(100 + i, 500))
+    out = tmp_path / "big"
+    assert rosbag(["convert", "-q", str(path), str(out)]) == 0
+    mcap = out / "big.mcap"
+    with open(mcap, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        assert summary.statistics.message_count == 24 and len(summary.chunk_indexes) >= 4
+        assert summary.statistics.message_start_time == 100 * 10**9
+        assert summary.statistics.message_end_time == 111 * 10**9 + 500
+        assert {s.name for s in summary.schemas.values()} == {"sensor_msgs/msg/Image",
+                                                              "std_msgs/msg/String"}
+        got = [(ch.topic, m.log_time, len(m.data)) for _s, ch, m in
+               reader.iter_messages(log_time_order=True)]
+        words = [m.data for _s, _c, m in reader.iter_messages(topics=["/words"])]
+        (meta,) = list(reader.iter_metadata())
+    assert [t for _topic, t, _n in got] == sorted(t for _topic, t, _n in got)
+    assert len(got) == 24 and all(n > 400_000 for topic, _t, n in got if topic == "/image")
+    assert len(words) == 12 and words[3].endswith(b"w3\x00")
+    assert meta.name == "rosbag2"
+    assert yaml.safe_load(meta.metadata["serialized_metadata"])["message_count"] == 24
+    with Reader(out) as r:
+        window = [(c.topic, t) for c, t, _d in r.messages(start=103 * 10**9, stop=105 * 10**9)]
+    assert window == [("/image", 103 * 10**9), ("/words", 103 * 10**9 + 500),
+                      ("/image", 104 * 10**9), ("/words", 104 * 10**9 + 500)]

@@ -1,9 +1,10 @@
-"""Writing a rosbag2 recording: rosbags' MCAP and SQLite storage, minros's metadata.yaml.
+"""Writing a rosbag2 recording: the storage file, and minros's metadata.yaml.
 
-rosbags (Ternaris) writes the storage file: MCAP (profile ros2, schemas ``ros2msg``, chunks
-with their message indexes and a summary) or SQLite3 (rosbag2's schema 4 tables). Its
-``Writer`` also writes metadata.yaml, but only in versions 8 and 9 and always with a type
-hash, so minros drives rosbags' storage writers itself and writes the metadata as the
+rosbags (Ternaris) writes the SQLite3 storage (rosbag2's schema 4 tables); the MCAP storage is
+:mod:`.mcapwriter`'s (rosbags' layout, one copy of each message where rosbags' writer makes
+four: most of a conversion's time). rosbags' ``Writer`` also writes metadata.yaml, but only in
+versions 8 and 9 and always with a type hash, so minros drives the storage writers itself and
+writes the metadata as the
 distro's rosbag2 does: version 9 for Jazzy and Kilted (``type_description_hash`` on each
 topic, QoS as a list, ``ros_distro``; the layout rosbags-convert writes), version 5 for Humble
 (no type hashes, QoS as a YAML string). ``custom_data`` (a version 6 key that Humble's reader
@@ -49,8 +50,9 @@ class Rosbag2Writer:
 
     def __init__(self, path: str, storage: str = "mcap", distro: str = "jazzy") -> None:
         from rosbags.rosbag2.enums import CompressionMode
-        from rosbags.rosbag2.storage_mcap import McapWriter
         from rosbags.rosbag2.storage_sqlite3 import Sqlite3Writer
+
+        from minros.bag.ros2.mcapwriter import McapStorageWriter
 
         if storage not in ("mcap", "sqlite3"):
             raise ValueError(f"storage {storage!r}: expected mcap or sqlite3")
@@ -67,7 +69,7 @@ class Rosbag2Writer:
         except OSError as exc:
             raise ROSBagException(f"cannot create {path}: {exc.strerror or exc}") from None
         try:
-            plugin = McapWriter if storage == "mcap" else Sqlite3Writer
+            plugin = McapStorageWriter if storage == "mcap" else Sqlite3Writer
             self.storage: Any = plugin(self.path, CompressionMode.NONE)
         except BaseException:
             shutil.rmtree(self.path, ignore_errors=True)
