@@ -139,6 +139,30 @@ def test_invalid_quaternion_is_aborted_as_move_base_does(sim):
                                      "quaternion")
 
 
+@pytest.mark.parametrize("position", ["float('nan'), 1.0", "1.0, float('inf')"])
+def test_non_finite_goal_position_is_refused_in_one_line(sim, position):
+    code = (
+        "import actionlib, rospy\n"
+        "from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal\n"
+        "rospy.init_node('nan_goal')\n"
+        "c = actionlib.SimpleActionClient('move_base', MoveBaseAction)\n"
+        "c.wait_for_server(rospy.Duration(20))\n"
+        "g = MoveBaseGoal(); g.target_pose.header.frame_id = 'map'\n"
+        f"g.target_pose.pose.position.x, g.target_pose.pose.position.y = {position}\n"
+        "g.target_pose.pose.orientation.w = 1.0\n"
+        "c.send_goal(g); c.wait_for_result(rospy.Duration(20))\n"
+        "print(c.get_state(), c.get_goal_status_text())\n")
+    result = sim.python("-c", code)
+    state, _, text = result.stdout.strip().partition(" ")
+    assert state == "4", result.stdout + result.stderr
+    assert text.startswith("Aborting on goal because it was sent with a non-finite position "
+                           "(x="), text
+    # move_base said so in one line, with no traceback
+    out = sim.proc.read_until("non-finite position", timeout=10)
+    assert "Traceback" not in out and "cannot convert" not in out
+    assert sim.proc.alive()
+
+
 def test_simple_goal_from_rostopic_pub(sim):
     sim.reset()
     result_echo = Proc([PYTHON, "-m", "minros", "topic", "echo", "-n", "1",

@@ -175,5 +175,18 @@ def test_goal_quaternions_are_checked_as_move_base_does(q, problem):
     assert (found is None) if problem is None else (problem in found)
 
 
+@pytest.mark.parametrize("goal", [(math.nan, 0.0), (0.0, math.inf), (-math.inf, math.nan)])
+def test_non_finite_points_are_no_path_not_a_traceback(rooms, goal):
+    cost = planner.inflate(rooms, planner.CostmapParams())
+    with pytest.raises(planner.NoPath, match="not a finite position") as info:
+        planner.plan(rooms, cost, (0.0, 0.0), goal)
+    assert info.value.about_goal
+    with pytest.raises(planner.NoPath, match="not a finite position") as info:
+        planner.plan(rooms, cost, goal, (0.0, 0.0))
+    assert not info.value.about_goal
+    assert "nans or infs" in planner.position_problem(goal[0], goal[1], 0.0)
+    assert planner.position_problem(1.0, 2.0, 0.0) is None
+
+
 def test_yaw_of():
     assert planner.yaw_of(0.0, 0.0, math.sin(0.4), math.cos(0.4)) == pytest.approx(0.8)

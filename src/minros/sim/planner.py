@@ -207,6 +207,10 @@ def astar(cost: np.ndarray, start: Tuple[int, int], goal: Tuple[int, int],
 def plan(grid: GridMap, cost: np.ndarray, start: Point, goal: Point,
          params: PlannerParams = PlannerParams(), robot_radius: float = 0.105) -> List[Point]:
     """A* between two world points; the path in world coordinates, from start to goal exactly."""
+    for what, point in (("robot", start), ("goal", goal)):
+        if not all(math.isfinite(v) for v in point):
+            raise NoPath(f"the {what} ({point[0]}, {point[1]}) is not a finite position",
+                         about_goal=what == "goal")
     s = grid.cell_of(*start)
     if s is None:
         raise NoPath(f"the robot ({start[0]:.2f}, {start[1]:.2f}) is outside the map")
@@ -355,6 +359,14 @@ def quaternion_problem(x: float, y: float, z: float, w: float) -> str | None:
     if abs((1.0 - 2.0 * (x * x + y * y)) - 1.0) > 1e-3:
         return ("Quaternion is invalid... for navigation the z-axis of the quaternion must be "
                 "close to vertical.")
+    return None
+
+
+def position_problem(x: float, y: float, z: float) -> str | None:
+    """Why a goal position cannot be used (None when it can): the companion of
+    :func:`quaternion_problem`, which move_base lacks (its planner turns a NaN into a cell)."""
+    if not all(math.isfinite(v) for v in (x, y, z)):
+        return f"(x={x}, y={y}, z={z}): the position has nans or infs"
     return None
 
 

@@ -11,8 +11,9 @@ Interfaces, as move_base's:
 
 * action server ``move_base`` (move_base_msgs/MoveBase): goals in any frame tf can transform
   to the global frame (``map``, ``odom``, ``base_footprint``...), transformed once when they
-  arrive; SUCCEEDED "Goal reached."; ABORTED with the reason (invalid quaternion, unknown
-  frame, goal off the map or in an obstacle, no path even after recovery, no map);
+  arrive; SUCCEEDED "Goal reached."; ABORTED with the reason (invalid quaternion, a position
+  with nans or infs, unknown frame, goal off the map or in an obstacle, no path even after
+  recovery, no map);
   a new goal preempts the current one;
 * ``move_base_simple/goal`` (geometry_msgs/PoseStamped): re-sent as an action goal on
   ``move_base/goal``, as move_base does (the 2D Nav Goal tool of Rviz publishes there);
@@ -46,6 +47,7 @@ from minros.sim import planner
 from minros.sim.grid import GridMap
 
 INVALID_QUATERNION = "Aborting on goal because it was sent with an invalid quaternion"
+INVALID_POSITION = "Aborting on goal because it was sent with a non-finite position"
 NO_PLAN = "Failed to find a valid plan. Even after executing recovery behaviors."
 NO_CONTROL = "Failed to find a valid control. Even after executing recovery behaviors."
 #: how long the follower may be blocked before it replans around what the laser sees
@@ -195,10 +197,19 @@ class MoveBase:
 
     # -- geometry
 
+    @staticmethod
+    def check_position(pose_stamped: Any) -> None:
+        """GoalRejected for a position with nans or infs (before tf or the planner sees it)."""
+        p = pose_stamped.pose.position
+        problem = planner.position_problem(p.x, p.y, p.z)
+        if problem:
+            raise GoalRejected(f"{INVALID_POSITION} {problem}; discarding it as a navigation goal")
+
     def to_global(self, pose_stamped: Any) -> Tuple[float, float, float]:
         """(x, y, yaw) of a PoseStamped in the map frame, with the latest transform."""
         import rospy
 
+        self.check_position(pose_stamped)
         source = pose_stamped.header.frame_id
         if not source:
             raise GoalRejected("The goal pose has no frame_id: set header.frame_id (e.g. map)")
@@ -306,6 +317,7 @@ class MoveBase:
             hint = " (set orientation.w: 1.0 for a heading of 0)" if "zero" in problem else ""
             rospy.logerr(problem + hint)
             raise GoalRejected(INVALID_QUATERNION)
+        self.check_position(goal.target_pose)
         if not self.wait_for_map():
             raise GoalRejected("move_base has no map: is map_server publishing on "
                                f"{self.map_sub.resolved_name}?")
