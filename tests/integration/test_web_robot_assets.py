@@ -131,7 +131,7 @@ def test_the_page_route_serves_package_meshes_and_nothing_else(system):
 def test_a_custom_allow_list_and_the_token_guard_the_route(system, tmp_path):
     home = tmp_path / "home"
     (home / "log").mkdir(parents=True)
-    web, port = start_web(system.port, home, "--token", "s3cret",
+    web, port = start_web(system.port, home, "--token", "s3cret", "--name", "web_allowlist",
                           "_asset_uri_allowlist:=['^package://scene_pkg/meshes/wedge\\.stl$']",
                           env=system.extra)
     try:
