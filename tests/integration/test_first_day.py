@@ -1,0 +1,91 @@
+"""A newcomer's first day, as the README leads it: the talker stops quietly on Ctrl-C."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+from pathlib import Path
+from typing import Dict
+
+from support import PYTHON, REPO, Proc, ros_env
+
+VENV_BIN = Path(PYTHON).parent
+
+
+def readme_talker() -> str:
+    """The Python script the README's talker section shows."""
+    readme = (REPO / "README.md").read_text()
+    section = readme.split("Your own scripts are plain rospy", 1)[1]
+    return section.split("```python\n", 1)[1].split("```", 1)[0]
+
+
+#: the README's talker before the tutorial's try/except was put back (the loop bare), with a
+#: line to say it runs
+BARE_LOOP = """\
+import rospy
+from std_msgs.msg import String
+
+rospy.init_node('talker', anonymous=True)
+pub = rospy.Publisher('chatter', String, queue_size=10)
+rate = rospy.Rate(10)
+print("hello world: publishing", flush=True)
+while not rospy.is_shutdown():
+    pub.publish("hello world %s" % rospy.get_time())
+    rate.sleep()
+"""
+
+#: a loop that never looks at is_shutdown(): rospy's spins on forever after Ctrl-C
+ENDLESS_LOOP = """\
+import rospy
+
+rospy.init_node('talker', anonymous=True)
+rate = rospy.Rate(10)
+while True:
+    rospy.loginfo("hello world")
+    rate.sleep()
+"""
+
+
+def ctrl_c(script: Path, env: Dict[str, str], python: str = PYTHON) -> tuple:
+    """Run ``script`` until it logs "hello world", then SIGINT its process only (a terminal's
+    Ctrl-C); returns (exit status, output), bounded."""
+    proc = Proc([python, str(script)], env)
+    try:
+        proc.read_until("hello world", 30)
+        proc.popen.send_signal(signal.SIGINT)
+        try:
+            status = proc.popen.wait(15)
+        except subprocess.TimeoutExpired:
+            status = None
+    finally:
+        out = proc.stop()
+    return status, out
+
+
+def test_the_readme_talker_stops_quietly_on_ctrl_c(minros_core, ros_home, tmp_path):
+    script = tmp_path / "talker.py"
+    script.write_text(readme_talker())
+    assert "except rospy.ROSInterruptException:" in script.read_text()  # the tutorial's form
+    status, out = ctrl_c(script, ros_env(minros_core, ros_home))
+    assert status == 0 and "Traceback" not in out, out
+
+
+def test_a_bare_rate_loop_stops_quietly_on_ctrl_c_as_under_rospy(minros_core, ros_home, tmp_path):
+    """rospy's Rate.sleep on the wall clock raises nothing at shutdown: the while condition
+    ends the loop (Debian's rospy exits 0, silent; checked in the interop tests)."""
+    script = tmp_path / "talker.py"
+    script.write_text(BARE_LOOP)
+    status, out = ctrl_c(script, ros_env(minros_core, ros_home))
+    assert status == 0 and "Traceback" not in out, out
+
+
+def test_a_loop_that_never_checks_shutdown_ends_with_rospys_names(minros_core, ros_home, tmp_path):
+    """The next sleep after shutdown raises, so the loop ends (rospy's spins forever), and the
+    traceback names the exception as under ROS: rospy.exceptions, not minros.exceptions."""
+    script = tmp_path / "endless.py"
+    script.write_text(ENDLESS_LOOP)
+    status, out = ctrl_c(script, ros_env(minros_core, ros_home))
+    assert status == 1, out
+    assert out.rstrip().splitlines()[-1] == \
+        "rospy.exceptions.ROSInterruptException: ROS shutdown request"
+    assert "minros.exceptions" not in out
