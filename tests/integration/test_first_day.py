@@ -1,12 +1,16 @@
-"""A newcomer's first day, as the README leads it: the talker stops quietly on Ctrl-C."""
+"""A newcomer's first day, as the README leads it: the talker stops quietly on Ctrl-C,
+``minros --version``, ``rosbag --help`` offers only what exists, ``minros ws --help`` explains."""
 
 from __future__ import annotations
 
+import importlib.metadata
+import re
 import signal
 import subprocess
 from pathlib import Path
-from typing import Dict
+from typing import Dict, List
 
+import minros
 from support import PYTHON, REPO, Proc, ros_env
 
 VENV_BIN = Path(PYTHON).parent
@@ -89,3 +93,54 @@ def test_a_loop_that_never_checks_shutdown_ends_with_rospys_names(minros_core, r
     assert out.rstrip().splitlines()[-1] == \
         "rospy.exceptions.ROSInterruptException: ROS shutdown request"
     assert "minros.exceptions" not in out
+
+
+def run(argv: List[str], env: Dict[str, str] | None = None, cwd: Path | None = None,
+        timeout: float = 60) -> subprocess.CompletedProcess:
+    return subprocess.run(argv, env=env, cwd=cwd, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def test_minros_version():
+    done = run([str(VENV_BIN / "minros"), "--version"])
+    assert done.returncode == 0, done.stderr
+    where = Path(minros.__file__).resolve().parent
+    assert re.fullmatch(rf"minros {re.escape(minros.__version__)} from {re.escape(str(where))} "
+                        r"\(Python 3\.\d+\.\d+\S*, ROS 1 noetic\)\n", done.stdout), done.stdout
+    # one version: the package's, the installed distribution's (pyproject.toml)
+    assert importlib.metadata.version("minros") == minros.__version__
+    assert "'minros --version'" in run([str(VENV_BIN / "minros"), "--help"]).stdout
+
+
+def test_rosbag_help_offers_only_what_exists():
+    done = run([str(VENV_BIN / "rosbag"), "--help"])
+    assert done.returncode == 0
+    assert "encrypt" not in done.stdout and "decrypt" not in done.stdout, done.stdout
+    assert re.search(r"^   record  \tRecord a bag file", done.stdout, re.M)
+    for argv, fix in ((["encrypt", "x.bag"], "use ROS's rosbag encrypt"),
+                      (["decrypt", "-h"], "decrypt the bag with ROS's rosbag decrypt first")):
+        gone = run([str(VENV_BIN / "rosbag"), *argv])
+        assert gone.returncode == 1 and gone.stdout == "", gone
+        assert gone.stderr.startswith(f"ERROR: rosbag {argv[0]} is not available in minros")
+        assert fix in gone.stderr and gone.stderr.count("\n") == 1, gone.stderr
+
+
+def test_minros_ws_help_explains_its_commands(tmp_path):
+    done = run([str(VENV_BIN / "minros"), "ws", "--help"])
+    assert done.returncode == 0, done.stderr
+    text = done.stdout
+    assert text.startswith("usage: minros ws {init,create_pkg,make} ...\n")
+    for command, ros_name in (("init", "catkin_init_workspace"),
+                              ("create_pkg", "catkin_create_pkg"), ("make", "catkin_make")):
+        assert re.search(rf"^  {command} ", text, re.M) and f"({ros_name})" in text, text
+    assert "minros ws create_pkg my_package rospy std_msgs" in text
+    # the example it gives works
+    src = tmp_path / "catkin_ws" / "src"
+    src.mkdir(parents=True)
+    for argv in (["init"], ["create_pkg", "my_package", "rospy", "std_msgs"]):
+        step = run([str(VENV_BIN / "minros"), "ws", *argv], cwd=src)
+        assert step.returncode == 0, step.stderr
+    assert (src / "CMakeLists.txt").exists() and (src / "my_package" / "package.xml").exists()
+    wrong = run([str(VENV_BIN / "minros"), "ws", "build"])
+    assert wrong.returncode == 2 and "unknown command 'build'" in wrong.stderr
+    assert "'minros ws --help' explains them" in wrong.stderr
