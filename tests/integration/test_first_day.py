@@ -1,5 +1,6 @@
 """A newcomer's first day, as the README leads it: the talker stops quietly on Ctrl-C,
-``minros --version``, ``rosbag --help`` offers only what exists, ``minros ws --help`` explains."""
+``minros --version``, ``rosbag --help`` offers only what exists, ``minros ws --help`` explains,
+and a ROS_MASTER_URI without its scheme is named, with the fix, by whatever reads it."""
 
 from __future__ import annotations
 
@@ -7,8 +8,11 @@ import importlib.metadata
 import re
 import signal
 import subprocess
+import time
 from pathlib import Path
 from typing import Dict, List
+
+import pytest
 
 import minros
 from support import PYTHON, REPO, Proc, ros_env
@@ -144,3 +148,42 @@ def test_minros_ws_help_explains_its_commands(tmp_path):
     wrong = run([str(VENV_BIN / "minros"), "ws", "build"])
     assert wrong.returncode == 2 and "unknown command 'build'" in wrong.stderr
     assert "'minros ws --help' explains them" in wrong.stderr
+
+
+BAD_URI = "ERROR: ROS_MASTER_URI is 'localhost:11311', which is not a master URI (it lacks the " \
+          "scheme http://): set ROS_MASTER_URI=http://localhost:11311\n"
+
+
+@pytest.mark.parametrize("argv", [
+    ["rostopic", "list"], ["rostopic", "echo", "/chatter"], ["rosnode", "list"],
+    ["rosparam", "get", "/x"], ["rosservice", "list"], ["rosbag", "record", "-a"],
+    ["roslaunch", "turtlesim", "multisim.launch"], ["roscore"], ["rqt_graph", "-o", "g.png"],
+    ["minros", "web"], ["minros", "sim"]], ids=lambda argv: " ".join(argv[:2]))
+def test_a_master_uri_without_scheme_is_named_by_every_tool(argv, ros_home, tmp_path):
+    env = ros_env(None, ros_home, {"ROS_MASTER_URI": "localhost:11311"})
+    done = run([str(VENV_BIN / argv[0]), *argv[1:]], env=env, cwd=tmp_path, timeout=30)
+    assert done.returncode == 1, done
+    # rosbag keeps its own prefix for what stops the recorder
+    assert done.stderr.replace("[FATAL] ", "ERROR: ") == BAD_URI, done.stderr
+    assert "Traceback" not in done.stdout + done.stderr
+
+
+def test_a_master_uri_without_scheme_ends_init_node_at_once(ros_home, tmp_path):
+    """A rospy script: init_node raises ROSInitException at once, its last line the value and
+    the fix (it waited forever before, as Debian's rospy does, which says "Failed to
+    initialize time")."""
+    script = tmp_path / "node.py"
+    script.write_text("import rospy\n"
+                      "try:\n"
+                      "    rospy.init_node('x')\n"
+                      "except rospy.ROSInitException as exc:\n"
+                      "    print('caught:', exc)\n"
+                      "    raise\n")
+    env = ros_env(None, ros_home, {"ROS_MASTER_URI": "localhost:11311"})
+    began = time.monotonic()
+    done = run([PYTHON, str(script)], env=env, timeout=30)
+    assert time.monotonic() - began < 20
+    assert done.returncode == 1
+    assert done.stdout == "caught: " + BAD_URI[len("ERROR: "):]
+    assert done.stderr.rstrip().splitlines()[-1] == \
+        "minros.rosenv.MasterURIError: " + BAD_URI[len("ERROR: "):].rstrip()

@@ -92,8 +92,14 @@ def run(command: str, argv: List[str], prog: Optional[str] = None) -> int:
             raise
         print(f"minros: '{command}' is not available in this version of minros", file=sys.stderr)
         return 1
+    from minros.rosenv import MasterURIError
+
     try:
         return int(module.main(argv, prog=prog or f"minros {command}") or 0)
+    except MasterURIError as exc:  # ROS_MASTER_URI=localhost:11311: the value and its fix
+        sys.stdout.flush()
+        print(f"ERROR: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:
