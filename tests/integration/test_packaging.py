@@ -12,7 +12,9 @@ import shutil
 import subprocess
 import sys
 import sysconfig
+import tarfile
 import xmlrpc.client
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -117,3 +119,37 @@ def test_roscore_and_a_talker_run_from_the_folder_holding_the_clone(clone_parent
             talker.stop()
         core_output = core.stop()
     assert "Traceback" not in core_output, core_output
+
+
+def test_the_wheel_carries_the_packages_and_the_sdist_the_examples(clone_parent, tmp_path):
+    """A wheel is minros and the packages under ROS names, not the clone's examples/, which
+    the README runs from a checkout; a source distribution carries them, and its own build
+    backend, so a wheel builds from it."""
+    parent, python = clone_parent
+    project = parent / "minros"
+    pip(python, "install", "setuptools>=77", cwd=parent)
+    out = tmp_path / "dist"
+    # what a build front-end does: the backend's hook, run in the source tree, backend-path
+    # first on sys.path (pyproject.toml's [build-system])
+    subprocess.run([str(python), "-c", "import sys; sys.path.insert(0, 'build_backend'); "
+                    "import minros_build_backend as b; print(b.build_sdist(sys.argv[1]))",
+                    str(out)], cwd=project, check=True, capture_output=True, timeout=300)
+    (sdist,) = out.glob("minros-*.tar.gz")
+    with tarfile.open(sdist) as tar:
+        names = {name.split("/", 1)[1] for name in tar.getnames() if "/" in name}
+    assert {"pyproject.toml", "README.md", "build_backend/minros_build_backend.py",
+            "examples/README.md", "examples/sim/send_goal.py",
+            "examples/talker_listener/talker.py", "src/minros/__init__.py",
+            "stubs/rospy/__init__.py"} <= names
+    assert not any("__pycache__" in name for name in names)
+    pip(python, "wheel", "--no-deps", "-w", str(out), str(sdist), cwd=parent)
+    (wheel,) = out.glob("minros-*.whl")
+    with zipfile.ZipFile(wheel) as whl:
+        names = set(whl.namelist())
+    top = {name.split("/", 1)[0] for name in names}
+    assert {"minros/__init__.py", "rospy/__init__.py", "std_msgs/__init__.py",
+            "minros/msgs/share/std_msgs/msg/String.msg"} <= names
+    assert not top & {"examples", "build_backend", "tests", "src", "stubs"}, sorted(top)
+    readme = (REPO / "README.md").read_text()
+    assert "python examples/" in readme
+    assert "`examples/` are the checkout's" in readme  # and the README says where they are
