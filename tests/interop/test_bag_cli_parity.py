@@ -146,6 +146,9 @@ def test_check_and_usage_like_debian(bagdir):
                  ["bag", "record"], ["bag", "play"], ["bag", "info"], ["bag", "info", "-k", "x", "a.bag"],
                  ["bag", "record", "-o", "a", "-O", "b", "/x"], ["bag", "record", "--split", "/x"]):
         ours, theirs = both(bagdir, *argv)
+        if argv == ["bag"]:  # the list of commands: Debian's but encrypt and decrypt
+            theirs.stdout = "".join(line for line in theirs.stdout.splitlines(keepends=True)
+                                    if not line.startswith(("   encrypt  ", "   decrypt  ")))
         assert (ours.returncode, ours.stdout, ours.stderr) == (theirs.returncode, theirs.stdout, theirs.stderr), argv
 
 

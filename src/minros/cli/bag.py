@@ -438,28 +438,32 @@ def fix_cmd(argv: List[str], prog: str = "rosbag") -> int:
     return 1
 
 
-def _unavailable(name: str, why: str) -> Callable[[List[str], str], int]:
+def _unavailable(name: str, fix: str) -> Callable[[List[str], str], int]:
+    """A rosbag command minros does not have: one line, with ``-h`` too (no usage of a command
+    that does nothing)."""
     def cmd(argv: List[str], prog: str) -> int:
-        p = _parser(prog, f"rosbag {name} [options] ...", DESCRIPTIONS[name])
-        p.parse_args(argv)  # -h still prints a usage
-        return _fail(f"ERROR: rosbag {name} is not available in minros: {why}")
+        return _fail(f"ERROR: rosbag {name} is not available in minros (it reads and writes "
+                     f"unencrypted bags only): {fix}")
 
     return cmd
 
 
 COMMANDS: Dict[str, Callable[[List[str], str], int]] = {
     "check": check_cmd, "compress": compress_cmd, "decompress": decompress_cmd,
-    "decrypt": _unavailable("decrypt", "encrypted bags are not supported"),
-    "encrypt": _unavailable("encrypt", "encrypted bags are not supported"),
+    "decrypt": _unavailable("decrypt", "decrypt the bag with ROS's rosbag decrypt first"),
+    "encrypt": _unavailable("encrypt", "use ROS's rosbag encrypt, or encrypt the whole file "
+                                       "(gpg -c BAG)"),
     "filter": filter_cmd,
     "fix": fix_cmd,
     "info": info_cmd, "play": play_cmd, "record": record_cmd, "reindex": reindex_cmd,
 }
+#: in COMMANDS for scripts written for ROS's rosbag, not offered by --help
+UNAVAILABLE = ("decrypt", "encrypt")
 
 
 def _valid_cmds() -> str:
     out = "Available subcommands:\n"
-    for name in sorted([*COMMANDS, "help"]):
+    for name in sorted([*(c for c in COMMANDS if c not in UNAVAILABLE), "help"]):
         out += f"   {name}  "
         if name in DESCRIPTIONS:
             out += f"\t{DESCRIPTIONS[name]}"

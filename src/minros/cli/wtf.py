@@ -115,7 +115,7 @@ def _load_env(ctx: WtfContext, env: Any) -> None:
     ctx.ros_root = env.get("ROS_ROOT")
     ctx.ros_package_path = env.get("ROS_PACKAGE_PATH")
     ctx.pythonpath = env.get("PYTHONPATH")
-    ctx.ros_master_uri = rosenv.get_master_uri(env)
+    ctx.ros_master_uri = rosenv.get_master_uri(env, check=False)  # its own rule reports it
 
 
 Rule = Tuple[Callable[[WtfContext], Any], str]
