@@ -40,7 +40,7 @@ ROS_DESKTOP_FULL="ros-desktop-full-python-dev python3-pykdl python3-tf2-sensor-m
   python3-tf-conversions python3-tf2-kdl python3-bondpy python3-nodelet python3-topic-tools
   python3-resource-retriever python3-smclib python3-actionlib-tools
   libbond-dev libnodelet-dev libnodeletlib-tools topic-tools
-  ros-robot-state-publisher joint-state-publisher image-transport-tools
+  ros-robot-state-publisher joint-state-publisher joint-state-publisher-gui image-transport-tools
   python3-camera-calibration-parsers python3-map-msgs
   python3-pcl-msgs python3-polled-camera python3-roswtf
   python3-rosclean python3-rosmake python3-rospkg"
