@@ -185,8 +185,13 @@ class MsgImportFinder:
     """Finds ``<pkg>``, ``<pkg>.msg`` and ``<pkg>.srv`` of ROS packages with definitions.
 
     A plain ``sys.meta_path`` finder (importlib's protocol without its ABCs, whose import
-    would pull in importlib.resources and slow every ``import rospy``).
+    would pull in importlib.resources and slow every ``import rospy``). With
+    ``environment_only`` it answers only for packages found on ROS_PACKAGE_PATH, not for the
+    ones minros ships (the start-up hook's finder, :data:`ENVIRONMENT_FINDER`).
     """
+
+    def __init__(self, environment_only: bool = False) -> None:
+        self.environment_only = environment_only
 
     def find_spec(self, fullname: str, path: Sequence[str] | None = None,
                   target: ModuleType | None = None) -> ModuleSpec | None:
@@ -221,8 +226,12 @@ class MsgImportFinder:
             package_dir = _package_dir(parts[0])
             if package_dir is None or not (package_dir / "cfg").is_dir():
                 return None
+            if self.environment_only and packages.is_builtin(package_dir):
+                return None
             return _plugin("cfg").find_spec(fullname, parts, package_dir)
         else:
+            return None
+        if self.environment_only and packages.is_builtin(package_dir):
             return None
         loader: Any = _NamespaceLoader(parts[0], kind)  # importlib's protocol, not its ABC
         spec = ModuleSpec(fullname, loader,
@@ -246,6 +255,9 @@ def _plugin(folder: str) -> Any:
 _NOT_ROS = frozenset(getattr(sys, "stdlib_module_names", ())) | frozenset(sys.builtin_module_names)
 _busy = threading.local()
 _FINDER = MsgImportFinder()
+#: what ``_minros_import_hook`` (the .pth installed with minros) asks: packages on
+#: ROS_PACKAGE_PATH import before anything imported rospy
+ENVIRONMENT_FINDER = MsgImportFinder(environment_only=True)
 _hook_lock = threading.Lock()
 
 
