@@ -87,7 +87,9 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosservice": {"rosservice": "minros.cli.service"},
     "rosmsg": {"rosmsg": "minros.cli.msg", "rossrv": "minros.cli.srv"},
     "rosconsole": {"rosconsole": "minros.cli.console"},
-    "rostest": {"rostest": "minros.cli.rostest"},
+    # rostest's own test nodes (<test pkg="rostest" type="hztest">)
+    "rostest": {"rostest": "minros.cli.rostest", **{name: f"minros.nodes.rostest.{name}" for name in (
+        "hztest", "paramtest", "publishtest", "advertisetest")}},
     "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
     "image_transport": {"republish": "minros.nodes.image_transport.republish"},
     "robot_state_publisher": {
