@@ -110,7 +110,7 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     # topic_tools' programs (minros.topic_tools; ROS ships C++ relay/throttle/drop/mux)
     "topic_tools": {name: f"minros.nodes.topic_tools.{name}" for name in (
         "relay", "throttle", "drop", "mux", "transform", "mux_select", "mux_add",
-        "mux_delete", "mux_list")},
+        "mux_delete", "mux_list", "switch_mux")},
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...
