@@ -54,8 +54,6 @@ log = logging.getLogger("minros.ros2")
 
 #: the socket buffer minros asks for (the kernel caps it at net.core.rmem_max / wmem_max)
 SOCKET_BUFFER = 8 << 20
-#: a reader asks for a half-received sample's missing fragments after this long without one
-NACK_DELAY = 0.004
 #: participant ids tried when choosing ours (RTPS leaves 120 per domain)
 MAX_PARTICIPANT_ID = 120
 
@@ -860,7 +858,7 @@ class Participant:
                     continue
                 for reader in self._route(sub.src + sub.writer_id, sub.reader_id):
                     with reader.lock:
-                        samples = reader.machine.on_data(sub)
+                        samples = reader.machine.on_data(sub, now)
                     if samples:
                         reader._deliver(samples)
             elif kind == m.DATA_FRAG:
@@ -871,7 +869,7 @@ class Participant:
                         if not samples and sub.start + sub.count > sub.total:
                             # its last fragment came, others did not: ask for them now
                             out += reader.machine.nack_partial(sub.src + sub.writer_id)
-                        due = reader.machine.next_deadline(NACK_DELAY)
+                        due = reader.machine.next_deadline()
                     if samples:
                         reader._deliver(samples)
                     if due is not None:
@@ -880,8 +878,11 @@ class Participant:
                 assert isinstance(sub, m.Heartbeat)
                 for reader in self._route(sub.src + sub.writer_id, sub.reader_id):
                     with reader.lock:
-                        samples, answer = reader.machine.on_heartbeat(sub)
+                        samples, answer = reader.machine.on_heartbeat(sub, now)
+                        due = reader.machine.next_deadline()
                     out += answer
+                    if due is not None:
+                        self._wake_timer(due)
                     if samples:
                         reader._deliver(samples)
             elif kind == m.GAP:
@@ -997,10 +998,14 @@ class Participant:
                     target = min(target, due)
             for reader in readers:
                 with reader.lock:
-                    due = reader.machine.next_deadline(NACK_DELAY)
+                    due = reader.machine.next_deadline()
+                    late: List[Sample] = []
                     if due is not None and due <= now:
-                        out += reader.machine.tick(now, NACK_DELAY)
-                        due = reader.machine.next_deadline(NACK_DELAY)
+                        out += reader.machine.tick(now)
+                        late = reader.machine.take_late()
+                        due = reader.machine.next_deadline()
+                if late:
+                    reader._deliver(late)
                 if due is not None:
                     target = min(target, due)
             if out:

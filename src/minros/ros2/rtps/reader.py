@@ -43,7 +43,8 @@ class _Reassembly:
     """One sample arriving in fragments."""
 
     __slots__ = ("size", "fragment_size", "total", "buffer", "view", "have", "missing",
-                 "inline_qos", "timestamp", "little", "received", "updated", "nacked")
+                 "inline_qos", "timestamp", "little", "received", "updated", "nacked",
+                 "interval")
 
     def __init__(self, size: int, fragment_size: int, timestamp: Optional[int]) -> None:
         self.size = size
@@ -60,7 +61,8 @@ class _Reassembly:
         self.received = 0
         #: when a fragment last arrived, and when the reader last asked for the missing ones
         self.updated = 0.0
-        self.nacked = 0.0
+        self.nacked = -1.0
+        self.interval = 0.0
 
     def add(self, start: int, count: int, payload: memoryview) -> int:
         """Fragments ``start`` .. of ``payload``; returns the bytes that were new."""
@@ -98,7 +100,7 @@ class WriterProxy:
 
     __slots__ = ("guid", "entity", "addresses", "next", "pending", "irrelevant", "partial",
                  "known", "synced", "hb_count", "acknack_count", "nackfrag_count", "prefix",
-                 "last_delivered", "pending_bytes")
+                 "last_delivered", "pending_bytes", "answer_due", "unsynced_since")
 
     def __init__(self, guid: bytes, addresses: Sequence[Address], message_header: bytes) -> None:
         self.guid = guid
@@ -120,6 +122,10 @@ class WriterProxy:
         self.prefix = message_header + m.info_dst(guid[:12])
         #: best effort: the newest sequence number delivered
         self.last_delivered = 0
+        #: when to answer the last HEARTBEAT (None: no answer owed)
+        self.answer_due: Optional[float] = None
+        #: when the first sample came while the writer had not said where to start
+        self.unsynced_since: Optional[float] = None
 
 
 class Reader:
@@ -128,7 +134,9 @@ class Reader:
     def __init__(self, guid: bytes, message_header: bytes, *, reliable: bool = True,
                  durable: bool = False, max_sample_size: int = 256 << 20,
                  max_partial: int = 4, max_partial_bytes: int = 512 << 20,
-                 max_pending: int = 10_000, max_pending_bytes: int = 256 << 20) -> None:
+                 max_pending: int = 10_000, max_pending_bytes: int = 256 << 20,
+                 response_delay: float = 0.001, nack_delay: float = 0.004,
+                 sync_timeout: float = 0.2) -> None:
         self.guid = guid
         self.entity = guid[12:]
         self.header = message_header
@@ -139,6 +147,13 @@ class Reader:
         self.max_partial_bytes = max_partial_bytes
         self.max_pending = max_pending
         self.max_pending_bytes = max_pending_bytes
+        self.response_delay = response_delay
+        self.nack_delay = nack_delay
+        self.sync_timeout = sync_timeout
+        #: samples :meth:`tick` released (a writer that never sent a HEARTBEAT): take them
+        #: with :meth:`take_late`
+        self.late: List[Sample] = []
+        self._now = 0.0
         self.writers: Dict[bytes, WriterProxy] = {}
         self._partial_bytes = 0
         #: counters for tests: samples refused for their size, reassemblies dropped
@@ -174,14 +189,20 @@ class Reader:
 
     # -- data --------------------------------------------------------------------------------
 
-    def on_data(self, sub: m.Data) -> List[Sample]:
+    def take_late(self) -> List[Sample]:
+        out, self.late = self.late, []
+        return out
+
+    def on_data(self, sub: m.Data, now: float = 0.0) -> List[Sample]:
         """A DATA: the samples it makes deliverable, in order."""
+        self._now = now
         proxy = self.writers.get(sub.src + sub.writer_id)
         if proxy is None or sub.payload is None:
             if proxy is not None and self.reliable:
                 # a change without data (a dispose, a key only): it takes its number
                 return self._arrived(proxy, sub.sn, None)
             return []
+        self._sync(proxy, sub.sn)
         if self._stale(proxy, sub.sn):
             return []
         qos = bytes(sub.inline_qos) if sub.inline_qos is not None else None
@@ -192,10 +213,12 @@ class Reader:
 
     def on_data_frag(self, sub: m.DataFrag, now: float = 0.0) -> List[Sample]:
         """A DATA_FRAG: the samples it completes and makes deliverable."""
+        self._now = now
         proxy = self.writers.get(sub.src + sub.writer_id)
         if proxy is None:
             return []
         sn = sub.sn
+        self._sync(proxy, sn)
         if self._stale(proxy, sn):
             return []
         r = proxy.partial.get(sn)
@@ -240,10 +263,17 @@ class Reader:
         if oldest is not None:
             self._drop_partial(*oldest)
 
+    def _sync(self, proxy: WriterProxy, sn: int) -> None:
+        """Samples before the writer's first HEARTBEAT (or GAP) wait: it says where this
+        reader starts (a writer GAPs what a volatile reader is not meant to get, as Fast DDS
+        and minros do), and data can arrive before this reader knew the writer."""
+        if self.reliable and not proxy.synced and proxy.unsynced_since is None:
+            proxy.unsynced_since = self._now
+
     def _stale(self, proxy: WriterProxy, sn: int) -> bool:
         if self.reliable:
-            return proxy.synced and (sn < proxy.next or sn in proxy.pending
-                                     or sn in proxy.irrelevant)
+            return sn in proxy.pending or (proxy.synced and (sn < proxy.next
+                                                             or sn in proxy.irrelevant))
         return sn <= proxy.last_delivered
 
     def _arrived(self, proxy: WriterProxy, sn: int, sample: Optional[Sample]) -> List[Sample]:
@@ -254,12 +284,11 @@ class Reader:
             for old in [s for s in proxy.partial if s < sn]:
                 self._drop_partial(proxy, old)
             return [sample]
-        if not proxy.synced:
-            proxy.synced = True
-            proxy.next = sn if not self.durable else min(sn, max(proxy.next, 1))
-        if sn < proxy.next or sn in proxy.pending or sn in proxy.irrelevant:
+        self._sync(proxy, sn)
+        if sn in proxy.pending or (proxy.synced and (sn < proxy.next
+                                                     or sn in proxy.irrelevant)):
             return []
-        if sn > proxy.next:
+        if sn > proxy.next or not proxy.synced:
             if sample is None:
                 proxy.irrelevant.add(sn)
             else:
@@ -291,6 +320,15 @@ class Reader:
             self._drop_partial(proxy, sn)
         return out
 
+    def _start_at(self, proxy: WriterProxy, sn: int) -> List[Sample]:
+        """The writer said where this reader starts: what waited from there on is delivered."""
+        proxy.synced = True
+        proxy.unsynced_since = None
+        for old in [s for s in proxy.pending if s < sn]:
+            proxy.pending_bytes -= len(proxy.pending.pop(old).payload)
+        proxy.next = sn
+        return self._drain(proxy)
+
     def _skip_to(self, proxy: WriterProxy, sn: int) -> List[Sample]:
         proxy.irrelevant = {s for s in proxy.irrelevant if s > sn}
         proxy.next = sn
@@ -303,6 +341,7 @@ class Reader:
             return []
         if not proxy.synced:
             proxy.synced = True
+            proxy.unsynced_since = None
             proxy.next = sub.start
         # a GAP's range may be huge (a peer's numbers): only the part at `next` is walked
         if sub.start <= proxy.next < sub.list_base:
@@ -317,25 +356,33 @@ class Reader:
 
     # -- heartbeats --------------------------------------------------------------------------
 
-    def on_heartbeat(self, sub: m.Heartbeat) -> Tuple[List[Sample], List[Datagram]]:
-        """A HEARTBEAT: the samples that a forward skip releases, and the answer to send."""
+    def on_heartbeat(self, sub: m.Heartbeat,
+                     now: float = 0.0) -> Tuple[List[Sample], List[Datagram]]:
+        """A HEARTBEAT: the samples that a forward skip releases, and an answer to send now.
+
+        Whole samples missing are asked for at once. Otherwise the answer waits
+        ``response_delay`` (:meth:`tick` sends it): a writer that sends a HEARTBEAT after every
+        fragment (Fast DDS does) gets one answer per burst, not one per fragment, and
+        fragments still on their way are not asked for again."""
         proxy = self.writers.get(sub.src + sub.writer_id)
         if proxy is None or not self.reliable or sub.count <= proxy.hb_count:
             return [], []
         proxy.hb_count = sub.count
         delivered: List[Sample] = []
         if not proxy.synced:
-            proxy.synced = True
-            proxy.next = sub.first if self.durable else sub.last + 1
+            delivered = self._start_at(proxy, sub.first)
         if sub.last > proxy.known:
             proxy.known = sub.last
         if sub.first > proxy.next:
             # the writer no longer has what comes before `first`: those will never come
-            delivered = self._skip_to(proxy, sub.first)
+            delivered += self._skip_to(proxy, sub.first)
         missing = self._missing(proxy)
-        if sub.final and not missing and not proxy.partial:
-            return delivered, []
-        return delivered, [self._answer(proxy, missing)]
+        if missing:
+            return delivered, [self._answer(proxy, missing, now)]
+        if not sub.final or proxy.partial:
+            if proxy.answer_due is None:
+                proxy.answer_due = now + self.response_delay
+        return delivered, []
 
     def on_heartbeat_frag(self, sub: m.HeartbeatFrag) -> List[Datagram]:
         """A HEARTBEAT_FRAG: a NACK_FRAG when fragments of that sample are missing."""
@@ -360,39 +407,57 @@ class Reader:
         return [sn for sn in range(proxy.next, top + 1)
                 if sn not in have and sn not in skip and sn not in proxy.partial]
 
-    def _answer(self, proxy: WriterProxy, missing: List[int]) -> Datagram:
+    def _answer(self, proxy: WriterProxy, missing: List[int], now: float) -> Datagram:
+        """ACKNACK, after a NACK_FRAG for each half-received sample whose fragments stopped
+        coming (``nack_delay`` without one; asked again with a growing interval)."""
         parts: List[Buffer] = [proxy.prefix]
         for sn in sorted(proxy.partial):
             r = proxy.partial[sn]
+            if now - r.updated < self.nack_delay or now - r.nacked < r.interval:
+                continue
             base, frags = r.missing_fragments()
             if frags:
                 proxy.nackfrag_count += 1
                 parts.append(m.nack_frag(self.entity, proxy.entity, sn, base, frags,
                                          proxy.nackfrag_count))
+                r.interval = self.nack_delay if r.nacked < r.updated else \
+                    min(r.interval * 2, 0.2)
+                r.nacked = now
         proxy.acknack_count += 1
         parts.append(m.acknack(self.entity, proxy.entity, proxy.next, missing,
                                proxy.acknack_count, final=not missing))
+        proxy.answer_due = None
         return Datagram(proxy.addresses, parts)
 
-    def tick(self, now: float, delay: float) -> List[Datagram]:
-        """NACK_FRAGs for samples whose fragments stopped arriving ``delay`` seconds ago (the
-        writer's HEARTBEAT may be seconds away: Fast DDS's period is 3 s)."""
+    def tick(self, now: float) -> List[Datagram]:
+        """Answers due: to HEARTBEATs (after ``response_delay``), and NACK_FRAGs for samples
+        whose fragments stopped coming (the writer's HEARTBEAT may be seconds away: Fast
+        DDS's period is 3 s)."""
         out: List[Datagram] = []
         if not self.reliable:
             return out
         for proxy in self.writers.values():
-            stalled = [r for r in proxy.partial.values()
-                       if now - r.updated >= delay and now - r.nacked >= delay]
-            if stalled:
-                for r in stalled:
-                    r.nacked = now
-                out.append(self._answer(proxy, self._missing(proxy)))
+            if not proxy.synced and proxy.unsynced_since is not None \
+                    and now - proxy.unsynced_since >= self.sync_timeout:
+                # no HEARTBEAT came: start at the oldest sample that did
+                first = min([*proxy.pending, *proxy.partial], default=proxy.next)
+                self.late.extend(self._start_at(proxy, first))
+            due = proxy.answer_due is not None and now >= proxy.answer_due
+            stalled = any(self._stalled(r, now) for r in proxy.partial.values())
+            if due or stalled:
+                out.append(self._answer(proxy, self._missing(proxy), now))
         return out
 
-    def next_deadline(self, delay: float) -> Optional[float]:
-        """When :meth:`tick` may have something to ask (None: no sample half-received)."""
-        times = [max(r.updated, r.nacked) + delay for p in self.writers.values()
-                 for r in p.partial.values()]
+    def _stalled(self, r: _Reassembly, now: float) -> bool:
+        return now - r.updated >= self.nack_delay and now - r.nacked >= r.interval
+
+    def next_deadline(self) -> Optional[float]:
+        """When :meth:`tick` has something to do (None: nothing pending)."""
+        times = [max(r.updated + self.nack_delay, r.nacked + r.interval)
+                 for p in self.writers.values() for r in p.partial.values()]
+        times += [p.answer_due for p in self.writers.values() if p.answer_due is not None]
+        times += [p.unsynced_since + self.sync_timeout for p in self.writers.values()
+                  if not p.synced and p.unsynced_since is not None]
         return min(times) if times else None
 
     def nack_partial(self, writer: bytes) -> List[Datagram]:
@@ -401,4 +466,5 @@ class Reader:
         proxy = self.writers.get(writer)
         if proxy is None or not self.reliable or not proxy.partial:
             return []
-        return [self._answer(proxy, self._missing(proxy))]
+        now = max(r.updated for r in proxy.partial.values()) + self.nack_delay
+        return [self._answer(proxy, self._missing(proxy), now)]
