@@ -171,12 +171,12 @@ class Agent:
         if not ready:
             return {"ready": False}
         results = []
-        for i in range(c.get("count", 1)):
+        for _ in range(c.get("count", 1)):
             request = (SetBool.Request(data=bool(c.get("data", True)))
                        if srv_type is SetBool else Trigger.Request())
             future = client.call_async(request)
             done = threading.Event()
-            future.add_done_callback(lambda f: done.set())
+            future.add_done_callback(lambda f, done=done: done.set())
             done.wait(c.get("timeout", 10))
             result = future.result() if future.done() else None
             results.append(None if result is None else
