@@ -325,3 +325,27 @@ def read_setbool_response(payload: bytes) -> tuple:
 
 
 CDR_TRIGGER_REQUEST = CDR_LE + b"\0"  # an empty struct is one byte (structure_needs_at_least_one_field)
+
+
+def cdr_uint8_array(data: bytes) -> bytes:
+    """std_msgs/UInt8MultiArray with no dimensions: dim (empty), data_offset 0, data."""
+    return CDR_LE + struct.pack("<III", 0, 0, len(data)) + data
+
+
+def read_uint8_array(payload: memoryview) -> memoryview:
+    """The data of a std_msgs/UInt8MultiArray without dimensions."""
+    view = memoryview(payload)
+    dims, _, size = struct.unpack_from("<III", view, 4)
+    if dims:
+        raise ValueError("dimensions are not read here")
+    return view[16:16 + size]
+
+
+def cyclone_python() -> Path:
+    return ROS2_HOME / "cyclonedds" / "bin" / "python"
+
+
+def require_cyclone() -> None:
+    need(cyclone_python().exists(), f"cyclonedds-python is not installed in {ROS2_HOME}",
+         INSTALLER)
+    require_netns()
