@@ -40,7 +40,7 @@ __all__ = [
 
 Buffer = Union[bytes, bytearray, memoryview]
 
-#: the version minros writes in its header (Fast DDS 2.14 writes 2.2, 3.x 2.3, Cyclone 2.5 or
+#: the version minros writes in its header (Fast DDS 2.14 and 3.2 write 2.2, Cyclone 2.5 or
 #: 2.1; each accepts any 2.x)
 PROTOCOL_VERSION = (2, 4)
 HEADER_SIZE = 20
