@@ -20,6 +20,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any, Callable, List
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "tests"))
@@ -83,7 +84,7 @@ FIELDS = ["frame.number", "udp.srcport", "udp.dstport", "udp.payload", "rtps.ven
           "rtps.reliability_kind", "rtps.durability", "rtps.param.userData"]
 
 
-def capture(name: str, run) -> list:
+def capture(name: str, run: Callable[[Netns, Path], None]) -> list:
     """Run ``run(ns, tmp)`` under tshark in a fresh namespace; the frames as field dicts."""
     ns = Netns()
     with tempfile.TemporaryDirectory() as tmp_name:
@@ -105,7 +106,7 @@ def capture(name: str, run) -> list:
     return [frame["_source"]["layers"] for frame in json.loads(out)]
 
 
-def run_fastdds(distro: str):
+def run_fastdds(distro: str) -> Callable[[Netns, Path], None]:
     def run(ns: Netns, tmp: Path) -> None:
         script = tmp / "scenario.py"
         script.write_text(SCENARIO)
@@ -133,7 +134,7 @@ def withhold_a_fragment(ns: Netns) -> None:
     original = part.Participant._send
     dropped = []
 
-    def send(self, datagrams):
+    def send(self: Any, datagrams: List[Any]) -> None:
         kept = []
         for dg in datagrams:
             heads = [bytes(b[:36]) for b in dg.buffers[1:] if len(b) >= 36 and b[0] == m.DATA_FRAG]
@@ -176,7 +177,7 @@ def run_cyclone(ns: Netns, tmp: Path) -> None:
         agent.close()
 
 
-def first(frames: list, predicate) -> dict:
+def first(frames: list, predicate: Callable[[dict], bool]) -> dict:
     for f in frames:
         if predicate(f):
             return f
