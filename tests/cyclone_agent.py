@@ -158,6 +158,10 @@ class Agent:
         with self.lock:
             while len(self.received[sid]) < c.get("count", 1) and time.time() < deadline:
                 self.lock.wait(0.05)
+                # cyclonedds-python's listener does not always fire for a sample that came
+                # while the reader was being made (transient-local history): read it too
+                for msg in self.entities[sid].take(N=100):
+                    self.received[sid].append(summary(msg))
             return {"items": list(self.received[sid]), "count": len(self.received[sid])}
 
     def op_serve(self, c):

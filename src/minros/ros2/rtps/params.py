@@ -210,7 +210,7 @@ def decode_duration(value: memoryview, little: bool) -> float:
     sec, frac = struct.unpack_from("<iI" if little else ">iI", value)
     if (sec, frac) == _INFINITE or sec == 0x7FFFFFFF:
         return math.inf
-    return round(sec + frac / (1 << 32), 9)  # to the nanosecond: DDS's own unit
+    return float(round(sec + frac / (1 << 32), 9))  # to the nanosecond: DDS's own unit
 
 
 def decode_string(value: memoryview, little: bool) -> str:

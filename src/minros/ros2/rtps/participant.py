@@ -896,7 +896,7 @@ class Participant:
                 assert isinstance(sub, m.HeartbeatFrag)
                 for reader in self._route(sub.src + sub.writer_id, sub.reader_id):
                     with reader.lock:
-                        out += reader.machine.on_heartbeat_frag(sub)
+                        out += reader.machine.on_heartbeat_frag(sub, now)
             elif kind == m.ACKNACK or kind == m.NACK_FRAG:
                 writer = self._writers.get(sub.writer_id)  # type: ignore[attr-defined]
                 if writer is None:

@@ -44,7 +44,7 @@ class _Reassembly:
 
     __slots__ = ("size", "fragment_size", "total", "buffer", "view", "have", "missing",
                  "inline_qos", "timestamp", "little", "received", "updated", "nacked",
-                 "interval")
+                 "interval", "highest", "announced", "last_nack")
 
     def __init__(self, size: int, fragment_size: int, timestamp: Optional[int]) -> None:
         self.size = size
@@ -63,6 +63,10 @@ class _Reassembly:
         self.updated = 0.0
         self.nacked = -1.0
         self.interval = 0.0
+        #: the newest fragment that came (1-based), and the last one a HEARTBEAT_FRAG named
+        self.highest = 0
+        self.announced = 0
+        self.last_nack: List[int] = []
 
     def add(self, start: int, count: int, payload: memoryview) -> int:
         """Fragments ``start`` .. of ``payload``; returns the bytes that were new."""
@@ -82,6 +86,8 @@ class _Reassembly:
                 self.have[index] = 1
                 self.missing -= 1
                 new += want
+                if index + 1 > self.highest:
+                    self.highest = index + 1
         self.received += new
         return new
 
@@ -384,21 +390,17 @@ class Reader:
                 proxy.answer_due = now + self.response_delay
         return delivered, []
 
-    def on_heartbeat_frag(self, sub: m.HeartbeatFrag) -> List[Datagram]:
-        """A HEARTBEAT_FRAG: a NACK_FRAG when fragments of that sample are missing."""
+    def on_heartbeat_frag(self, sub: m.HeartbeatFrag, now: float = 0.0) -> List[Datagram]:
+        """A HEARTBEAT_FRAG: fragments 1 .. ``last_fragment`` of a sample were sent. Answered
+        at once (one datagram: NACK_FRAG of those missing, then ACKNACK), which is what a
+        writer's flow control waits for."""
         proxy = self.writers.get(sub.src + sub.writer_id)
         if proxy is None or not self.reliable:
             return []
         r = proxy.partial.get(sub.sn)
-        if r is None or not r.missing:
-            return []
-        base, frags = r.missing_fragments()
-        frags = [f for f in frags if f <= sub.last_fragment]
-        if not frags:
-            return []
-        proxy.nackfrag_count += 1
-        return [Datagram(proxy.addresses, [proxy.prefix, m.nack_frag(
-            self.entity, proxy.entity, sub.sn, base, frags, proxy.nackfrag_count)])]
+        if r is not None and sub.last_fragment > r.announced:
+            r.announced = min(sub.last_fragment, r.total)
+        return [self._answer(proxy, self._missing(proxy), now)]
 
     def _missing(self, proxy: WriterProxy) -> List[int]:
         top = min(proxy.known, proxy.next + m.MAX_SET_BITS - 1)
@@ -408,21 +410,27 @@ class Reader:
                 if sn not in have and sn not in skip and sn not in proxy.partial]
 
     def _answer(self, proxy: WriterProxy, missing: List[int], now: float) -> Datagram:
-        """ACKNACK, after a NACK_FRAG for each half-received sample whose fragments stopped
-        coming (``nack_delay`` without one; asked again with a growing interval)."""
+        """ACKNACK, after a NACK_FRAG for each half-received sample that misses fragments the
+        writer has sent: those before the newest that came (a datagram's fragments leave in
+        order), those a HEARTBEAT_FRAG named, and, when fragments stopped coming for
+        ``nack_delay``, all. The same request is not repeated within a growing interval."""
         parts: List[Buffer] = [proxy.prefix]
         for sn in sorted(proxy.partial):
             r = proxy.partial[sn]
-            if now - r.updated < self.nack_delay or now - r.nacked < r.interval:
-                continue
+            stalled = now - r.updated >= self.nack_delay
+            limit = r.total if stalled else max(r.highest - 1, r.announced)
             base, frags = r.missing_fragments()
-            if frags:
-                proxy.nackfrag_count += 1
-                parts.append(m.nack_frag(self.entity, proxy.entity, sn, base, frags,
-                                         proxy.nackfrag_count))
-                r.interval = self.nack_delay if r.nacked < r.updated else \
-                    min(r.interval * 2, 0.2)
-                r.nacked = now
+            frags = [f for f in frags if f <= limit]
+            if not frags:
+                continue
+            if frags == r.last_nack and now - r.nacked < r.interval:
+                continue
+            r.interval = self.nack_delay if frags != r.last_nack else min(r.interval * 2, 0.2)
+            r.last_nack = frags
+            r.nacked = now
+            proxy.nackfrag_count += 1
+            parts.append(m.nack_frag(self.entity, proxy.entity, sn, frags[0], frags,
+                                     proxy.nackfrag_count))
         proxy.acknack_count += 1
         parts.append(m.acknack(self.entity, proxy.entity, proxy.next, missing,
                                proxy.acknack_count, final=not missing))
@@ -449,7 +457,8 @@ class Reader:
         return out
 
     def _stalled(self, r: _Reassembly, now: float) -> bool:
-        return now - r.updated >= self.nack_delay and now - r.nacked >= r.interval
+        return now - r.updated >= self.nack_delay and now - r.nacked >= r.interval \
+            and r.missing > 0
 
     def next_deadline(self) -> Optional[float]:
         """When :meth:`tick` has something to do (None: nothing pending)."""

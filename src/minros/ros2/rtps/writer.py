@@ -278,12 +278,18 @@ class Writer:
         for guid in dirty:
             proxy = self.proxies.get(guid)
             if proxy is not None:
+                self._settle(proxy)
                 out += self._flush(proxy, now)
         return out
 
     def _answered(self, proxy: ReaderProxy, now: float) -> None:
-        """The reader answered: what was in flight has arrived or is named lost."""
+        """The reader answered (what was in flight arrived, or is named lost): settled in
+        :meth:`answer`, once the whole datagram was read."""
         self._dirty.add(proxy.guid)
+
+    def _settle(self, proxy: ReaderProxy) -> None:
+        """A window's worth of answers is in: the window doubles after a round without loss,
+        halves after one with loss."""
         if proxy.awaiting or proxy.in_flight:
             proxy.rounds += 1
             if proxy.lost:
@@ -398,8 +404,15 @@ class Writer:
             else:
                 self._add_data(batch, proxy, change)
         if proxy.reliable and (blocked or batch.fragments):
-            # the window is used up, or a fragmented sample went out: ask for an answer now
-            batch.add([self._heartbeat(proxy, final=False)])
+            # the window is used up, or a fragmented sample went out: ask for an answer now,
+            # naming the last fragment sent (a reader that reads HEARTBEAT_FRAG, as minros
+            # and Cyclone do, asks for exactly the ones lost; Fast DDS answers the HEARTBEAT)
+            parts: List[Buffer] = [self._heartbeat(proxy, final=False)]
+            if batch.last_fragment is not None:
+                self._hb_count += 1
+                parts.append(m.heartbeat_frag(proxy.entity, self.entity, *batch.last_fragment,
+                                              self._hb_count))
+            batch.add(parts)
             if blocked:
                 proxy.awaiting = True
             proxy.hb_due = now + max(0.005, self.heartbeat_period / 4)
@@ -453,6 +466,7 @@ class Writer:
             parts.append(pad)
         batch.add(parts, change.timestamp, alone=True)
         batch.fragments += 1
+        batch.last_fragment = (change.sn, frag)
         proxy.in_flight += len(piece)
 
     def _add_gaps(self, batch: _Batch, proxy: ReaderProxy, sns: List[int]) -> None:
@@ -474,7 +488,7 @@ def _runs(sns: List[int]) -> List[Tuple[int, int]]:
 class _Batch:
     """Submessages to one reader, packed into datagrams of at most MAX_DATAGRAM bytes."""
 
-    __slots__ = ("proxy", "parts", "size", "out", "timestamp", "fragments")
+    __slots__ = ("proxy", "parts", "size", "out", "timestamp", "fragments", "last_fragment")
 
     def __init__(self, proxy: ReaderProxy) -> None:
         self.proxy = proxy
@@ -483,6 +497,8 @@ class _Batch:
         self.out: List[Datagram] = []
         self.timestamp: Optional[int] = -1
         self.fragments = 0
+        #: (sequence number, fragment) of the last fragment added
+        self.last_fragment: Optional[Tuple[int, int]] = None
 
     def add(self, parts: List[Buffer], timestamp: Optional[int] = -1,
             alone: bool = False) -> None:
