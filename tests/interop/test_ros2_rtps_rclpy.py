@@ -154,7 +154,9 @@ def test_transient_local_reaches_late_joiners_both_ways(world):
 def test_best_effort_rclpy_subscriber(world):
     agent, node = world["agent"], world["node"]
     pub = node.create_publisher("be_out", STRING, type_hash=HASHES[STRING])
-    agent("sub", id="be", topic="be_out", type=STRING, qos={"reliability": "best_effort"})
+    # depth 100: a busy machine may leave rclpy's executor behind; its history keeps them
+    agent("sub", id="be", topic="be_out", type=STRING,
+          qos={"reliability": "best_effort", "depth": 100})
     assert pub.wait_for_subscriptions(1, 10)
     time.sleep(0.1)  # the subscriber's side matches on its own SEDP; best effort does not wait
     for i in range(50):

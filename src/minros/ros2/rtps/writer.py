@@ -4,7 +4,7 @@ reliability (HEARTBEAT, ACKNACK, GAP), fragmentation (DATA_FRAG, NACK_FRAG) and 
 A stateful writer keeps, for every matched reader, what that reader has acknowledged and what
 it asked for again (:class:`ReaderProxy`)::
 
-    write(payload)  -> the new sample to every proxy (DATA, or DATA_FRAGs within its window)
+    write(payload)  -> the new sample to every proxy (DATA, or DATA_FRAGs burst by burst)
     ACKNACK         -> the reader has all before `base`, misses `missing`: resend or GAP them
     NACK_FRAG       -> the reader misses these fragments of one sample: resend them
     tick(now)       -> HEARTBEATs to readers that have not acknowledged everything yet
@@ -14,12 +14,16 @@ them) after new data and periodically while data is unacknowledged; a reliable r
 a HEARTBEAT without the F flag with an ACKNACK (and NACK_FRAGs for half-received samples).
 
 **Flow control.** A peer's UDP receive buffer is what the OS gives it (212992 bytes by default
-on Linux: three 64 KiB datagrams), and a 6 MB image is a hundred of them. A burst larger than
-that buffer is lost whenever the reader's thread is not scheduled at that moment, so a proxy
-sends at most ``window`` bytes of fragments, then a HEARTBEAT that asks for an answer, and
-goes on when the answer (ACKNACK/NACK_FRAG) comes, resending what it names. The window
-doubles after a round without loss and halves after one with loss (between ``min_window``
-and ``max_window``), so it settles at what the reader keeps up with.
+on Linux: three 64 KiB datagrams; Fast DDS keeps that default), and a 6 MB image is a
+hundred datagrams. Sent in one burst it overflows whenever the reader's thread is not
+running at that moment, and on a loaded machine it often is not. So fragments go in
+bursts of ``burst`` bytes, ``gap`` seconds apart (the code that calls :meth:`Writer.tick`
+sends the next one), each followed by a HEARTBEAT and a HEARTBEAT_FRAG naming the last
+fragment sent; the reader's answer (NACK_FRAG for what was lost, ACKNACK) is resent from,
+and sizes the bursts: they halve after an answer naming losses and grow by a quarter after
+a full burst without (AIMD, as TCP's window). A burst starts at what the reader's vendor is
+known to receive (see the participant), and nothing waits for an answer unless
+``max_unanswered`` bytes went without one: Fast DDS answers a HEARTBEAT only after 5 ms.
 
 **History.** KEEP_LAST keeps the newest ``depth`` samples; KEEP_ALL keeps every sample until
 each reliable reader has acknowledged it, at most ``max_samples`` (:meth:`Writer.full` says
@@ -30,8 +34,8 @@ new reader at its next sample and GAPs what came before.
 
 from __future__ import annotations
 
-from collections import OrderedDict
-from typing import Dict, List, Optional, Sequence, Set, Tuple
+from collections import OrderedDict, deque
+from typing import Deque, Dict, List, Optional, Sequence, Set, Tuple
 
 from minros.ros2.rtps import messages as m
 from minros.ros2.rtps.endpoint import MAX_DATAGRAM, Address, Buffer, Datagram
@@ -61,12 +65,13 @@ class ReaderProxy:
     """The writer's view of one matched reader."""
 
     __slots__ = ("guid", "entity", "addresses", "reliable", "durable", "start", "acked", "sent",
-                 "resend", "frag_resend", "cursor", "in_flight", "window", "acknack_count",
-                 "nackfrag_count", "hb_due", "hb_backoff", "awaiting", "prefix", "lost",
-                 "rounds", "announced")
+                 "resend", "frag_resend", "cursor", "unanswered", "burst", "next_send",
+                 "paced", "acknack_count", "nackfrag_count", "hb_due", "hb_backoff",
+                 "awaiting", "prefix", "lost", "rounds", "cuts", "announced", "bursts",
+                 "answers_bursts", "cap", "answered")
 
     def __init__(self, guid: bytes, addresses: Sequence[Address], reliable: bool, durable: bool,
-                 message_header: bytes, window: int) -> None:
+                 message_header: bytes, burst: int) -> None:
         self.guid = guid
         self.entity = guid[12:]
         self.addresses = list(addresses)
@@ -85,21 +90,35 @@ class ReaderProxy:
         #: a sample sent in pieces: (sequence number, next fragment to send)
         self.cursor: Optional[Tuple[int, int]] = None
         #: bytes sent since the reader last answered
-        self.in_flight = 0
-        self.window = window
+        self.unanswered = 0
+        #: bytes of fragments sent in one go, then a pause of the writer's ``gap``
+        self.burst = burst
+        #: when the next burst may leave, and whether fragments wait for it
+        self.next_send = 0.0
+        self.paced = False
         self.acknack_count = -(1 << 31)
         self.nackfrag_count = -(1 << 31)
         #: when to send the next HEARTBEAT (None: nothing unacknowledged)
         self.hb_due: Optional[float] = None
         self.hb_backoff = 0.0
-        #: the window is used up: a HEARTBEAT asked for an answer, none came yet
+        #: ``max_unanswered`` bytes went without an answer: nothing more until one comes
         self.awaiting = False
         #: the message header and INFO_DST every datagram to this reader starts with
         self.prefix = message_header + m.info_dst(guid[:12])
         #: fragments resent since the last answer (this round's losses)
         self.lost = 0
         self.rounds = 0
+        self.cuts = 0
         self.announced = 0
+        #: a reader that answers every burst's HEARTBEAT_FRAG at once (minros's): what each
+        #: unanswered burst held, oldest first, so an answer frees exactly its burst
+        self.answers_bursts = False
+        self.bursts: Deque[Tuple[int, int]] = deque()
+        #: the highest ACKNACK count seen (such a reader's answer to a HEARTBEAT_FRAG counts
+        #: at least as high as it: the bursts up to that one are answered)
+        self.answered = -(1 << 31)
+        #: bytes that may go without an answer
+        self.cap = 64 << 20
 
 
 class Writer:
@@ -108,8 +127,9 @@ class Writer:
     def __init__(self, guid: bytes, message_header: bytes, *, reliable: bool = True,
                  transient_local: bool = False, keep_all: bool = False, depth: int = 10,
                  max_samples: int = 5000, fragment_size: int = FRAGMENT_SIZE,
-                 heartbeat_period: float = 0.1, window: int = 1 << 20,
-                 min_window: int = 4 * FRAGMENT_SIZE, max_window: int = 32 << 20) -> None:
+                 heartbeat_period: float = 0.1, burst: int = 3 * FRAGMENT_SIZE,
+                 gap: float = 0.0003, max_burst: int = 8 << 20,
+                 max_unanswered: int = 64 << 20) -> None:
         self.guid = guid
         self.entity = guid[12:]
         self.header = message_header
@@ -120,9 +140,10 @@ class Writer:
         self.max_samples = max(1, max_samples)
         self.fragment_size = fragment_size
         self.heartbeat_period = heartbeat_period
-        self.initial_window = window
-        self.min_window = min_window
-        self.max_window = max_window
+        self.burst = burst
+        self.gap = gap
+        self.max_burst = max_burst
+        self.max_unanswered = max_unanswered
         self.history: OrderedDict[int, _Change] = OrderedDict()
         self.last_sn = 0
         self.proxies: Dict[bytes, ReaderProxy] = {}
@@ -135,10 +156,17 @@ class Writer:
     # -- readers -----------------------------------------------------------------------------
 
     def add_reader(self, guid: bytes, addresses: Sequence[Address], reliable: bool,
-                   durable: bool, now: float) -> List[Datagram]:
-        """Match a reader. A durable reader of a transient-local writer gets the history."""
+                   durable: bool, now: float, burst: Optional[int] = None,
+                   answers_bursts: bool = False, cap: Optional[int] = None) -> List[Datagram]:
+        """Match a reader. A durable reader of a transient-local writer gets the history.
+        ``burst``: the bytes of fragments it is sent in one go at first (what its receive
+        buffer is thought to hold); ``answers_bursts``: it answers each HEARTBEAT_FRAG at
+        once (then at most ``cap`` bytes go unanswered: a slow reader is waited for instead
+        of overflowed)."""
         proxy = ReaderProxy(guid, addresses, reliable and self.reliable, durable,
-                            self.header, self.initial_window)
+                            self.header, burst or self.burst)
+        proxy.answers_bursts = answers_bursts
+        proxy.cap = cap or self.max_unanswered
         first = self._first_available()
         if durable and self.transient_local:
             proxy.start = first
@@ -174,7 +202,7 @@ class Writer:
     def write(self, payload: Buffer, now: float, *, inline_qos: bytes = b"",
               timestamp: Optional[int] = None, key: bool = False) -> Tuple[int, List[Datagram]]:
         """Add a sample (``payload`` with its encapsulation header; ``inline_qos`` a parameter
-        list with its sentinel) and send it to every reader as far as each one's window
+        list with its sentinel) and send it to every reader (a large one's first burst of
         allows. Returns its sequence number and the datagrams."""
         self.last_sn += 1
         sn = self.last_sn
@@ -231,6 +259,7 @@ class Writer:
         if proxy is None or not proxy.reliable or sub.count <= proxy.acknack_count:
             return
         proxy.acknack_count = sub.count
+        proxy.answered = max(proxy.answered, sub.count)
         base = sub.base
         if base - 1 > proxy.acked:
             proxy.acked = min(base - 1, self.last_sn)
@@ -278,7 +307,7 @@ class Writer:
         for guid in dirty:
             proxy = self.proxies.get(guid)
             if proxy is not None:
-                self._settle(proxy)
+                self._settle(proxy, now)
                 out += self._flush(proxy, now)
         return out
 
@@ -287,25 +316,36 @@ class Writer:
         :meth:`answer`, once the whole datagram was read."""
         self._dirty.add(proxy.guid)
 
-    def _settle(self, proxy: ReaderProxy) -> None:
-        """A window's worth of answers is in: the window doubles after a round without loss,
-        halves after one with loss."""
-        if proxy.awaiting or proxy.in_flight:
-            proxy.rounds += 1
-            if proxy.lost:
-                proxy.window = max(self.min_window, proxy.window // 2)
-            elif proxy.awaiting:
-                proxy.window = min(self.max_window, proxy.window * 2)
+    def _settle(self, proxy: ReaderProxy, now: float) -> None:
+        """An answer came: after loss the bursts halve, after a clean one they grow by a
+        fragment (between one fragment and ``max_burst``: AIMD)."""
+        answered = 0
+        if proxy.answers_bursts:
+            while proxy.bursts and proxy.bursts[0][0] <= proxy.answered:
+                answered += proxy.bursts.popleft()[1]
+            proxy.unanswered = max(0, proxy.unanswered - answered)
+        else:
+            answered = proxy.unanswered
+            proxy.unanswered = 0
+            proxy.bursts.clear()
+        if proxy.lost:
+            proxy.burst = max(self.fragment_size, proxy.burst // 2)
+            proxy.cuts += 1
+        elif answered:
+            proxy.burst = min(self.max_burst, proxy.burst + self.fragment_size)
+        proxy.rounds += 1
         proxy.lost = 0
-        proxy.in_flight = 0
-        proxy.awaiting = False
+        if proxy.unanswered < proxy.cap:
+            proxy.awaiting = False
 
     # -- time --------------------------------------------------------------------------------
 
     def tick(self, now: float) -> List[Datagram]:
-        """HEARTBEATs due (unacknowledged data, or a window waiting for an answer)."""
+        """The next bursts of fragments and the HEARTBEATs that are due."""
         out: List[Datagram] = []
         for proxy in self.proxies.values():
+            if proxy.paced and now >= proxy.next_send and not proxy.awaiting:
+                out += self._flush(proxy, now)
             if proxy.reliable:
                 out += self._heartbeat_if_due(proxy, now)
         return out
@@ -313,6 +353,7 @@ class Writer:
     def next_deadline(self) -> Optional[float]:
         """When :meth:`tick` has something to do next (None: nothing pending)."""
         due = [p.hb_due for p in self.proxies.values() if p.hb_due is not None]
+        due += [p.next_send for p in self.proxies.values() if p.paced and not p.awaiting]
         return min(due) if due else None
 
     def _heartbeat_if_due(self, proxy: ReaderProxy, now: float) -> List[Datagram]:
@@ -350,7 +391,8 @@ class Writer:
     # -- sending -----------------------------------------------------------------------------
 
     def _flush(self, proxy: ReaderProxy, now: float) -> List[Datagram]:
-        """Everything this reader should get now, as far as its window allows."""
+        """Everything this reader should get now: whole samples at once, fragments one burst
+        at a time (the rest when :meth:`tick` says the next burst is due)."""
         batch = _Batch(proxy)
         history = self.history
         if proxy.resend:
@@ -367,7 +409,11 @@ class Writer:
             proxy.resend.clear()
             if gaps:
                 self._add_gaps(batch, proxy, gaps)
-        blocked = False
+        budget = proxy.burst if now >= proxy.next_send else 0
+        if proxy.reliable and proxy.unanswered >= proxy.cap:
+            budget = 0  # a reader that stopped answering is not flooded
+            proxy.awaiting = True
+        paced = False
         for sn in sorted(proxy.frag_resend):
             change = history.get(sn)
             frags = proxy.frag_resend[sn]
@@ -376,67 +422,74 @@ class Writer:
                 self._add_gaps(batch, proxy, [sn])
                 continue
             for frag in sorted(frags):
-                if proxy.reliable and proxy.in_flight >= proxy.window:
-                    blocked = True
+                if budget <= 0:
+                    paced = True
                     break
-                self._add_fragment(batch, proxy, change, frag)
+                budget -= self._add_fragment(batch, proxy, change, frag)
                 frags.discard(frag)
                 self.fragments_resent += 1
             if not frags:
                 del proxy.frag_resend[sn]
-            if blocked:
+            if paced:
                 break
-        if not blocked and proxy.cursor is not None:
-            blocked = self._continue_cursor(batch, proxy)
-        while not blocked and proxy.sent < self.last_sn:
+        if not paced and proxy.cursor is not None:
+            paced, budget = self._continue_cursor(batch, proxy, budget)
+        while not paced and proxy.sent < self.last_sn:
             sn = proxy.sent + 1
             change = history.get(sn)
-            proxy.sent = sn
             if change is None:  # dropped from the history before it was sent: a GAP
+                proxy.sent = sn
                 self._add_gaps(batch, proxy, [sn])
-                continue
-            if change.size > self.fragment_size:
+            elif change.size > self.fragment_size:
+                if budget <= 0:
+                    paced = True
+                    break
+                proxy.sent = sn
                 proxy.cursor = (sn, 1)
-                blocked = self._continue_cursor(batch, proxy)
-            elif proxy.reliable and proxy.in_flight >= proxy.window:
-                proxy.sent = sn - 1
-                blocked = True
+                paced, budget = self._continue_cursor(batch, proxy, budget)
             else:
+                proxy.sent = sn
                 self._add_data(batch, proxy, change)
-        if proxy.reliable and (blocked or batch.fragments):
-            # the window is used up, or a fragmented sample went out: ask for an answer now,
-            # naming the last fragment sent (a reader that reads HEARTBEAT_FRAG, as minros
-            # and Cyclone do, asks for exactly the ones lost; Fast DDS answers the HEARTBEAT)
-            parts: List[Buffer] = [self._heartbeat(proxy, final=False)]
-            if batch.last_fragment is not None:
-                self._hb_count += 1
-                parts.append(m.heartbeat_frag(proxy.entity, self.entity, *batch.last_fragment,
-                                              self._hb_count))
-            batch.add(parts)
-            if blocked:
-                proxy.awaiting = True
-            proxy.hb_due = now + max(0.005, self.heartbeat_period / 4)
-            proxy.hb_backoff = proxy.hb_due - now
+        proxy.paced = paced
+        if batch.fragments:
+            proxy.next_send = now + self.gap
+            if proxy.reliable:
+                # ask for an answer, naming the last fragment sent (a reader that reads
+                # HEARTBEAT_FRAG, as minros and Cyclone do, answers at once with exactly the
+                # ones lost; Fast DDS answers the HEARTBEAT, 5 ms later)
+                parts: List[Buffer] = [self._heartbeat(proxy, final=False)]
+                if batch.last_fragment is not None:
+                    # counts leave room: a reader's other answers between two bursts, each
+                    # counting one more, do not reach the next burst's
+                    self._hb_count += 16
+                    parts.append(m.heartbeat_frag(proxy.entity, self.entity,
+                                                  *batch.last_fragment, self._hb_count))
+                    proxy.bursts.append((self._hb_count, batch.fragment_bytes))
+                batch.add(parts)
+                proxy.hb_due = now + max(0.005, self.heartbeat_period / 4)
+                proxy.hb_backoff = proxy.hb_due - now
         return batch.finish()
 
-    def _continue_cursor(self, batch: _Batch, proxy: ReaderProxy) -> bool:
-        """Send fragments of the sample in progress; True when the window stopped it."""
+    def _continue_cursor(self, batch: _Batch, proxy: ReaderProxy,
+                         budget: int) -> Tuple[bool, int]:
+        """Fragments of the sample in progress while ``budget`` bytes last: (whether some wait
+        for the next burst, the budget left)."""
         assert proxy.cursor is not None
         sn, frag = proxy.cursor
         change = self.history.get(sn)
         if change is None:
             proxy.cursor = None
             self._add_gaps(batch, proxy, [sn])
-            return False
+            return False, budget
         total = self._fragments(change)
         while frag <= total:
-            if proxy.reliable and proxy.in_flight >= proxy.window:
+            if budget <= 0:
                 proxy.cursor = (sn, frag)
-                return True
-            self._add_fragment(batch, proxy, change, frag)
+                return True, budget
+            budget -= self._add_fragment(batch, proxy, change, frag)
             frag += 1
         proxy.cursor = None
-        return False
+        return False, budget
 
     def _fragments(self, change: _Change) -> int:
         return -(-change.size // self.fragment_size)
@@ -450,10 +503,10 @@ class Writer:
         if pad:
             parts.append(pad)
         batch.add(parts, change.timestamp)
-        proxy.in_flight += change.size
+        proxy.unanswered += change.size
 
     def _add_fragment(self, batch: _Batch, proxy: ReaderProxy, change: _Change,
-                      frag: int) -> None:
+                      frag: int) -> int:
         size = self.fragment_size
         offset = (frag - 1) * size
         piece = memoryview(change.payload)[offset:offset + size]
@@ -466,8 +519,10 @@ class Writer:
             parts.append(pad)
         batch.add(parts, change.timestamp, alone=True)
         batch.fragments += 1
+        batch.fragment_bytes += len(piece)
         batch.last_fragment = (change.sn, frag)
-        proxy.in_flight += len(piece)
+        proxy.unanswered += len(piece)
+        return len(piece)
 
     def _add_gaps(self, batch: _Batch, proxy: ReaderProxy, sns: List[int]) -> None:
         for start, end in _runs(sns):
@@ -488,7 +543,8 @@ def _runs(sns: List[int]) -> List[Tuple[int, int]]:
 class _Batch:
     """Submessages to one reader, packed into datagrams of at most MAX_DATAGRAM bytes."""
 
-    __slots__ = ("proxy", "parts", "size", "out", "timestamp", "fragments", "last_fragment")
+    __slots__ = ("proxy", "parts", "size", "out", "timestamp", "fragments", "last_fragment",
+                 "fragment_bytes")
 
     def __init__(self, proxy: ReaderProxy) -> None:
         self.proxy = proxy
@@ -497,6 +553,7 @@ class _Batch:
         self.out: List[Datagram] = []
         self.timestamp: Optional[int] = -1
         self.fragments = 0
+        self.fragment_bytes = 0
         #: (sequence number, fragment) of the last fragment added
         self.last_fragment: Optional[Tuple[int, int]] = None
 
