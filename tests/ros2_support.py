@@ -88,15 +88,17 @@ def _ip(*args: str) -> None:
 
 class Netns:
     """A network namespace with only loopback, multicast on (DDS's discovery group routed to
-    lo). Named uniquely (pid and a counter): other test runs share the machine."""
+    lo) unless ``multicast`` is False (as lo is outside a namespace: no multicast at all).
+    Named uniquely (pid and a counter): other test runs share the machine."""
 
-    def __init__(self) -> None:
+    def __init__(self, multicast: bool = True) -> None:
         self.name = f"mrtps{os.getpid()}x{next(_counter)}"
         _ip("netns", "add", self.name)
         try:
             _ip("netns", "exec", self.name, "ip", "link", "set", "lo", "up")
-            _ip("netns", "exec", self.name, "ip", "link", "set", "lo", "multicast", "on")
-            _ip("netns", "exec", self.name, "ip", "route", "add", "224.0.0.0/4", "dev", "lo")
+            if multicast:
+                _ip("netns", "exec", self.name, "ip", "link", "set", "lo", "multicast", "on")
+                _ip("netns", "exec", self.name, "ip", "route", "add", "224.0.0.0/4", "dev", "lo")
         except Exception:
             self.delete()
             raise

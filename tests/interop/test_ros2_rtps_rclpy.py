@@ -332,3 +332,34 @@ def test_a_peer_killed_is_dropped_after_its_lease_and_minros_goes_on(world, capl
     pub.publish(cdr_string("still here"))
     assert world["agent"]("received", id="after", count=1)["items"] == ["still here"]
     pub.destroy()
+
+
+@pytest.mark.parametrize("distro", ["jazzy", "kilted"])
+def test_localhost_only_discovery_without_multicast(distro, tmp_path, caplog):
+    """No multicast at all (lo as a host has it: no MULTICAST flag, no route):
+    ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST makes Fast DDS announce itself to the unicast
+    ports of participant ids 0-31 on 127.0.0.1, as minros does: they find each other."""
+    require_ros2(distro)
+    caplog.set_level(logging.INFO, logger="minros.ros2")
+    ns = Netns(multicast=False)
+    agent = ctx = None
+    try:
+        agent = Agent(ns, ros2_python(distro), AGENT, "local_agent", tmp_path,
+                      env={"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"})
+        ctx = context(ns)
+        assert ctx.participant.mc_sock is None
+        node = ctx.create_node("minros_local")
+        pub = node.create_publisher("local", STRING, type_hash=HASHES[STRING])
+        agent("sub", id="l", topic="local", type=STRING)
+        seen = agent("graph", want_node="minros_local", timeout=10)
+        assert ("minros_local", "/") in [tuple(n) for n in seen["nodes"]]
+        assert pub.wait_for_subscriptions(1, 10)
+        pub.publish(cdr_string("by unicast"))
+        assert agent("received", id="l", count=1)["items"] == ["by unicast"]
+        assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+    finally:
+        if ctx is not None:
+            ctx.shutdown()
+        if agent is not None:
+            agent.close()
+        ns.delete()

@@ -315,7 +315,12 @@ class Participant:
         send.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
         send.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
         self.mc_sock: Optional[socket.socket] = None
-        if self.multicast:
+        if self.multicast and not _multicast_capable(self.host):
+            # a host's lo has no MULTICAST flag: the group would be sent to and never heard
+            log.info("ROS 2: the interface of %s does not do multicast; discovering by "
+                     "unicast to the participant ports of localhost (as Fast DDS does with "
+                     "ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST)", self.host)
+        elif self.multicast:
             mc = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
             mc.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             if hasattr(socket, "SO_REUSEPORT"):
@@ -1037,6 +1042,33 @@ class Participant:
         for prefix, lease in expired:
             self._remove_participant(prefix, f"is gone: nothing heard from it for its lease "
                                              f"of {lease:g} s")
+
+
+def _multicast_capable(host: str) -> bool:
+    """Whether the interface that has address ``host`` has the MULTICAST flag (Linux
+    ioctls; elsewhere, or when no interface has it, True: multicast is tried)."""
+    try:
+        import fcntl
+        import struct
+
+        probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    except (ImportError, OSError):
+        return True
+    try:
+        for _, name in socket.if_nameindex():
+            raw = name.encode()[:15]
+            try:
+                addr = fcntl.ioctl(probe.fileno(), 0x8915, struct.pack("16sH14s", raw, 0,
+                                                                       b""))  # SIOCGIFADDR
+            except OSError:
+                continue
+            if socket.inet_ntoa(addr[20:24]) != host:
+                continue
+            flags = fcntl.ioctl(probe.fileno(), 0x8913, struct.pack("16sH", raw, 0))
+            return bool(struct.unpack("16sH", flags[:18])[1] & 0x1000)  # IFF_MULTICAST
+        return True
+    finally:
+        probe.close()
 
 
 def _readable(sock: socket.socket) -> bool:
