@@ -165,12 +165,16 @@ def run_cyclone(ns: Netns, tmp: Path) -> None:
         node = ctx.create_node("listener")
         node.create_subscription("chatter", "std_msgs/msg/String", lambda p, i: None)
         node.create_subscription("big", "std_msgs/msg/UInt8MultiArray", lambda p, i: None)
+        # a SetBool server the Cyclone client calls in rmw_cyclonedds's in-band form
+        node.create_service("set", "std_srvs/srv/SetBool",
+                            lambda req: b"\x00\x01\x00\x00\x01\x00\x00\x00\x03\x00\x00\x00on\x00")
         agent("pub", id="talker", topic="chatter", type="std_msgs/msg/String")
         agent("pub", id="big", topic="big", type="std_msgs/msg/UInt8MultiArray")
         agent("matched", id="talker")
         agent("matched", id="big")
         agent("publish", id="talker", count=5)
         agent("publish", id="big", count=1, size=20_000)
+        agent("call", name="set", data=True)
         time.sleep(0.5)
     finally:
         ctx.shutdown()
@@ -213,7 +217,8 @@ def kinds(frames: list, source: str, vendor: str) -> list:
         "discovery_info": lambda f: "0x15" in ids(f) and "ros_discovery_info" in topics(f)
         and user(f),
         "heartbeat": lambda f: "0x07" in ids(f),
-        "acknack": lambda f: "0x06" in ids(f),
+        "acknack": lambda f: "0x06" in ids(f) and any(
+            r in ("0x000003c7", "0x000004c7") for r in f.get("rtps.sm.rdEntityId", [])),
         "data_frag": lambda f: "0x16" in ids(f),
         "nack_frag": lambda f: "0x12" in ids(f),
         "gap": lambda f: "0x08" in ids(f),
@@ -245,6 +250,7 @@ def main() -> None:
                         if v["kind"] in ("spdp", "data_frag", "heartbeat")]
     frames = capture("cyclone", run_cyclone)
     vectors += kinds(frames, "Cyclone DDS 11.0.1 (cyclonedds-python)", "0x0110")
+    vectors += [v for v in kinds(frames, "minros (to Cyclone)", "0x016d") if v["kind"] == "reply"]
     OUT.parent.mkdir(parents=True, exist_ok=True)
     OUT.write_text(json.dumps(vectors, indent=1) + "\n")
     for v in vectors:
