@@ -322,7 +322,9 @@ class Publisher:
         node._register(self, [], [self.gid])
 
     def publish(self, payload: Payload) -> int:
-        """Send one serialized sample; its sequence number."""
+        """Send one serialized sample (CDR, encapsulation header first); its sequence number.
+        The payload object is kept, not copied, while it is in the history (resends, late
+        joiners): do not change it afterwards (bytes cannot be)."""
         return self.writer.write(payload)
 
     def get_subscription_count(self) -> int:

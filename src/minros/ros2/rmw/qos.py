@@ -72,7 +72,8 @@ def from_dds(qos: d.Qos) -> QoSProfile:
         reliability="reliable" if qos.reliability == d.RELIABLE else "best_effort",
         durability="transient_local" if qos.durability >= d.TRANSIENT_LOCAL else "volatile",
         history="keep_all" if qos.history == d.KEEP_ALL else "keep_last",
-        depth=qos.depth if qos.history != d.KEEP_ALL else max(qos.depth, 0),
+        # (a remote endpoint's history is not on the wire: the default's depth, 1, then)
+        depth=max(qos.depth, 1),
         deadline=qos.deadline, lifespan=qos.lifespan,
         liveliness="manual_by_topic" if qos.liveliness == d.MANUAL_BY_TOPIC else "automatic",
         liveliness_lease_duration=qos.lease_duration)
