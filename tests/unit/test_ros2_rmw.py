@@ -111,8 +111,16 @@ def test_the_graph_joins_nodes_and_endpoints():
 
 def test_two_minros_contexts_pubsub_and_a_service():
     """minros to minros (no peer of another vendor): the same code paths, in one process."""
-    from ros2_support import Netns, cdr_setbool_request, cdr_setbool_response, cdr_string, \
-        context, read_setbool_response, read_string, require_netns
+    from ros2_support import (
+        Netns,
+        cdr_setbool_request,
+        cdr_setbool_response,
+        cdr_string,
+        context,
+        read_setbool_response,
+        read_string,
+        require_netns,
+    )
 
     require_netns()
     ns = Netns()
