@@ -28,7 +28,6 @@ at most ``max_pending`` samples wait behind a gap, after which the reader gives 
 from __future__ import annotations
 
 import mmap
-import sys
 from typing import Dict, List, Optional, Sequence, Set, Tuple
 
 from minros.ros2.rtps import messages as m
@@ -263,15 +262,18 @@ class Reader:
         del self._delivered[:-2]
         return self._arrived(proxy, sn, sample)
 
-    def _reuse(self, size: int) -> mmap.mmap | bytearray | None:
-        """A buffer of a delivered sample nobody holds any more (no view of it is left: its
-        reference count is back to this list's), for the next sample of the same size: a
-        fresh 6 MB buffer costs 1500 page faults, each zeroing a page."""
+    def _reuse(self, size: int) -> "mmap.mmap | bytearray | None":
+        """A memory map of a delivered sample nobody holds a view of any more, for the next
+        sample of the same size: a fresh 6 MB buffer costs 1500 page faults, each zeroing a
+        page. (A map with views exported refuses to be resized: that is the test.)"""
         delivered = self._delivered
-        for i in range(len(delivered)):  # (enumerate's reused tuple would hold one more)
+        for i in range(len(delivered)):
             buffer = delivered[i]
-            # references: the list, `buffer`, getrefcount's argument
-            if len(buffer) == size and sys.getrefcount(buffer) <= 3:
+            if isinstance(buffer, mmap.mmap) and len(buffer) == size:
+                try:
+                    buffer.resize(size)
+                except (BufferError, OSError, ValueError, SystemError):
+                    continue
                 del delivered[i]
                 return buffer
         return None
