@@ -262,7 +262,7 @@ class Reader:
         del self._delivered[:-2]
         return self._arrived(proxy, sn, sample)
 
-    def _reuse(self, size: int) -> "mmap.mmap | bytearray | None":
+    def _reuse(self, size: int) -> mmap.mmap | bytearray | None:
         """A memory map of a delivered sample nobody holds a view of any more, for the next
         sample of the same size: a fresh 6 MB buffer costs 1500 page faults, each zeroing a
         page. (A map with views exported refuses to be resized: that is the test.)"""
