@@ -285,3 +285,19 @@ def test_a_huge_gap_range_is_not_walked():
     gap = m.parse_message(m.header(WPREFIX) + m.gap(RGUID[12:], WGUID[12:], 5, 1 << 40))
     reader.on_gap(gap.submessages[0])  # type: ignore[arg-type]
     assert len(reader.writers[WGUID].irrelevant) <= reader.max_pending
+
+
+def test_keep_all_holds_what_is_unacknowledged_and_says_when_full():
+    net = Net(keep_all=True, max_samples=5, depth=1)
+    net.match()
+    net.loss = 1.0  # nothing gets through: nothing is acknowledged
+    for i in range(5):
+        net.write(payload(i))
+    assert net.writer.full() and len(net.writer.history) == 5
+    net.loss = 0.0
+    net.run_until(lambda: len(net.got) == 5 and not net.writer.full())
+    assert net.numbers() == list(range(5))
+    for _ in range(50):
+        net.step()
+    net.write(payload(5))
+    assert len(net.writer.history) <= 2  # acknowledged samples left the history
