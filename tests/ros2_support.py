@@ -15,6 +15,7 @@ import itertools
 import json
 import os
 import queue
+import re
 import shutil
 import struct
 import subprocess
@@ -86,12 +87,29 @@ def _ip(*args: str) -> None:
     subprocess.run(["ip", *args], check=True, capture_output=True, timeout=20)
 
 
+def _sweep() -> None:
+    """Delete this helper's namespaces left by a run that was killed (their pid is gone and
+    nothing runs in them)."""
+    try:
+        names = os.listdir("/var/run/netns")
+    except OSError:
+        return
+    for name in names:
+        found = re.fullmatch(r"mrtps(\d+)x\d+", name)
+        if found is None or os.path.exists(f"/proc/{found.group(1)}"):
+            continue
+        pids = subprocess.run(["ip", "netns", "pids", name], capture_output=True, text=True)
+        if pids.returncode == 0 and not pids.stdout.strip():
+            subprocess.run(["ip", "netns", "del", name], capture_output=True, timeout=20)
+
+
 class Netns:
     """A network namespace with only loopback, multicast on (DDS's discovery group routed to
     lo) unless ``multicast`` is False (as lo is outside a namespace: no multicast at all).
     Named uniquely (pid and a counter): other test runs share the machine."""
 
     def __init__(self, multicast: bool = True) -> None:
+        _sweep()
         self.name = f"mrtps{os.getpid()}x{next(_counter)}"
         _ip("netns", "add", self.name)
         try:
