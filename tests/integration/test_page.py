@@ -432,6 +432,44 @@ def test_parameter_edit_reaches_the_parameter_server(page, system):
 
 # -- console -------------------------------------------------------------------------------------
 
+def test_a_urdf_parameter_reads_as_text_folded_under_its_first_line(page, system):
+    """A long multi-line string (a URDF, as /robot_description holds) used to be one line of
+    escaped "\\n"s; now it is folded under its first line and its size, opens as preformatted
+    text, stays open while the tree is redrawn, and is edited in a text box."""
+    urdf = (WEB / "scene_pkg" / "urdf" / "robot.urdf").read_text()
+    name = "/page_test/robot_description"
+    assert system.master.setParam("/t", name, urdf)[0] == 1
+    page.open("params")
+    view = page.view("params")
+    view.locator("summary", has_text="page_test/").click()  # a new tab: the tree is folded
+    row = view.locator(f'[data-param="{name}"]')
+    text = row.locator("details.param-text")
+    text.wait_for(timeout=10_000)
+    lines = urdf.count("\n") + (0 if urdf.endswith("\n") else 1)
+    summary = text.locator("summary").inner_text()
+    assert summary.startswith('<?xml version="1.0"?>') and f"{lines} lines" in summary, summary
+    pre = text.locator("pre")
+    assert not pre.is_visible()  # folded: the tree stays readable
+    text.locator("summary").click()
+    assert pre.is_visible() and pre.text_content() == urdf
+    # a string that is one line and its newline ("noetic\\n", as ROS sets it) stays a line
+    distro = view.locator('[data-param="/rosdistro"]')
+    assert distro.locator(".param-yaml").inner_text() == '"noetic\\n"'
+    page.shot("params_urdf")
+    # a change elsewhere redraws the tree: the text stays open
+    assert system.master.setParam("/t", "/page_test/redraw", 1)[0] == 1
+    view.locator('[data-param="/page_test/redraw"]').wait_for(timeout=10_000)
+    assert row.locator("details.param-text pre").is_visible()
+    row.locator("button", has_text="Edit").click()
+    area = row.locator("textarea.param-edit-text")
+    assert area.input_value() == urdf
+    edited = urdf.replace('<robot name="scene_bot">', '<robot name="renamed_bot">')
+    area.fill(edited)
+    row.locator("button", has_text="Save").click()
+    wait_until(lambda: system.param(name) == edited, timeout=10, what="the edited URDF")
+    row.locator("details.param-text pre", has_text="renamed_bot").wait_for(timeout=10_000)
+
+
 def test_console_filters_by_level_and_regex(page):
     page.open("console")
     view = page.view("console")

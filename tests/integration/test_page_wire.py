@@ -270,7 +270,7 @@ def test_missing_cut_and_foreign_trace_files_are_reported_and_the_server_keeps_g
     missing = tmp_path / "later.jsonl"
     web_port = free_port()
     web = run.start([PYTHON, "-m", "minros", "web", "--port", str(web_port), "--trace",
-                     str(missing), str(cut), str(foreign)])
+                     str(missing), str(cut), str(foreign), "__name:=web_bad_traces"])
     web.read_until("listening on", timeout=30)
 
     class Where:

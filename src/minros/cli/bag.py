@@ -478,11 +478,12 @@ def fix_cmd(argv: List[str], prog: str = "rosbag") -> int:
     return 1
 
 
-def _unavailable(name: str, why: str) -> Callable[[List[str], str], int]:
+def _unavailable(name: str, fix: str) -> Callable[[List[str], str], int]:
+    """A rosbag command minros does not have: one line, with ``-h`` too (no usage of a command
+    that does nothing)."""
     def cmd(argv: List[str], prog: str) -> int:
-        p = _parser(prog, f"rosbag {name} [options] ...", DESCRIPTIONS[name])
-        p.parse_args(argv)  # -h still prints a usage
-        return _fail(f"ERROR: rosbag {name} is not available in minros: {why}")
+        return _fail(f"ERROR: rosbag {name} is not available in minros (it reads and writes "
+                     f"unencrypted bags only): {fix}")
 
     return cmd
 
@@ -490,23 +491,20 @@ def _unavailable(name: str, why: str) -> Callable[[List[str], str], int]:
 COMMANDS: Dict[str, Callable[[List[str], str], int]] = {
     "check": check_cmd, "compress": compress_cmd, "convert": convert_cmd,
     "decompress": decompress_cmd,
-    "decrypt": _unavailable("decrypt", "encrypted bags are not supported"),
-    "encrypt": _unavailable("encrypt", "encrypted bags are not supported"),
+    "decrypt": _unavailable("decrypt", "decrypt the bag with ROS's rosbag decrypt first"),
+    "encrypt": _unavailable("encrypt", "use ROS's rosbag encrypt, or encrypt the whole file "
+                                       "(gpg -c BAG)"),
     "filter": filter_cmd,
     "fix": fix_cmd,
     "info": info_cmd, "play": play_cmd, "record": record_cmd, "reindex": reindex_cmd,
 }
+#: in COMMANDS for scripts written for ROS's rosbag, not offered by --help
+UNAVAILABLE = ("decrypt", "encrypt")
 
 
-#: minros's own sub-commands: ``minros bag`` lists them; ``rosbag``'s list stays ROS's (they
-#: run under both names)
-MINROS_ONLY = ("convert",)
-
-
-def _valid_cmds(prog: str = "rosbag") -> str:
+def _valid_cmds() -> str:
     out = "Available subcommands:\n"
-    names = [n for n in COMMANDS if prog != "rosbag" or n not in MINROS_ONLY]
-    for name in sorted([*names, "help"]):
+    for name in sorted([*(c for c in COMMANDS if c not in UNAVAILABLE), "help"]):
         out += f"   {name}  "
         if name in DESCRIPTIONS:
             out += f"\t{DESCRIPTIONS[name]}"
@@ -522,14 +520,14 @@ def _help(argv: List[str], prog: str) -> int:
         print("A bag is a file format in ROS for storing ROS message data. The rosbag command "
               "can record, replay and manipulate bags.")
         print()
-        print(_valid_cmds(prog))
+        print(_valid_cmds())
         print("For additional information, see http://wiki.ros.org/rosbag")
         print()
         return 0
     if argv[0] in COMMANDS:
         return _run(argv[0], ["-h"], prog)
     print(f"Unknown command: '{argv[0]}'", file=sys.stderr)
-    print(_valid_cmds(prog), file=sys.stderr)
+    print(_valid_cmds(), file=sys.stderr)
     return 0
 
 

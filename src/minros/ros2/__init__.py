@@ -12,11 +12,14 @@ layers under it):
     generated ROS 1 <-> CDR byte converters the bridge and bag conversion run per message.
     Sits on :mod:`minros.msgs` (the ROS 1 message system) and nothing else of minros.
 ``rtps/``
-    DDSI-RTPS, sans-IO: discovery (SPDP, SEDP), reliable writers and readers, fragments.
-    (Written in its own session.)
-the ROS 2 node and the bridge
-    A ROS 2 participant on the RTPS layer, and ``minros ros2``, joining a ROS 1 graph to a
-    ROS 2 domain. (Written in their own sessions.)
+    DDSI-RTPS: the wire (messages, parameter lists), discovery data (SPDP, SEDP, QoS matching),
+    reliable and best-effort writers and readers as state machines (fragments, flow control),
+    all without I/O, and ``participant``, the thin UDP layer on loopback under them.
+``rmw/``
+    What ROS 2's middleware puts on DDS: nodes, rmw's topic and type names, QoS profiles,
+    the graph (``ros_discovery_info``), services and clients in each vendor's form.
+the bridge
+    ``minros ros2``, joining a ROS 1 graph to a ROS 2 domain, on ``rmw`` and ``types``.
 
 Importing this package imports nothing.
 """
