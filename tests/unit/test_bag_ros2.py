@@ -250,6 +250,13 @@ def test_info_echo_and_the_bag_api_read_rosbag2(bag, tmp_path, capsys):
     assert rostopic(["echo", "-b", str(out), "-n", "1", "/odom/pose/pose/position"]) == 0
     text = capsys.readouterr().out
     assert text == "x: 0.0\ny: 0.0\nz: 0.0\n---\n"
+    # a topic that does not read as ROS 1 is named with the reason
+    meta = out / "metadata.yaml"
+    meta.write_text(meta.read_text().replace("type: std_msgs/msg/String",
+                                             "type: nowhere_msgs/msg/Gone"))
+    assert rostopic(["echo", "-b", str(out), "/chatter"]) == 1
+    err = capsys.readouterr().err
+    assert "/chatter [nowhere_msgs/msg/Gone]" in err and "does not read as ROS 1" in err
 
 
 def test_rosbag2_from_another_writer_with_its_own_custom_type(tmp_path, capsys):
@@ -370,6 +377,14 @@ def test_convert_usage(bag, tmp_path, capsys):
     status, _text, err = run(capsys, "convert", str(bag), str(tmp_path / "taken"))
     assert status == 1 and "exists already: remove it, give another output name, or pass " \
                            "--force" in err
+    (tmp_path / "taken" / "notes.txt").write_text("mine")
+    status, _text, err = run(capsys, "convert", str(bag), str(tmp_path / "taken"), "--force")
+    assert status == 1 and "is a directory that is not a ROS 2 recording" in err
+    assert (tmp_path / "taken" / "notes.txt").exists()
+    assert rosbag(["convert", "-q", str(bag), str(tmp_path / "rec")]) == 0
+    assert rosbag(["convert", "-q", "--force", "--topic", "/odom", str(bag),
+                   str(tmp_path / "rec")]) == 0
+    assert load_metadata(tmp_path / "rec")["message_count"] == 4
     status, _text, err = run(capsys, "convert", str(bag), str(tmp_path / "x.txt"), "--to", "ros1")
     assert status == 1 and "must end in .bag (or .mcap for ROS 1 MCAP)" in err
     status, _text, err = run(capsys, "convert", str(bag), str(tmp_path / "x.bag"), "--to", "ros1")

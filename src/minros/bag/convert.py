@@ -327,6 +327,16 @@ def _same(data: Any) -> Any:
     return data
 
 
+def _replaceable(path: str) -> bool:
+    """Whether directory ``path`` holds only what a rosbag2 recording does (--force may go)."""
+    try:
+        names = os.listdir(path)
+    except OSError:
+        return False
+    return all(n == "metadata.yaml" or n.endswith((".mcap", ".db3", ".db3-journal", ".zstd"))
+               for n in names)
+
+
 def _remove(path: str) -> None:
     try:
         if os.path.isdir(path):
@@ -361,6 +371,9 @@ def convert(src: str, dst: str, to: Optional[str] = None, storage: str = "mcap",
         if not force:
             return fail(f"ERROR: {dst} exists already: remove it, give another output name, "
                         f"or pass --force to replace it")
+        if os.path.isdir(dst) and not _replaceable(dst):
+            return fail(f"ERROR: {dst} is a directory that is not a ROS 2 recording: --force "
+                        f"replaces only recordings (remove it yourself, or give another name)")
         _remove(dst)
     if to == "ros1" and not (dst.endswith(".bag") or dst.endswith(".mcap")):
         return fail(f"ERROR: the ROS 1 output {dst} must end in .bag (or .mcap for ROS 1 MCAP)")
