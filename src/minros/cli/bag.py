@@ -1,4 +1,5 @@
-"""``rosbag`` / ``minros bag``: record, play, info, filter, compress, decompress, reindex, check.
+"""``rosbag`` / ``minros bag``: record, play, info, filter, compress, decompress, reindex, check,
+and convert (minros's: ROS 1 bags to ROS 2 recordings and back).
 
 The options, help texts, messages and exit statuses are rosbag's (ros_comm noetic); the work
 is done by :mod:`minros.bag`.
@@ -17,6 +18,7 @@ from minros.tools.common import strip_ros_args
 DESCRIPTIONS = {
     "check": "Determine whether a bag is playable in the current system, or if it can be migrated.",
     "compress": "Compress one or more bag files.",
+    "convert": "Convert a bag to a ROS 2 recording (rosbag2), or a ROS 2 recording to a bag.",
     "decompress": "Decompress one or more bag files.",
     "decrypt": "Decrypt one or more bag files.",
     "encrypt": "Encrypt one or more bag files.",
@@ -204,6 +206,44 @@ def info_cmd(argv: List[str], prog: str = "rosbag") -> int:
     from minros.bag.ops import info
 
     return info(args, options.yaml, options.key, options.freq)
+
+
+def _append(option: Any, opt_str: Any, value: Any, parser: Any) -> None:
+    getattr(parser.values, option.dest).append(value)
+
+
+def convert_parser(prog: str) -> optparse.OptionParser:
+    p = _parser(prog, """rosbag convert [options] INBAG OUTBAG
+
+Convert the ROS 1 bag INBAG (.bag, or ROS 1 .mcap) into the ROS 2 recording OUTBAG (a rosbag2
+directory: metadata.yaml and an .mcap or .db3 file), or the ROS 2 recording INBAG (a rosbag2
+directory, a ROS 2 .mcap or .db3 file) into the ROS 1 bag OUTBAG (.bag, or .mcap). Types map
+by ros1_bridge's rules (Header loses seq, time becomes builtin_interfaces/Time, field names
+lower case); a type ROS 2 has no counterpart of is made from the bag's own definition. A topic
+that cannot be converted is named with the reason, and the rest is converted.""",
+                DESCRIPTIONS["convert"])
+    p.add_option("--to", dest="to", default=None, choices=["ros2", "ros1"], metavar="ros2|ros1", help="what to convert to (default: ros2 for a ROS 1 bag, ros1 for a ROS 2 recording)")
+    p.add_option("--storage", dest="storage", default="mcap", choices=["mcap", "sqlite3"], metavar="mcap|sqlite3", help="the ROS 2 recording's storage (default: %default)")
+    p.add_option("--distro", dest="distro", default=None, choices=["jazzy", "kilted", "humble"], metavar="jazzy|kilted|humble", help="the ROS 2 distro whose types and metadata to write (default: jazzy); reading, the one the recording names")
+    p.add_option("--topic", dest="topics", default=[], type="string", action="callback", callback=_append, metavar="TOPIC", help="convert only TOPIC: a topic name or a message type, wildcards allowed (repeat for more)")
+    p.add_option("--exclude", dest="exclude", default=[], type="string", action="callback", callback=_append, metavar="TOPIC", help="leave out TOPIC: a topic name or a message type, wildcards allowed (repeat for more)")
+    p.add_option("-f", "--force", dest="force", default=False, action="store_true", help="replace OUTBAG if it exists")
+    p.add_option("-q", "--quiet", dest="quiet", default=False, action="store_true", help="print no plan, progress or summary (warnings still)")
+    return p
+
+
+def convert_cmd(argv: List[str], prog: str = "rosbag") -> int:
+    p = convert_parser(prog)
+    options, args = p.parse_args(argv)
+    if len(args) < 2:
+        p.error("You must specify an input bag and an output bag." if not args
+                else "You must specify an output bag.")
+    if len(args) > 2:
+        p.error("Too many arguments.")
+    from minros.bag.convert import convert
+
+    return convert(args[0], args[1], options.to, options.storage, options.distro,
+                   options.topics, options.exclude, options.quiet, options.force)
 
 
 def filter_cmd(argv: List[str], prog: str = "rosbag") -> int:
@@ -449,7 +489,8 @@ def _unavailable(name: str, fix: str) -> Callable[[List[str], str], int]:
 
 
 COMMANDS: Dict[str, Callable[[List[str], str], int]] = {
-    "check": check_cmd, "compress": compress_cmd, "decompress": decompress_cmd,
+    "check": check_cmd, "compress": compress_cmd, "convert": convert_cmd,
+    "decompress": decompress_cmd,
     "decrypt": _unavailable("decrypt", "decrypt the bag with ROS's rosbag decrypt first"),
     "encrypt": _unavailable("encrypt", "use ROS's rosbag encrypt, or encrypt the whole file "
                                        "(gpg -c BAG)"),

@@ -230,6 +230,11 @@ def _echo_bag(path: str, topic: str | None, args: Any, filter_fn: Callable | Non
     """rostopic echo -b: the messages of ``topic`` (or, with -a, of every topic) in a bag."""
     echo: _Echo | None = None
     with _open_bag(path) as bag:
+        # a ROS 2 recording's topic that does not convert to ROS 1: say why, not nothing
+        for skipped, (ros2_type, reason) in getattr(bag._reader, "skipped", {}).items():
+            if topic is not None and (topic == skipped or topic.startswith(skipped + "/")):
+                raise ToolError(f"{skipped} [{ros2_type}] in {path} does not read as ROS 1: "
+                                f"{reason}")
         for top, raw, stamp, header in bag.read_messages(raw=True, return_connection_header=True):
             if top[0] != "/":
                 top = resolve(NAME, top)

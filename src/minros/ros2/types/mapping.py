@@ -422,7 +422,9 @@ class Mapper:
         for f1 in spec.fields:
             if f1.name in used_roots:
                 continue
-            partner = struct.field(f1.name.lower())
+            # ros1_bridge's lower-cased name; or the same name, for ROS 2 types written with
+            # ROS 1's names (rosbags-convert stores custom types so, ``Name`` and all)
+            partner = struct.field(f1.name.lower()) or struct.field(f1.name)
             if partner is None or partner.name in sources:
                 dropped.append(f1.name)
             else:
