@@ -9,6 +9,8 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+# the page tests' harness (tests/web/page_support.py) beside the pages' sources
+sys.path.insert(0, str(Path(__file__).resolve().parent / "web"))
 
 #: a ROS package the rostest tests run: its test_*.py are rostest's test nodes, not pytest's
 collect_ignore_glob = ["integration/rostest_pkgs/*"]
