@@ -90,17 +90,56 @@ __all__ = ["PYTHON", "REFERENCE_PYTHON", "Proc", "free_port", "reference_env", "
 
 #: the fixtures above that start processes: a test using one is `slow` (below)
 PROCESS_FIXTURES = {"debian_rosmaster", "minros_master", "minros_core", "tf_oracle"}
+#: tests per xdist group: a longer file (parametrized property tests) is cut into groups
+GROUP_SIZE = 200
 
 
 def pytest_collection_modifyitems(config, items) -> None:
     """Every hypothesis test is in the `fuzz` tier (property and fuzz tests, many examples
     each): `pytest tests/unit -m "not slow and not fuzz"` is the quick run, and CI runs every
-    tier. A test using a fixture that starts a process is `slow`."""
+    tier. A test using a fixture that starts a process is `slow`; every test of tests/unit is
+    `unit` (the other Pythons' runs in scripts/test.sh select `unit or smoke`)."""
     for item in items:
         if getattr(getattr(item, "obj", None), "is_hypothesis_test", False):
             item.add_marker(pytest.mark.fuzz)
         if PROCESS_FIXTURES.intersection(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.slow)
+        if UNIT in item.path.parents:
+            item.add_marker(pytest.mark.unit)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """--dist loadfile (scripts/test.sh), with files cut: a test file is one unit of work, so
+    that it runs in one worker, in its order, with its module fixtures set up once; a file of
+    more than GROUP_SIZE tests (parametrized property tests) is cut into units of GROUP_SIZE
+    consecutive tests, so that it does not hold one worker while the others are idle.
+    (xdist's own loadgroup cannot do it under pytest 9: its group suffix on the test ids is
+    lost.)"""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class FileUnits(LoadFileScheduling):
+        def __init__(self, config, log) -> None:
+            super().__init__(config, log)
+            self.units: dict = {}
+
+        def _split_scope(self, nodeid: str) -> str:
+            if not self.units and self.collection:
+                counts: dict = {}
+                for test in self.collection:
+                    name = test.split("::", 1)[0]
+                    counts[name] = counts.get(name, 0) + 1
+                seen: dict = {}
+                for test in self.collection:
+                    name = test.split("::", 1)[0]
+                    index = seen[name] = seen.get(name, -1) + 1
+                    self.units[test] = (name if counts[name] <= GROUP_SIZE
+                                        else f"{name}#{index // GROUP_SIZE}")
+            return self.units.get(nodeid) or super()._split_scope(nodeid)
+
+    return FileUnits(config, log)
 
 
 # The quick tier runs in one process: a test of tests/unit that starts one (a node, a master,

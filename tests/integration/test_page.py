@@ -74,6 +74,7 @@ def page(browser, system, shots):
 
 # -- graph -------------------------------------------------------------------------------------
 
+@pytest.mark.smoke
 def test_graph_shows_the_running_nodes_and_their_info(page):
     page.open("graph")
     graph = page.view("graph")
