@@ -96,18 +96,21 @@ class Agent:
         while pub.get_num_connections() < c.get("wait_for", 1) and time.time() < deadline:
             time.sleep(0.005)
         sid = c["id"]
-        t = c["start"]
+        t = int(round(c["start"] * 1e9))  # whole nanoseconds: a Rate's next time is exact
+        step = int(round(c["step"] * 1e9))
         missed = 0
         for _ in range(c["count"]):
             with self.lock:
                 before = len(self.received[sid])
-            t += c["step"]
-            pub.publish(Clock(clock=minros.Time.from_sec(t)))
+            t += step
+            if c.get("rate"):
+                time.sleep(1.0 / c["rate"])
+            pub.publish(Clock(clock=minros.Time(t // 10**9, t % 10**9)))
             with self.lock:
                 if not self.lock.wait_for(lambda n=before: len(self.received[sid]) > n,
                                           c.get("timeout", 2)):
                     missed += 1
-        return {"time": t, "missed": missed}
+        return {"time": t / 1e9, "missed": missed}
 
     def op_call(self, c):
         from minros.ros2.bridge.raw import raw_service_class
@@ -122,6 +125,22 @@ class Agent:
             return {"failed": f"{type(exc).__name__}: {exc}"}
         finally:
             proxy.close()
+
+    def op_sub_connections(self, c):
+        """Wait until each subscription in ``ids`` is connected to ``count`` publishers."""
+        deadline = time.time() + c.get("timeout", 10)
+        while True:
+            counts = {i: self.entities[i].get_num_connections() for i in c["ids"]}
+            if all(v >= c.get("count", 1) for v in counts.values()) or time.time() > deadline:
+                return {"counts": counts}
+            time.sleep(0.01)
+
+    def op_param(self, c):
+        if c.get("delete"):
+            minros.delete_param(c["name"])
+        else:
+            minros.set_param(c["name"], c["value"])
+        return {}
 
     def op_unregister(self, c):
         entity = self.entities.pop(c["id"])

@@ -312,8 +312,8 @@ def test_plan_with_a_configuration_bridges_exactly_what_it_lists():
 # -- the type book over the real mapper --------------------------------------------------------
 
 def test_type_book_over_the_mapper():
-    from minros.ros2.bridge.runtime import TypeBook
     from minros.msgs import get_message_class
+    from minros.ros2.bridge.runtime import TypeBook
 
     book = TypeBook("jazzy")
     assert book.ros2_for_ros1("sensor_msgs/CameraInfo") == "sensor_msgs/msg/CameraInfo"
@@ -328,6 +328,9 @@ def test_type_book_over_the_mapper():
     with pytest.raises(Unmapped, match="no ROS 1 counterpart"):
         book.ros1_service_for_ros2("foo_msgs/srv/Bar")
     assert book.ros1_md5("std_msgs/String") == get_message_class("std_msgs/String")._md5sum
+    from minros.msgs import get_service_class
+
+    assert book.ros1_srv_md5("std_srvs/SetBool") == get_service_class("std_srvs/SetBool")._md5sum
 
 
 def test_type_book_learns_a_type_from_a_connection_header():
@@ -387,8 +390,14 @@ def test_a_service_handler_may_decline_to_answer():
     import logging
 
     from minros.ros2.rmw import ServiceTimeout
-    from ros2_support import Netns, cdr_setbool_request, cdr_setbool_response, context
-    from ros2_support import read_setbool_response, require_netns
+    from ros2_support import (
+        Netns,
+        cdr_setbool_request,
+        cdr_setbool_response,
+        context,
+        read_setbool_response,
+        require_netns,
+    )
 
     require_netns()
     ns = Netns()

@@ -43,7 +43,7 @@ from typing import Any, Callable, Dict, List, Optional, Set, Tuple
 
 import minros
 from minros.exceptions import ServiceException
-from minros.msgs.registry import UnknownTypeError
+from minros.msgs.registry import REGISTRY, UnknownTypeError
 from minros.msgs.spec import MsgSpecError
 from minros.ros2.bridge import plan as planning
 from minros.ros2.bridge.config import Config
@@ -237,8 +237,9 @@ class TypeBook:
             return self.mapper.ros1_context.full_text(ros1_type)
 
     def ros1_srv_md5(self, ros1_type: str) -> str:
+        # services map from installed ROS 1 definitions only (the mapper's)
         with self.lock:
-            return self.mapper.ros1_context.srv_md5sum(ros1_type)
+            return REGISTRY.srv_md5sum(ros1_type)
 
 
 # -- the ROS 1 graph --------------------------------------------------------------------------
@@ -342,9 +343,10 @@ class Ros1ToRos2:
             if mapping is not None and mapping.ros2_type == spec.ros2_type:
                 self.converters[bridge.types.ros1_md5(spec.ros1_type)] = mapping.transcoder
                 self._advertise(mapping, False)
+        # no queue limit: what TCPROS carried is not dropped here (a receive reads what one
+        # buffer holds, and the conversion and the DDS write never wait)
         self.subscriber = minros.Subscriber(spec.topic, raw_class(spec.ros1_type),
-                                            self._on_message, queue_size=spec.queue_size,
-                                            tcp_nodelay=True)
+                                            self._on_message, tcp_nodelay=True)
 
     @property
     def ros2_type(self) -> Optional[str]:

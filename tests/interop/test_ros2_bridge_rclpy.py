@@ -1,0 +1,316 @@
+"""``minros ros2`` between real ROS 1 (rospy_tutorials' nodes run by minros, Debian's rospy and
+roscpp) and real ROS 2 (rclpy from PyPI: Jazzy on Fast DDS 2.14, Kilted on Fast DDS 3.2).
+
+Per distro, one network namespace holds one master (minros core), one bridge (dynamic, as
+ros1_bridge's dynamic_bridge), one rclpy agent (tests/ros2_agent.py) and one minros ROS 1 agent
+(tests/ros1_bridge_agent.py); each test adds the few programs it needs. Nothing leaves the
+namespace's loopback.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from bridge_support import (
+    CLIENT,
+    LISTENER,
+    NODE_CPP,
+    SERVER,
+    TALKER,
+    World,
+    lines_of,
+)
+from ros2_support import HASHES, cdr_string, require_ros2, wait_for
+from support import PYTHON, REFERENCE_PYTHON, build_roscpp, require_reference
+
+pytestmark = [pytest.mark.interop, pytest.mark.timeout(300)]
+
+STRING = "std_msgs/msg/String"
+COUNT = 1000
+
+
+@pytest.fixture(scope="module", params=["jazzy", "kilted"])
+def world(request, tmp_path_factory):
+    distro = request.param
+    require_ros2(distro)
+    tmp = tmp_path_factory.mktemp(f"bridge-{distro}")
+    w = World(tmp)
+    try:
+        agent = w.rclpy(distro)
+        started = time.monotonic()
+        bridge = w.bridge(distro=distro)
+        seen = agent("graph", want_node="ros_bridge", timeout=20)
+        listed_after = time.monotonic() - started
+        bridge.read_until("minros ros2: bridging the ROS master", 30)
+        ros1 = w.ros1_agent()
+        yield {"distro": distro, "w": w, "agent": agent, "bridge": bridge, "ros1": ros1,
+               "tmp": tmp, "listed_after": listed_after, "nodes": seen["nodes"]}
+    finally:
+        w.close()
+
+
+@pytest.fixture(scope="module")
+def scripts(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("bridge-scripts")
+    for name, text in (("talker.py", TALKER), ("listener.py", LISTENER), ("server.py", SERVER),
+                       ("client.py", CLIENT)):
+        (folder / name).write_text(text)
+    return folder
+
+
+def bridged(world, needle: str, timeout: float = 20) -> None:
+    """Wait until the bridge says it bridges ``needle`` (``/topic ROS 1 -> ROS 2``)."""
+    world["bridge"].read_until(f"bridging {needle}", timeout)
+
+
+# -- the bridge in both graphs ---------------------------------------------------------------
+
+
+def test_bridge_is_in_rclpys_node_list_within_a_second_of_starting(world):
+    print(f"rclpy listed the bridge {world['listed_after']:.3f} s after its start")
+    assert ["ros_bridge", "/"] in world["nodes"]
+    # from the bridge process's start (python, imports, the DDS participant) to rclpy's list
+    assert world["listed_after"] < 1.0, f"rclpy listed the bridge after {world['listed_after']:.2f} s"
+
+
+# -- talkers and listeners, 1000 of 1000 in order -----------------------------------------------
+
+
+def _rclpy_listener(world, sid: str, topic: str) -> None:
+    world["agent"]("sub", id=sid, topic=topic, type=STRING, qos={"depth": COUNT + 100})
+
+
+def _check_endpoint(world, topic: str, kind: str) -> None:
+    """The bridge's endpoint of ``topic`` in rclpy's graph: its node and the type's hash."""
+    info = wait_for(lambda: [e for e in world["agent"]("graph", topic=topic)[kind]
+                             if e["node"] == "ros_bridge"], 10, f"the bridge's {kind} of {topic}")
+    assert [(e["namespace"], e["type"], e["hash"]) for e in info] == [("/", STRING, HASHES[STRING])]
+
+
+def test_rospy_tutorials_talker_to_rclpy_listener(world):
+    """minros runs rospy_tutorials' talker (10 Hz, "hello world <time>"); on simulated time
+    the ROS 1 agent publishes /clock in 0.1 s steps (at 1 kHz) and waits for each message, so
+    the run takes a second, not 100 s. The rclpy listener gets every one, in order."""
+    agent, ros1, w = world["agent"], world["ros1"], world["w"]
+    topic = "/tutorial_chatter"
+    _rclpy_listener(world, "tut", topic)
+    ros1("sub", id="tut_ref", topic=topic, type="std_msgs/String")
+    ros1("param", name="/use_sim_time", value=True)
+    talker = w.start([PYTHON, "-m", "minros", "run", "rospy_tutorials", "talker",
+                      f"chatter:={topic}"], "talker")
+    try:
+        talker.read_until("hello world", 30)  # its first message (time 0, before any /clock)
+        ros1("param", name="/use_sim_time", delete=True)
+        bridged(world, f"{topic} ROS 1 -> ROS 2")
+        _check_endpoint(world, topic, "publishers")
+        assert ros1("sub_connections", ids=["tut_ref"])["counts"] == {"tut_ref": 1}
+        assert agent("counts", ids=["tut"])["counts"] == {"tut": 1}
+        # warm up: until the bridge's subscriber is connected, messages reach only the agent
+        t = 0.0
+        for _ in range(200):
+            t = ros1("clock", id="tut_ref", start=t, step=0.1, count=1)["time"]
+            if agent("received", id="tut", count=1, timeout=0.05, items=False)["count"]:
+                break
+        t = ros1("clock", id="tut_ref", start=t, step=0.1, count=5)["time"]
+        start = t
+        answer = ros1("clock", id="tut_ref", start=t, step=0.1, count=COUNT, rate=1000)
+        assert answer["missed"] == 0
+
+        def run_of(texts):  # the messages of the run: those stamped after its start
+            return [x for x in texts if float(x.rsplit(" ", 1)[1]) > start + 0.05]
+        sent = run_of([bytes.fromhex(x)[4:].decode() for x in
+                       ros1("received", id="tut_ref", count=10**6, timeout=0.2)["items"]])
+        assert len(sent) == COUNT and len(set(sent)) == COUNT
+        assert all(x.startswith("hello world ") for x in sent)
+        deadline = time.monotonic() + 20
+        while True:
+            got = run_of(agent("received", id="tut", count=10**6, timeout=0.1)["items"])
+            if len(got) >= COUNT or time.monotonic() > deadline:
+                break
+        assert got == sent, "the rclpy listener did not get the talker's 1000, in order"
+    finally:
+        talker.stop()
+
+
+def _talk_ros1_to_rclpy(world, argv, reference: bool, topic: str) -> None:
+    """Run a ROS 1 talker (``argv`` + topic, count, hz), warm it up until rclpy hears it, then
+    1000 messages: rclpy must hear all, in order."""
+    agent, w = world["agent"], world["w"]
+    sid = "l" + topic.replace("/", "_")
+    _rclpy_listener(world, sid, topic)
+    talker = w.start([*argv, topic, str(COUNT), "1000"], "talker", reference=reference,
+                     stdin=subprocess.PIPE)
+    try:
+        talker.read_until("talker up", 30)
+        bridged(world, f"{topic} ROS 1 -> ROS 2")
+        assert agent("received", id=sid, count=1, timeout=20, items=False)["count"] >= 1
+        talker.popen.stdin.write(b"go\n")
+        talker.popen.stdin.flush()
+        talker.read_until(f"sent {COUNT}", 30)
+        got = agent("received", id=sid, count=10**6, timeout=0.5)["items"]
+        deadline = time.monotonic() + 20
+        while sum(x.startswith("msg ") for x in got) < COUNT and time.monotonic() < deadline:
+            got = agent("received", id=sid, count=10**6, timeout=0.2)["items"]
+        assert [x for x in got if x.startswith("msg ")] == [f"msg {i}" for i in range(COUNT)]
+    finally:
+        talker.stop()
+
+
+def _talk_rclpy_to_ros1(world, listener_argv, reference: bool, topic: str, heard: str) -> None:
+    """An rclpy talker, warmed up until the ROS 1 listener hears it, then 1000 messages: the
+    listener must hear all, in order (``heard``: the text before each in its output)."""
+    agent, w = world["agent"], world["w"]
+    pid = "t" + topic.replace("/", "_")
+    listener = w.start(listener_argv, "listener", reference=reference)
+    try:
+        agent("pub", id=pid, topic=topic, type=STRING, qos={"depth": COUNT + 100})
+        bridged(world, f"{topic} ROS 2 -> ROS 1")
+        deadline = time.monotonic() + 30
+        while True:
+            agent("publish", id=pid, count=1, prefix="warm")
+            try:
+                listener.read_until(f"{heard}warm", 0.1)
+                break
+            except AssertionError:
+                assert time.monotonic() < deadline, "the ROS 1 listener heard no warm-up message"
+        agent("publish", id=pid, count=COUNT, prefix="msg", rate=1000)
+        lines = lines_of(listener, f"{heard}msg ", COUNT, 30)
+        assert [line.split(heard, 1)[1].strip() for line in lines] == \
+            [f"msg {i}" for i in range(COUNT)]
+    finally:
+        listener.stop()
+        agent("destroy", id=pid)
+
+
+def test_rclpy_talker_to_rospy_tutorials_listener(world):
+    topic = "/tutorial_listen"
+    _talk_rclpy_to_ros1(world, [PYTHON, "-m", "minros", "run", "rospy_tutorials", "listener",
+                                f"chatter:={topic}"], False, topic, "I heard ")
+
+
+def test_debian_rospy_talker_to_rclpy_listener(world, scripts):
+    require_reference()
+    _talk_ros1_to_rclpy(world, [REFERENCE_PYTHON, str(scripts / "talker.py")], True,
+                        "/rospy_chatter")
+
+
+def test_rclpy_talker_to_debian_rospy_listener(world, scripts):
+    require_reference()
+    topic = "/rospy_listen"
+    _talk_rclpy_to_ros1(world, [REFERENCE_PYTHON, str(scripts / "listener.py"), topic,
+                                str(COUNT)], True, topic, "got ")
+
+
+@pytest.fixture(scope="module")
+def roscpp_node(tmp_path_factory) -> Path:
+    return build_roscpp(NODE_CPP, "bridge_node", tmp_path_factory.mktemp("roscpp"),
+                        ("roscpp", "std_msgs"))
+
+
+def test_roscpp_talker_to_rclpy_listener(world, roscpp_node):
+    _talk_ros1_to_rclpy(world, [str(roscpp_node), "talker"], True, "/roscpp_chatter")
+
+
+def test_rclpy_talker_to_roscpp_listener(world, roscpp_node):
+    topic = "/roscpp_listen"
+    _talk_rclpy_to_ros1(world, [str(roscpp_node), "listener", topic, str(COUNT)], True, topic,
+                        "got ")
+
+
+# -- services each way ------------------------------------------------------------------------
+
+
+def test_services_rclpy_client_to_rospy_server_and_rospy_client_to_rclpy_server(world, scripts):
+    require_reference()
+    agent, w = world["agent"], world["w"]
+    server = w.start([REFERENCE_PYTHON, str(scripts / "server.py"), "/ros1_set",
+                      "/ros1_trigger"], "server", reference=True)
+    try:
+        server.read_until("serving", 30)
+        bridged(world, "service /ros1_set")
+        bridged(world, "service /ros1_trigger")
+        answer = agent("call", id="c_set", name="/ros1_set", type="std_srvs/srv/SetBool",
+                       data=True, count=3)
+        assert answer["ready"] and answer["results"] == \
+            [{"success": True, "message": "rospy set True"}] * 3
+        answer = agent("call", id="c_set", name="/ros1_set", type="std_srvs/srv/SetBool",
+                       data=False)
+        assert answer["results"] == [{"success": False, "message": "rospy set False"}]
+        answer = agent("call", id="c_trig", name="/ros1_trigger", type="std_srvs/srv/Trigger")
+        assert answer["results"] == [{"success": True, "message": "rospy triggered"}]
+    finally:
+        server.stop()
+    agent("serve", id="s_set", name="/rclpy_set", type="std_srvs/srv/SetBool")
+    agent("serve", id="s_trig", name="/rclpy_trigger", type="std_srvs/srv/Trigger")
+    client = w.start([REFERENCE_PYTHON, str(scripts / "client.py"), "/rclpy_set",
+                      "/rclpy_trigger"], "client", reference=True)
+    try:
+        out = client.read_until("trigger ->", 40)
+        assert "setbool True -> True rclpy set True" in out
+        assert "setbool False -> False rclpy set False" in out
+        assert "trigger -> True rclpy triggered" in out
+    finally:
+        client.stop()
+    # the ROS 1 server is gone: its bridge goes, and rclpy's client no longer finds a server
+    world["bridge"].read_until("stopped bridging service /ros1_set", 10)
+    assert wait_for(lambda: not agent("call", id="c_set", name="/ros1_set",
+                                      type="std_srvs/srv/SetBool", timeout=0.2)["ready"],
+                    10, "the bridged server to leave ROS 2")
+
+
+# -- latched <-> transient local -----------------------------------------------------------
+
+
+def test_latched_ros1_topic_reaches_a_late_rclpy_subscriber_and_back(world):
+    agent, ros1 = world["agent"], world["ros1"]
+    ros1("pub", id="latched", topic="/latched_state", type="std_msgs/String",
+         md5="992ce8a1687cec8c8bd883ec73ca41d1", definition="string data\n", latch=True)
+    ros1("publish", id="latched", hex=[cdr_string("old")[4:].hex(),
+                                       cdr_string("latched state")[4:].hex()])
+    # a ROS 2 subscriber joins later: the bridge connects, the latched message comes, and
+    # the bridge's transient-local writer keeps it for the subscriber
+    agent("sub", id="late", topic="/latched_state", type=STRING,
+          qos={"durability": "transient_local", "depth": 1})
+    got = agent("received", id="late", count=1, timeout=20)
+    assert got["items"] == ["latched state"]
+    publishers = agent("graph", topic="/latched_state")["publishers"]
+    assert [(p["node"], p["durability"], p["hash"]) for p in publishers] == \
+        [("ros_bridge", "TRANSIENT_LOCAL", HASHES[STRING])]
+    # a second late subscriber gets it too (the writer's history), then ROS 2 -> ROS 1
+    agent("sub", id="later", topic="/latched_state", type=STRING,
+          qos={"durability": "transient_local", "depth": 1})
+    assert agent("received", id="later", count=1, timeout=10)["items"] == ["latched state"]
+    agent("pub", id="tl", topic="/ros2_latched", type=STRING,
+          qos={"durability": "transient_local", "depth": 1})
+    agent("publish", id="tl", count=2, prefix="ros2 state")
+    ros1("sub", id="late1", topic="/ros2_latched", type="std_msgs/String")
+    got = ros1("received", id="late1", count=1, timeout=20)
+    assert [bytes.fromhex(h)[4:].decode() for h in got["items"]] == ["ros2 state 1"]
+    assert got["latching"] == ["1"] and got["callers"] == ["/ros_bridge"]
+
+
+# -- the graphs ---------------------------------------------------------------------------------
+
+
+def test_the_bridge_is_a_ros1_node_rosnode_info_lists_its_topics(world):
+    """After the latched test: the bridge subscribes to /latched_state (ROS 1 -> ROS 2) and
+    publishes /ros2_latched (ROS 2 -> ROS 1), as Debian's rosnode says."""
+    require_reference()
+    out = world["w"].run_in(["/usr/bin/rosnode", "info", "/ros_bridge"], timeout=30,
+                            reference=True)
+    assert out.returncode == 0, out.stderr
+    text = out.stdout
+    assert "Node [/ros_bridge]" in text
+    publications = text.split("Publications:", 1)[1].split("Subscriptions:", 1)[0]
+    subscriptions = text.split("Subscriptions:", 1)[1].split("Services:", 1)[0]
+    assert "/ros2_latched [std_msgs/String]" in publications
+    assert "/latched_state [std_msgs/String]" in subscriptions
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(pytest.main([__file__, "-q"]))
