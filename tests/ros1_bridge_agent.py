@@ -126,6 +126,19 @@ class Agent:
         finally:
             proxy.close()
 
+    def op_many(self, c):
+        """Several commands in one: ``commands`` is a list of them; the answers' list."""
+        return {"answers": [getattr(self, "op_" + sub.pop("op"))(sub) for sub in c["commands"]]}
+
+    def op_pub_connections(self, c):
+        """Wait until each publisher in ``ids`` has ``count`` subscribers connected."""
+        deadline = time.time() + c.get("timeout", 10)
+        while True:
+            counts = {i: self.entities[i][0].get_num_connections() for i in c["ids"]}
+            if all(v >= c.get("count", 1) for v in counts.values()) or time.time() > deadline:
+                return {"counts": counts}
+            time.sleep(0.01)
+
     def op_sub_connections(self, c):
         """Wait until each subscription in ``ids`` is connected to ``count`` publishers."""
         deadline = time.time() + c.get("timeout", 10)
