@@ -132,7 +132,27 @@ def lines_of(proc: Proc, needle: str, count: int, timeout: float) -> List[str]:
     return found
 
 
-__all__ = ["BRIDGE_CYCLONE_AGENT", "JsonAgent", "MASTER_PORT", "World", "lines_of",
+def drain(proc: Proc, seconds: float) -> str:
+    """What ``proc`` writes within ``seconds`` (and what it wrote before, not yet read)."""
+    import select
+
+    assert proc.popen.stdout is not None
+    fd = proc.popen.stdout.fileno()
+    data = proc._pending
+    proc._pending = b""
+    deadline = time.monotonic() + seconds
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0 or not select.select([fd], [], [], left)[0]:
+            break
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            break
+        data += chunk
+    return data.decode("utf-8", "replace")
+
+
+__all__ = ["BRIDGE_CYCLONE_AGENT", "JsonAgent", "drain", "MASTER_PORT", "World", "lines_of",
            "wait_for", "REFERENCE_PYTHON"]
 
 

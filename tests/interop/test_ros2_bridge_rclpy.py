@@ -24,6 +24,7 @@ from bridge_support import (
     SERVER,
     TALKER,
     World,
+    drain,
     lines_of,
 )
 from ros2_support import HASHES, cdr_string, require_ros2, wait_for
@@ -73,7 +74,6 @@ def bridged(world, needle: str, timeout: float = 20) -> None:
 
 
 def test_bridge_is_in_rclpys_node_list_within_a_second_of_starting(world):
-    print(f"rclpy listed the bridge {world['listed_after']:.3f} s after its start")
     assert ["ros_bridge", "/"] in world["nodes"]
     # from the bridge process's start (python, imports, the DDS participant) to rclpy's list
     assert world["listed_after"] < 1.0, f"rclpy listed the bridge after {world['listed_after']:.2f} s"
@@ -291,8 +291,8 @@ def test_latched_ros1_topic_reaches_a_late_rclpy_subscriber_and_back(world):
     agent("publish", id="tl", count=2, prefix="ros2 state")
     ros1("sub", id="late1", topic="/ros2_latched", type="std_msgs/String")
     got = ros1("received", id="late1", count=1, timeout=20)
-    assert [bytes.fromhex(h)[4:].decode() for h in got["items"]] == ["ros2 state 1"]
-    assert got["latching"] == ["1"] and got["callers"] == ["/ros_bridge"]
+    assert [bytes.fromhex(h)[4:].decode() for h in got["items"]] == ["ros2 state 1"], got
+    assert got["latching"] == ["1"] and got["callers"] == ["/ros_bridge"], got
 
 
 # -- every type both sides ship, there and back ----------------------------------------------
@@ -432,6 +432,181 @@ def test_every_type_both_sides_ship_goes_ros1_to_ros2_to_ros1_and_comes_back_equ
     echoed = agent("echo_report")
     assert echoed["failures"] == [], "rclpy's deserialize_message refused what the bridge sent"
     assert echoed["echoed"] == {"/rt/" + t: len(sent[t]) for t, _m in kinds}
+
+
+# -- a type no wheel ships, through Cyclone DDS ----------------------------------------------
+
+CUSTOM = (Path(__file__).resolve().parent.parent / "unit" / "ros2_fixtures"
+          / "my_robot_msgs_Status.txt").read_text()
+CUSTOM_TYPE = "my_robot_msgs/Status"
+
+
+def _cyclone_types(mapper, ros2_type: str, out: list) -> list:
+    """The IDL structs (dependencies first) of ``ros2_type`` as bridge_cyclone_agent builds
+    them, from the ROS 2 type minros made."""
+    from minros.ros2.types import dds_type_name
+
+    struct = mapper.ros2.message(ros2_type)
+    fields = []
+    for f in struct.fields:
+        ft = f.type
+        base = ft.base
+        if ft.is_nested:
+            _cyclone_types(mapper, base, out)
+            base = dds_type_name(base)
+        fields.append([f.name, {"base": base, "kind": ft.kind or "scalar", "size": ft.size}])
+    name = dds_type_name(ros2_type)
+    if all(s["name"] != name for s in out):
+        out.append({"name": name, "fields": fields})
+    return out
+
+
+def test_a_type_no_wheel_ships_goes_through_with_cyclone_dds_on_the_far_side(world):
+    """A robot's own ROS 1 message (a definition nobody installed: the bridge has it only from
+    its publisher's connection header) becomes a ROS 2 type made by minros; cyclonedds-python,
+    which builds IDL types at run time, reads it on the far side and writes it back."""
+    from bridge_support import BRIDGE_CYCLONE_AGENT, JsonAgent
+    from minros.msgs.registry import REGISTRY, MsgContext
+    from minros.msgs.spec import parse_msg, split_full_text
+    from minros.msgs.testing import strategy_for, to_plain
+    from minros.ros2.types import Mapper
+    from minros.ros2.types.testing import ros2_plain_of_ros1, samples
+    from ros2_support import CYCLONE_URI, cyclone_python, require_cyclone
+
+    require_cyclone()
+    ros1, w = world["ros1"], world["w"]
+    context = MsgContext(search=False, fallback=REGISTRY)
+    for block, text in split_full_text(CUSTOM):
+        name = CUSTOM_TYPE if block is None else block
+        context.add_spec(parse_msg(text, name, "fixture"))
+    cls = context.get_class(CUSTOM_TYPE)
+    mapper = Mapper(world["distro"])
+    mapper.add_ros1_definition(CUSTOM_TYPE, CUSTOM)
+    mapping = mapper.message(CUSTOM_TYPE)
+    assert (mapping.ros2_type, mapping.generated) == ("my_robot_msgs/msg/Status", True)
+    cyclone = JsonAgent(w.ns, cyclone_python(), BRIDGE_CYCLONE_AGENT, "cyclone_echo", w.tmp,
+                        {"CYCLONEDDS_URI": CYCLONE_URI})
+    w.agents.append(cyclone)
+    made = cyclone("types", types=_cyclone_types(mapper, mapping.ros2_type, []))
+    assert "my_robot_msgs::msg::dds_::Status_" in made["made"]
+    cyclone("echo", type="my_robot_msgs::msg::dds_::Status_", topic="custom", out="custom_back")
+    ros1("sub", id="custom_back", topic="/custom_back", type=CUSTOM_TYPE)
+    ros1("pub", id="custom", topic="/custom", type=CUSTOM_TYPE, md5=cls._md5sum,
+         definition=cls._full_text)
+    bridged(world, "/custom ROS 1 -> ROS 2")
+
+    def serialized(msg) -> str:
+        buf = io.BytesIO()
+        msg.serialize(buf)
+        return buf.getvalue().hex()
+    msgs = samples(strategy_for(CUSTOM_TYPE, context), 5)
+    # the first message teaches the bridge the type; it goes on once Cyclone has one
+    deadline = time.monotonic() + 20
+    while not cyclone("received", count=1, timeout=0.2)["count"]:
+        assert time.monotonic() < deadline, "Cyclone got nothing"
+        ros1("publish", id="custom", hex=[serialized(msgs[0])], wait_for=1)
+    warm = cyclone("received", count=1, timeout=0.5)["count"]
+    bridged(world, "/custom_back ROS 2 -> ROS 1")
+    assert ros1("sub_connections", ids=["custom_back"], timeout=20)["counts"]["custom_back"] == 1
+    before = ros1("received", id="custom_back", count=0)["count"]
+    ros1("publish", id="custom", hex=[serialized(m) for m in msgs])
+    got = cyclone("received", count=warm + len(msgs), timeout=20)["items"][warm:]
+
+    def c_plain(value):
+        return _c_strings(value)
+    assert got == [c_plain(ros2_plain_of_ros1(mapping, m)) for m in msgs]
+    back = ros1("received", id="custom_back", count=before + len(msgs), timeout=20)
+    items = back["items"][-len(msgs):]
+    assert len(items) == len(msgs)
+    seq0 = context.get_class(CUSTOM_TYPE)().deserialize(bytes.fromhex(items[0])).header.seq
+    for k, (msg, data) in enumerate(zip(msgs, items)):
+        want = _c_strings(to_plain(msg))
+        want["header"]["seq"] = seq0 + k  # counted by the bridge's publisher
+        assert to_plain(cls().deserialize(bytes.fromhex(data))) == want
+
+
+# -- bad input: one line each, and everything goes on ------------------------------------------
+
+
+def test_bad_input_is_one_line_each_and_the_bridge_goes_on(world):
+    """Samples that do not decode (both ways), a type the subscriber's does not map to, a QoS
+    that cannot match, a ROS 2 publisher killed: each is one line in the bridge's log, said
+    once however often it happens, and the bridge keeps bridging."""
+    agent, ros1, w, bridge = world["agent"], world["ros1"], world["w"], world["bridge"]
+    string_md5 = "992ce8a1687cec8c8bd883ec73ca41d1"
+    # ROS 1 -> ROS 2: bytes that are not a std_msgs/String
+    agent("sub", id="bad1", topic="/bad_in", type=STRING, qos={"depth": 100})
+    ros1("pub", id="bad1", topic="/bad_in", type="std_msgs/String", md5=string_md5,
+         definition="string data\n")
+    bridged(world, "/bad_in ROS 1 -> ROS 2")
+    good = cdr_string("fine")[4:].hex()
+    ros1("publish", id="bad1", hex=["ffffff7f00", "0100", good], wait_for=1)
+    out = bridge.read_until("do not convert to std_msgs/msg/String", 10)
+    assert agent("received", id="bad1", count=1, timeout=10)["items"][-1:] == ["fine"]
+    # ROS 2 -> ROS 1: samples that are not CDR of the type
+    ros1("sub", id="bad2", topic="/bad_out", type="std_msgs/String")
+    agent("pub", id="bad2", topic="/bad_out", type=STRING, qos={"depth": 100})
+    bridged(world, "/bad_out ROS 2 -> ROS 1")
+    assert ros1("sub_connections", ids=["bad2"], timeout=20)["counts"]["bad2"] == 1
+    agent("counts", ids=["bad2"], timeout=20)
+    agent("publish_raw", id="bad2", hex=["000100000a000000ab", "00010000ffffff7f", "0001"])
+    agent("publish", id="bad2", count=1, prefix="still")
+    out += bridge.read_until("do not decode as std_msgs/msg/String", 10)
+    got = ros1("received", id="bad2", count=1, timeout=10)
+    assert [bytes.fromhex(h)[4:].decode() for h in got["items"]] == ["still 0"]
+    # a ROS 2 subscriber of another type: no mapping, one line
+    agent("sub", id="mismatch", topic="/mismatch", type="std_msgs/msg/Int32")
+    ros1("pub", id="mismatch", topic="/mismatch", type="std_msgs/String", md5=string_md5,
+         definition="string data\n")
+    out += bridge.read_until("ROS 2 subscribes to std_msgs/msg/Int32", 10)
+    # a QoS that cannot match: a subscriber asking for a deadline the bridge does not offer
+    agent("sub", id="deadline", topic="/bad_in", type=STRING, qos={"deadline": 0.5})
+    out += bridge.read_until("QoS cannot match", 10)
+    # a ROS 2 publisher that vanishes (SIGKILL; its lease made 2 s by a Fast DDS profile)
+    profile = w.tmp / "short_lease.xml"
+    profile.write_text(SHORT_LEASE)
+    doomed = w.rclpy(world["distro"], "doomed", env={"FASTRTPS_DEFAULT_PROFILES_FILE": str(profile),
+                                                     "FASTDDS_DEFAULT_PROFILES_FILE": str(profile)})
+    ros1("sub", id="doomed", topic="/doomed", type="std_msgs/String")
+    doomed("pub", id="d", topic="/doomed", type=STRING)
+    bridged(world, "/doomed ROS 2 -> ROS 1")
+    assert ros1("sub_connections", ids=["doomed"], timeout=20)["counts"]["doomed"] == 1
+    doomed("counts", ids=["d"], timeout=20)
+    doomed("publish", id="d", count=1, prefix="last words")
+    assert ros1("received", id="doomed", count=1, timeout=10)["count"] == 1
+    doomed.proc.kill()
+    doomed.proc.wait(5)
+    out += bridge.read_until("stopped bridging /doomed ROS 2 -> ROS 1", 30)
+    # the rest: still bridged, the graphs still answer
+    ros1("publish", id="bad1", hex=[cdr_string("after all that")[4:].hex()])
+    assert agent("received", id="bad1", count=2, timeout=10)["items"][-1] == "after all that"
+    assert ["ros_bridge", "/"] in agent("graph")["nodes"]
+    ros1("publish", id="bad1", hex=["ffffff7f00"] * 5)
+    agent("publish_raw", id="bad2", hex=["0001"] * 5)
+    ros1("publish", id="bad1", hex=[cdr_string("end")[4:].hex()])
+    assert agent("received", id="bad1", count=3, timeout=10)["items"][-1] == "end"
+    out += drain(bridge, 1.0)  # what the bridge said since, repeated faults included
+    assert "is gone" in out  # the DDS layer's line for the peer, with its lease
+    for needle in ("do not convert to std_msgs/msg/String", "do not decode as std_msgs/msg/String",
+                   "ROS 2 subscribes to std_msgs/msg/Int32", "QoS cannot match"):
+        assert out.count(needle) == 1, (needle, out)
+    assert "Traceback" not in out
+
+
+SHORT_LEASE = """<?xml version="1.0" encoding="UTF-8"?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <participant profile_name="short_lease" is_default_profile="true">
+    <rtps>
+      <builtin>
+        <discovery_config>
+          <leaseDuration><sec>2</sec></leaseDuration>
+          <leaseAnnouncement><nanosec>500000000</nanosec></leaseAnnouncement>
+        </discovery_config>
+      </builtin>
+    </rtps>
+  </participant>
+</profiles>
+"""
 
 
 # -- the graphs ---------------------------------------------------------------------------------
