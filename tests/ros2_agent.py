@@ -219,7 +219,8 @@ class Agent:
                 for i in self.node.get_publishers_info_by_topic(c["topic"])]
             out["subscriptions"] = [
                 {"node": i.node_name, "namespace": i.node_namespace, "type": i.topic_type,
-                 "hash": str(i.topic_type_hash)}
+                 "hash": str(i.topic_type_hash), "reliability": i.qos_profile.reliability.name,
+                 "durability": i.qos_profile.durability.name}
                 for i in self.node.get_subscriptions_info_by_topic(c["topic"])]
         return out
 

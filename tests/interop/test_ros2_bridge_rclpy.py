@@ -609,6 +609,27 @@ SHORT_LEASE = """<?xml version="1.0" encoding="UTF-8"?>
 """
 
 
+def test_a_best_effort_ros2_publisher_is_heard_best_effort(world):
+    """rclpy's sensor-data publisher (best effort) would not match a reliable reader: the
+    bridge's subscription asks for best effort, and ROS 1 hears it."""
+    agent, ros1 = world["agent"], world["ros1"]
+    ros1("sub", id="be", topic="/scan_like", type="std_msgs/String")
+    agent("pub", id="be", topic="/scan_like", type=STRING,
+          qos={"reliability": "best_effort", "depth": 5})
+    bridged(world, "/scan_like ROS 2 -> ROS 1")
+    subscriptions = wait_for(lambda: [s for s in agent("graph", topic="/scan_like")
+                                      ["subscriptions"] if s["node"] == "ros_bridge"],
+                             10, "the bridge's subscription")
+    assert [(s["reliability"], s["durability"], s["hash"]) for s in subscriptions] == \
+        [("BEST_EFFORT", "VOLATILE", HASHES[STRING])]
+    assert ros1("sub_connections", ids=["be"], timeout=20)["counts"]["be"] == 1
+    deadline = time.monotonic() + 20
+    while not ros1("received", id="be", count=1, timeout=0.1)["count"]:
+        assert time.monotonic() < deadline, "nothing reached ROS 1"
+        agent("publish", id="be", count=1, prefix="scan")
+    agent("destroy", id="be")
+
+
 # -- the graphs ---------------------------------------------------------------------------------
 
 
