@@ -53,6 +53,52 @@ class Agent:
                 time.sleep(1.0 / rate)
         return {"connections": pub.get_num_connections()}
 
+    def op_publish_images(self, c):
+        """``count`` sensor_msgs/Image frames (rgb8) of which each byte is the frame's number
+        times 7 plus 3; the md5 sums of their data."""
+        import hashlib
+
+        from sensor_msgs.msg import Image
+
+        if c["id"] not in self.entities:
+            self.entities[c["id"]] = (minros.Publisher(c["topic"], Image, queue_size=10), Image)
+        pub, _cls = self.entities[c["id"]]
+        w, h = c.get("width", 1920), c.get("height", 1080)
+        out = []
+        for i in range(c.get("count", 1)):
+            data = bytes([(i * 7 + 3) % 256]) * (w * h * 3)
+            pub.publish(Image(height=h, width=w, encoding="rgb8", step=w * 3, data=data))
+            out.append(hashlib.md5(data).hexdigest())
+            if c.get("rate"):
+                time.sleep(1.0 / c["rate"])
+        return {"md5": out}
+
+    def op_image_sub(self, c):
+        """A subscription keeping (width, height, encoding, seq, md5 of the data) per image."""
+        import hashlib
+
+        from sensor_msgs.msg import Image
+
+        sid = c["id"]
+        self.received[sid] = []
+
+        def callback(msg, sid=sid):
+            with self.lock:
+                self.received[sid].append(
+                    [msg.width, msg.height, msg.encoding, msg.header.seq,
+                     hashlib.md5(bytes(msg.data)).hexdigest()])
+                self.lock.notify_all()
+        self.entities[sid] = minros.Subscriber(c["topic"], Image, callback, queue_size=10)
+        return {}
+
+    def op_images(self, c):
+        sid = c["id"]
+        deadline = time.time() + c.get("timeout", 10)
+        with self.lock:
+            while len(self.received[sid]) < c.get("count", 1) and time.time() < deadline:
+                self.lock.wait(0.05)
+            return {"items": list(self.received[sid])}
+
     def op_connections(self, c):
         pub, _cls = self.entities[c["id"]]
         deadline = time.time() + c.get("timeout", 10)

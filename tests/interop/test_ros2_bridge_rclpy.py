@@ -630,6 +630,32 @@ def test_a_best_effort_ros2_publisher_is_heard_best_effort(world):
     agent("destroy", id="be")
 
 
+def test_1080p_images_both_ways(world):
+    """sensor_msgs/Image 1920x1080 rgb8 (6 MB, a hundred RTPS fragments) from a minros ROS 1
+    publisher to rclpy and from rclpy to a minros ROS 1 subscriber, every frame intact; the
+    ROS 1 side's Header seq counted by the bridge."""
+    agent, ros1 = world["agent"], world["ros1"]
+    image = "sensor_msgs/msg/Image"
+    agent("sub", id="img", topic="/camera_in", type=image, qos={"depth": 10})
+    ros1("publish_images", id="cam", topic="/camera_in", count=0)
+    bridged(world, "/camera_in ROS 1 -> ROS 2")
+    assert ros1("pub_connections", ids=["cam"], timeout=20)["counts"]["cam"] == 1
+    assert agent("counts", ids=["img"], timeout=20)["counts"]["img"] == 1
+    sent = ros1("publish_images", id="cam", count=5, rate=10)["md5"]
+    got = agent("received", id="img", count=5, timeout=30)["items"]
+    assert [(x["width"], x["height"], x["encoding"], x["md5"]) for x in got] == \
+        [(1920, 1080, "rgb8", md5) for md5 in sent]
+    ros1("image_sub", id="view", topic="/camera_out")
+    agent("pub", id="cam2", topic="/camera_out", type=image, qos={"depth": 10})
+    bridged(world, "/camera_out ROS 2 -> ROS 1")
+    assert ros1("sub_connections", ids=["view"], timeout=20)["counts"]["view"] == 1
+    agent("counts", ids=["cam2"], timeout=20)
+    sent = agent("publish", id="cam2", image=True, count=5, rate=10)["md5"]
+    got = ros1("images", id="view", count=5, timeout=30)["items"]
+    assert [tuple(x) for x in got] == [(1920, 1080, "rgb8", i + 1, md5)
+                                       for i, md5 in enumerate(sent)]
+
+
 # -- the graphs ---------------------------------------------------------------------------------
 
 

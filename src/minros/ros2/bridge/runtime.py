@@ -357,6 +357,8 @@ class Ros1ToRos2:
         old = self.publisher
         publisher = self.bridge.node.create_publisher(self.topic, mapping.ros2_type, qos,
                                                       type_hash=mapping.type_hash)
+        # big samples' bursts leave from the ROS 1 receive thread, on time (see the writer)
+        publisher.writer.pace_in_caller = True
         self.bridge.own_writers.add(publisher.gid)
         self.mapping = mapping
         self.publisher = publisher
