@@ -428,3 +428,51 @@ def test_a_service_handler_may_decline_to_answer():
             if ctx is not None:
                 ctx.shutdown()
         ns.delete()
+
+
+# -- the command ---------------------------------------------------------------------------------
+
+def _command(*args: str, env_extra=None):
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+    env.update(env_extra or {})
+    return subprocess.run([sys.executable, "-m", "minros", "ros2", *args], capture_output=True,
+                          text=True, timeout=60, env=env)
+
+
+def test_command_help_and_mistakes_are_one_line_before_anything_joins_dds(tmp_path):
+    """--help; a bad configuration and a missing master each end the command with one line
+    and a status, before any DDS participant exists (nothing is sent)."""
+    from support import free_port
+
+    out = _command("--help")
+    assert out.returncode == 0 and "--bridge-all-1to2-topics" in out.stdout
+    bad = tmp_path / "bridge.yaml"
+    bad.write_text("topics:\n  - {topic: /a, type: std_msgs/msg/String, queue_size: -3}\n")
+    out = _command("--config", str(bad))
+    assert out.returncode == 2
+    assert out.stderr.strip().splitlines() == [
+        f"minros ros2: error: {bad}: topics[0] (/a): queue_size must be a whole number (0 or "
+        f"absent: 100), got -3"]
+    out = _command("--domain", "300")
+    assert (out.returncode, out.stderr.strip()) == (
+        2, "minros ros2: error: --domain 300: a number from 0 to 232")
+    port = free_port()
+    out = _command(env_extra={"ROS_MASTER_URI": f"http://127.0.0.1:{port}"})
+    assert out.returncode == 1
+    assert out.stderr.strip() == (
+        f"minros ros2: error: cannot reach the ROS master at http://127.0.0.1:{port}: start one "
+        "with `minros core` (or roscore), or set ROS_MASTER_URI")
+    assert "Traceback" not in out.stderr
+
+
+def test_print_pairs_lists_ros1_bridges_pairs():
+    out = _command("--print-pairs")
+    assert out.returncode == 0
+    assert "  - 'sensor_msgs/msg/CameraInfo' (ROS 2) <=> 'sensor_msgs/CameraInfo' (ROS 1)" in \
+        out.stdout
+    assert "  - 'std_srvs/srv/SetBool' (ROS 2) <=> 'std_srvs/SetBool' (ROS 1)" in out.stdout
+    assert "'tf2_msgs/msg/TFMessage' (ROS 2) <=> 'tf/tfMessage' (ROS 1)" in out.stdout

@@ -108,6 +108,10 @@ def main(argv: List[str], prog: Optional[str] = None) -> int:
             config = configuration.load(args.config)
         except configuration.ConfigError as exc:
             return usage(str(exc))
+    error = _master_error()
+    if error:
+        print(f"{prog}: error: {error}", file=sys.stderr)
+        return 1
     # the ROS 2 node first, before the rest is imported: ROS 2's graph lists it at once
     from minros.ros2.rmw import Context
     from minros.ros2.rmw.names import NameError_
@@ -127,6 +131,23 @@ def main(argv: List[str], prog: Optional[str] = None) -> int:
         queue_size=args.queue_size, config=config, service_timeout=args.service_timeout)
     return run(options, context, node, config_from_parameters=args.parameters,
                announce=lambda text: print(text, flush=True))
+
+
+def _master_error() -> Optional[str]:
+    """Why the ROS master cannot be used, or None (asked before anything joins DDS)."""
+    from minros.tools.master import Master, MasterIOError
+
+    master = Master("/minros_ros2", timeout=2.0)
+    try:
+        master.get_pid()
+        return None
+    except MasterIOError:
+        return (f"cannot reach the ROS master at {master.uri}: start one with `minros core` "
+                "(or roscore), or set ROS_MASTER_URI")
+    except Exception as exc:  # noqa: BLE001 - any other answer: say what it was
+        return f"the ROS master at {master.uri} does not answer: {exc}"
+    finally:
+        master.close()
 
 
 def _print_pairs(distro: str) -> int:

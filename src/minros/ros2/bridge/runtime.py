@@ -66,7 +66,7 @@ from minros.ros2.rmw import Context, Node, Publisher, ServiceTimeout
 from minros.ros2.rmw import names as ros2_names
 from minros.ros2.rmw.qos import QoSProfile, from_dds
 from minros.ros2.types import Mapper, MessageMapping, NoMappingError, ServiceMapping
-from minros.tools.master import Master, MasterIOError
+from minros.tools.master import Master
 from minros.tools.services import probe_service
 
 __all__ = ["Bridge", "BridgeOptions", "OnceLog", "TypeBook"]
@@ -818,21 +818,6 @@ class _ToRos1Log(logging.Handler):
             pass
 
 
-def master_error() -> Optional[str]:
-    """Why the ROS master cannot be used, or None."""
-    master = Master("/minros_ros2", timeout=PROBE_TIMEOUT)
-    try:
-        master.get_pid()
-        return None
-    except MasterIOError:
-        return (f"cannot reach the ROS master at {master.uri}: start one with `minros core` "
-                "(or roscore), or set ROS_MASTER_URI")
-    except Exception as exc:  # noqa: BLE001
-        return f"the ROS master at {master.uri} does not answer: {exc}"
-    finally:
-        master.close()
-
-
 def run(options: BridgeOptions, context: Context, node: Node,
         config_from_parameters: bool = False, argv: Optional[List[str]] = None,
         announce: Callable[[str], None] = print) -> int:
@@ -853,9 +838,6 @@ def run(options: BridgeOptions, context: Context, node: Node,
     dds_log = logging.getLogger("minros.ros2")
     handler = _ToRos1Log()
     try:
-        error = master_error()
-        if error:
-            return fail(error)
         dds_log.addHandler(handler)
         dds_log.propagate = False
         minros.init_node(options.name, argv=argv, disable_signals=True)
