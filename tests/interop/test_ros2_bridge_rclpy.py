@@ -27,7 +27,7 @@ from bridge_support import (
     drain,
     lines_of,
 )
-from ros2_support import HASHES, cdr_string, require_ros2, wait_for
+from ros2_support import HASHES, cdr_string, context, require_ros2, wait_for
 from support import PYTHON, REFERENCE_PYTHON, build_roscpp, require_reference
 
 pytestmark = [pytest.mark.interop, pytest.mark.timeout(300)]
@@ -244,6 +244,21 @@ def test_services_rclpy_client_to_rospy_server_and_rospy_client_to_rclpy_server(
         assert answer["results"] == [{"success": False, "message": "rospy set False"}]
         answer = agent("call", id="c_trig", name="/ros1_trigger", type="std_srvs/srv/Trigger")
         assert answer["results"] == [{"success": True, "message": "rospy triggered"}]
+        # the bridge's server endpoints carry the request's and the response's hashes, as
+        # rclpy's do (a minros participant in the namespace reads SEDP)
+        ctx = context(w.ns)
+        try:
+            assert ctx.graph.wait_until(
+                lambda g: g.endpoints_of("rr/ros1_setReply", "publisher")
+                and g.endpoints_of("rq/ros1_setRequest", "subscription"), 10)
+            assert [e.type_hash for e in ctx.graph.endpoints_of("rq/ros1_setRequest",
+                                                                "subscription")] == \
+                [HASHES["std_srvs/srv/SetBool_Request"]]
+            assert [e.type_hash for e in ctx.graph.endpoints_of("rr/ros1_setReply",
+                                                                "publisher")] == \
+                [HASHES["std_srvs/srv/SetBool_Response"]]
+        finally:
+            ctx.shutdown()
     finally:
         server.stop()
     agent("serve", id="s_set", name="/rclpy_set", type="std_srvs/srv/SetBool")

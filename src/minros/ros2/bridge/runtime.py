@@ -507,9 +507,9 @@ class Ros1ServiceInRos2:
                                                bridge.types.ros1_srv_md5(spec.ros1_type))
         self._idle: List[Any] = []
         self._lock = threading.Lock()
-        srv_hash = _service_hash(bridge, mapping)
-        self.server = bridge.node.create_service(spec.service, spec.ros2_type, self._handle,
-                                                 request_hash=srv_hash, response_hash=srv_hash)
+        self.server = bridge.node.create_service(
+            spec.service, spec.ros2_type, self._handle,
+            request_hash=mapping.request.type_hash, response_hash=mapping.response.type_hash)
 
     def _handle(self, request: bytes) -> Optional[bytes]:
         try:
@@ -562,9 +562,10 @@ class Ros2ServiceInRos1:
         self.response = mapping.response.transcoder
         self.service_class = raw_service_class(spec.ros1_type,
                                                bridge.types.ros1_srv_md5(spec.ros1_type))
-        srv_hash = _service_hash(bridge, mapping)
-        self.client = bridge.node.create_client(spec.service, spec.ros2_type,
-                                                request_hash=srv_hash, response_hash=srv_hash)
+        # (rmw puts the request's hash on the request topic, the response's on the reply's)
+        self.client = bridge.node.create_client(
+            spec.service, spec.ros2_type, request_hash=mapping.request.type_hash,
+            response_hash=mapping.response.type_hash)
         try:
             self.service = minros.Service(spec.service, self.service_class, self._handle)
         except BaseException:
@@ -595,14 +596,6 @@ class Ros2ServiceInRos1:
     def close(self) -> None:
         self.service.shutdown()
         self.client.destroy()
-
-
-def _service_hash(bridge: Bridge, mapping: ServiceMapping) -> Optional[str]:
-    """The RIHS01 hash of the service type, which rmw puts on both of a service's endpoints."""
-    try:
-        return bridge.types.mapper.ros2.type_hash(mapping.ros2_type)
-    except Exception:  # noqa: BLE001 - Humble has none
-        return None
 
 
 # -- the bridge ---------------------------------------------------------------------------------
