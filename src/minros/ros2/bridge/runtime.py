@@ -754,6 +754,10 @@ class Bridge:
                               f"({sspec.ros1_type} <-> {sspec.ros2_type})")
             if made is not None:
                 self.services[service] = made
+        kept = {("topic " + d, t) for t, d in wanted.topics} | {("service", n)
+                                                                for n in wanted.services}
+        for stale in [k for k in self._retry if k not in kept]:
+            del self._retry[stale]
         return wanted
 
     def _make(self, key: Tuple[str, str], make: Any, spec: Any, what: str) -> Any:
