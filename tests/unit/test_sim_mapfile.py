@@ -361,3 +361,47 @@ def test_map_server_says_a_huge_map_in_one_line(tmp_path, capsys):
     assert map_server.main(["map_server", str(path)]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("map_server: image file ")
+
+
+def _alias_nest(levels: int = 8, width: int = 10) -> str:
+    """YAML's billion laughs: ``levels`` lists of ``width`` aliases of the one below, about
+    500 bytes that load (by reference) in milliseconds and stand for width**levels items."""
+    lines = ["n0: &n0 [" + ", ".join(["lol"] * width) + "]"]
+    lines += [f"n{i}: &n{i} [" + ", ".join([f"*n{i - 1}"] * width) + "]"
+              for i in range(1, levels + 1)]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("key", ["origin", "negate", "resolution", "mode", "occupied_thresh"])
+def test_a_nest_of_yaml_aliases_is_one_line_in_bounded_time_and_memory(tmp_path, key):
+    """An attacker's 569-byte map YAML whose ``origin`` (or any key an error names) is a nest
+    of aliases, 8 levels of 10: its repr is ~10**9 items (map_server hung, 1.46 GB in 30 s)."""
+    import subprocess
+    import sys
+    import time
+
+    base = {"image": "m.png", "resolution": "0.05", "origin": "[0, 0, 0]", "negate": "0",
+            "occupied_thresh": "0.65", "free_thresh": "0.196"}
+    base[key] = f"*n{8}"
+    path = tmp_path / "laughs.yaml"
+    path.write_text(_alias_nest() + "".join(f"{k}: {v}\n" for k, v in base.items()))
+    assert path.stat().st_size < 700
+    probe = ("import resource, sys\n"
+             "from minros.nodes.map_server import map_server\n"
+             "before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+             "code = map_server.main(['map_server', sys.argv[1]])\n"
+             "grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before\n"
+             "print(code, grown)\n")
+    start = time.monotonic()
+    try:
+        out = subprocess.run([sys.executable, "-c", probe, str(path)], capture_output=True,
+                             text=True, timeout=30)
+    except subprocess.TimeoutExpired:
+        pytest.fail("map_server did not answer a 600-byte YAML within 30 s")
+    elapsed = time.monotonic() - start
+    code, grown_kb = out.stdout.split()
+    assert code == "1", out.stderr
+    assert int(grown_kb) < 20_000, f"the YAML grew the peak RSS by {int(grown_kb) >> 10} MB"
+    assert out.stderr.count("\n") == 1 and out.stderr.startswith("map_server: ")
+    assert f"{key} tag" in out.stderr and len(out.stderr) < 400
+    assert elapsed < 20

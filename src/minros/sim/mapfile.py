@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 import os
+import reprlib
 import struct
 from dataclasses import dataclass
 from typing import Any, BinaryIO, Dict, Tuple
@@ -84,12 +85,29 @@ def _finite(value: Any) -> bool:
         return False
 
 
+def _shown_repr() -> reprlib.Repr:
+    """A repr that stops at two levels, a few items and 40 characters a string: YAML's
+    aliases make a 500-byte file whose value, written out whole, is 10**9 items."""
+    shown = reprlib.Repr()  # attributes, not keywords: Python 3.10's Repr takes none
+    shown.maxlevel = 2
+    shown.maxlist = shown.maxtuple = shown.maxset = shown.maxfrozenset = 4
+    shown.maxdict = 3
+    shown.maxstring = shown.maxother = 40
+    shown.maxlong = 30
+    return shown
+
+
+_SHOWN = _shown_repr()
+
+
 def _shown(value: Any) -> str:
-    """``repr(value)``, cut short (an error names what it found, not all of it)."""
+    """``value`` written out, cut short (an error names what it found, not all of it).
+
+    Bounded in time and memory whatever the value is: a nest of aliases, a recursive list."""
     try:
-        text = repr(value)
-    except ValueError:  # an int beyond the interpreter's digit limit
-        return "a huge number"
+        text = _SHOWN.repr(value)
+    except (ValueError, RecursionError):  # an int beyond the interpreter's digit limit
+        return "a huge number" if isinstance(value, int) else f"a {type(value).__name__}"
     return text if len(text) <= 60 else text[:57] + "..."
 
 
