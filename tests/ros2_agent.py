@@ -5,19 +5,25 @@ network namespace; an executor spins in a thread of its own while commands come.
 Commands (``op``): ``sub``/``pub`` (make a subscription or publisher: ``id``, ``topic``,
 ``type``, ``qos``), ``publish`` (``count`` samples, or one image), ``received`` (wait for
 ``count`` samples, then what came), ``matched``, ``graph``, ``serve``/``call`` (std_srvs
-SetBool and Trigger), ``destroy``, ``quit``.
+SetBool and Trigger), ``destroy``, ``quit``. Any other message type is imported by name
+(``pkg/msg/Name``); ``raw`` subscriptions keep each sample's bytes (hex), ``publish_raw`` sends
+bytes as they are, and ``echo`` republishes each sample of one topic on another after rclpy's
+own ``deserialize_message`` and ``serialize_message`` (whose failures it counts).
 """
 
 import hashlib
+import importlib
 import json
 import sys
 import threading
 import time
 
 import rclpy
+from rclpy.duration import Duration
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message, serialize_message
 
 from sensor_msgs.msg import Image
 from std_msgs.msg import String, UInt8MultiArray
@@ -28,9 +34,19 @@ TYPES = {"std_msgs/msg/String": String, "sensor_msgs/msg/Image": Image,
 SERVICES = {"std_srvs/srv/SetBool": SetBool, "std_srvs/srv/Trigger": Trigger}
 
 
+def message_type(name):
+    """The rclpy class of ``pkg/msg/Name`` (the tests' few by table, any other imported)."""
+    if name in TYPES:
+        return TYPES[name]
+    package, kind, short = name.split("/")
+    cls = getattr(importlib.import_module(f"{package}.{kind}"), short)
+    TYPES[name] = cls
+    return cls
+
+
 def qos_from(spec):
     spec = spec or {}
-    return QoSProfile(
+    qos = QoSProfile(
         reliability=ReliabilityPolicy.BEST_EFFORT if spec.get("reliability") == "best_effort"
         else ReliabilityPolicy.RELIABLE,
         durability=DurabilityPolicy.TRANSIENT_LOCAL if spec.get("durability") == "transient_local"
@@ -38,9 +54,14 @@ def qos_from(spec):
         history=HistoryPolicy.KEEP_ALL if spec.get("history") == "keep_all"
         else HistoryPolicy.KEEP_LAST,
         depth=spec.get("depth", 10))
+    if spec.get("deadline"):
+        qos.deadline = Duration(seconds=spec["deadline"])
+    return qos
 
 
 def summary(msg):
+    if isinstance(msg, bytes):
+        return msg.hex()
     if isinstance(msg, String):
         return msg.data
     data = bytes(msg.data)
@@ -74,14 +95,69 @@ class Agent:
                 self.received[sid].append(item)
                 self.times[sid].append(time.time())
                 self.lock.notify_all()
-        self.entities[sid] = self.node.create_subscription(TYPES[c["type"]], c["topic"], callback,
-                                                           qos_from(c.get("qos")))
+        self.entities[sid] = self.node.create_subscription(
+            message_type(c["type"]), c["topic"], callback, qos_from(c.get("qos")),
+            raw=bool(c.get("raw")))
         return {}
 
     def op_pub(self, c):
-        self.entities[c["id"]] = self.node.create_publisher(TYPES[c["type"]], c["topic"],
+        self.entities[c["id"]] = self.node.create_publisher(message_type(c["type"]), c["topic"],
                                                             qos_from(c.get("qos")))
         return {}
+
+    def op_publish_raw(self, c):
+        pub = self.entities[c["id"]]
+        for item in c["hex"]:
+            pub.publish(bytes.fromhex(item))
+            if c.get("rate"):
+                time.sleep(1.0 / c["rate"])
+        return {}
+
+    def op_echo(self, c):
+        """For each [in topic, out topic, type]: a raw subscription whose samples rclpy
+        deserializes, serializes again and publishes on the out topic (reliable, depth 100)."""
+        self.echoed = getattr(self, "echoed", {})
+        self.echo_failures = getattr(self, "echo_failures", [])
+        qos = qos_from({"depth": 100})
+        for topic, out, type_name in c["topics"]:
+            cls = message_type(type_name)
+            pub = self.node.create_publisher(cls, out, qos)
+            self.echoed[topic] = 0
+
+            def callback(data, cls=cls, pub=pub, topic=topic, type_name=type_name):
+                try:
+                    msg = deserialize_message(data, cls)
+                except Exception as exc:  # what the test asserts never happens
+                    with self.lock:
+                        self.echo_failures.append([topic, type_name, bytes(data).hex(),
+                                                   f"{type(exc).__name__}: {exc}"])
+                    return
+                pub.publish(serialize_message(msg))
+                with self.lock:
+                    self.echoed[topic] += 1
+            self.entities["echo " + topic] = self.node.create_subscription(
+                cls, topic, callback, qos, raw=True)
+            self.entities["echo out " + topic] = pub
+        return {}
+
+    def op_echo_report(self, c):
+        with self.lock:
+            return {"echoed": dict(self.echoed), "failures": list(self.echo_failures)}
+
+    def op_counts(self, c):
+        """Matched publishers of each subscription (or subscriptions of each publisher) in
+        ``ids``, waiting until each has at least ``count``."""
+        deadline = time.time() + c.get("timeout", 10)
+        while True:
+            counts = {}
+            for eid in c["ids"]:
+                entity = self.entities[eid]
+                counts[eid] = (entity.get_subscription_count()
+                               if hasattr(entity, "get_subscription_count")
+                               else entity.get_publisher_count())
+            if all(v >= c.get("count", 1) for v in counts.values()) or time.time() > deadline:
+                return {"counts": counts}
+            time.sleep(0.02)
 
     def op_matched(self, c):
         entity = self.entities[c["id"]]
@@ -143,7 +219,8 @@ class Agent:
                 for i in self.node.get_publishers_info_by_topic(c["topic"])]
             out["subscriptions"] = [
                 {"node": i.node_name, "namespace": i.node_namespace, "type": i.topic_type,
-                 "hash": str(i.topic_type_hash)}
+                 "hash": str(i.topic_type_hash), "reliability": i.qos_profile.reliability.name,
+                 "durability": i.qos_profile.durability.name}
                 for i in self.node.get_subscriptions_info_by_topic(c["topic"])]
         return out
 

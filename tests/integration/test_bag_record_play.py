@@ -10,6 +10,8 @@ import subprocess
 import time
 from pathlib import Path
 
+import pytest
+
 from integration.pubsub_scripts import TALKER
 from support import PYTHON, Proc, ros_env
 
@@ -133,6 +135,7 @@ def test_play_pause_and_step_keys(minros_core, ros_home, tmp_path):
     assert times[1] - times[0] > 0.5  # the step came alone, the rest after the space
 
 
+@pytest.mark.smoke
 def test_record_regex_exclude_and_drops(minros_core, ros_home, tmp_path):
     script = tmp_path / "talker.py"
     script.write_text(TALKER)

@@ -47,6 +47,7 @@ def test_topics_frames_and_map_are_turtlebot3s(sim):
         assert line in types
 
 
+@pytest.mark.smoke
 def test_map_saver_writes_what_map_server_serves(sim, tmp_path):
     from minros.sim import mapfile
     from minros.sim.world import DEFAULT_WORLD

@@ -450,6 +450,7 @@ def next_status(ws) -> dict:
             return msg
 
 
+@pytest.mark.smoke
 def test_bad_input_gets_status_and_leaves_others_alone(graph):
     with raw_client(graph.ws) as bystander, raw_client(graph.ws) as ws:
         bystander.send(json.dumps({"op": "subscribe", "topic": "/chatter", "id": "keep"}))

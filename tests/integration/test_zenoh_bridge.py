@@ -165,6 +165,7 @@ def test_definition_and_latching_travel_to_a_site_without_the_msg_file(pair, tmp
         assert "geometry_msgs/Point where" in definition and "MSG: geometry_msgs/Point" in definition
 
 
+@pytest.mark.smoke
 def test_plain_zenoh_publisher_feeds_a_subscriber_only_topic(pair, session):
     from minros.zenoh import keys
 

@@ -414,6 +414,7 @@ def debian_read_images(path: Path) -> List[list]:
     return json.loads(result.stdout)
 
 
+@pytest.mark.smoke
 def test_lz4_bag_api_multi_block_chunks_read_by_debian(tmp_path):
     """The Bag API's lz4 compression, chunks of 4 MB of varied bytes, read back by Debian."""
     require_reference()

@@ -71,6 +71,7 @@ def test_compressed_roundtrip():
     assert np.array_equal(bridge.compressed_imgmsg_to_cv2(msg), image)
 
 
+@pytest.mark.slow
 def test_matches_debians_cv_bridge():
     """getCvType and cv2_to_imgmsg fields agree with Debian's python3-cv-bridge."""
     require_reference()
@@ -158,6 +159,7 @@ print(json.dumps(out))
 '''
 
 
+@pytest.mark.slow
 def test_display_conversion_matches_debians_extension():
     """cv_bridge.boost's cvtColorForDisplay (label colours, scaling, guessing the output) and
     cvtColor2 give Debian's C++ extension's pixels, and its refusals with its texts."""

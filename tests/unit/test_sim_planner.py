@@ -122,6 +122,7 @@ def drive(world: World, name: str, follower: planner.Follower, seconds: float, d
     return status
 
 
+@pytest.mark.slow  # over half a CPU-second of its own
 @pytest.mark.parametrize("goal", [(4.0, 0.0, math.pi / 2), (-3.0, -3.0, math.pi), (-2.5, 3.0, 0.0)])
 def test_the_follower_drives_a_simulated_robot_to_the_goal(rooms, goal):
     world = World(rooms)

@@ -118,6 +118,7 @@ def _bash(script: str, cwd: Path, env=None) -> str:
     return result.stdout
 
 
+@pytest.mark.slow
 def test_make_writes_devel_space_and_setup_puts_paths_first(tmp_path: Path):
     ws = tmp_path / "ws"
     (ws / "src").mkdir(parents=True)
@@ -148,6 +149,7 @@ def test_make_writes_devel_space_and_setup_puts_paths_first(tmp_path: Path):
     assert printed[4] == "42 8"
 
 
+@pytest.mark.slow
 def test_env_sh_runs_command_in_workspace(tmp_path: Path):
     ws = tmp_path / "ws"
     (ws / "src").mkdir(parents=True)
@@ -157,6 +159,7 @@ def test_env_sh_runs_command_in_workspace(tmp_path: Path):
     assert out.stdout.strip() == str(ws / "src")
 
 
+@pytest.mark.slow
 def test_make_generates_importable_messages_and_rejects_malformed(tmp_path: Path):
     ws = tmp_path / "ws"
     (ws / "src").mkdir(parents=True)
@@ -183,6 +186,7 @@ def test_make_generates_importable_messages_and_rejects_malformed(tmp_path: Path
 # what it lacks: tests/integration/test_workspace_overlay.py
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shell,setup", [("bash", "setup.bash"), ("sh", "setup.sh"), ("zsh", "setup.zsh")])
 def test_setup_files_in_each_shell_with_a_space_in_the_path(tmp_path: Path, shell: str, setup: str):
     import shutil

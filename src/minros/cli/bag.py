@@ -285,10 +285,10 @@ def compress_cmd(argv: List[str], prog: str = "rosbag") -> int:
     options, args = p.parse_args(argv)
     if not args:
         p.error("You must specify at least one bag file.")
-    from minros.bag.ops import bag_op
+    from minros.bag import ops
 
-    return bag_op(args, "compress", options.compression, options.output_dir, bool(options.force),
-                  bool(options.quiet))
+    return ops.compress(args, options.compression, options.output_dir, bool(options.force),
+                        bool(options.quiet))
 
 
 def decompress_cmd(argv: List[str], prog: str = "rosbag") -> int:
@@ -296,9 +296,9 @@ def decompress_cmd(argv: List[str], prog: str = "rosbag") -> int:
     options, args = p.parse_args(argv)
     if not args:
         p.error("You must specify at least one bag file.")
-    from minros.bag.ops import bag_op
+    from minros.bag import ops
 
-    return bag_op(args, "decompress", "none", options.output_dir, bool(options.force), bool(options.quiet))
+    return ops.compress(args, "none", options.output_dir, bool(options.force), bool(options.quiet))
 
 
 def reindex_cmd(argv: List[str], prog: str = "rosbag") -> int:
@@ -307,9 +307,9 @@ def reindex_cmd(argv: List[str], prog: str = "rosbag") -> int:
     options, args = p.parse_args(argv)
     if not args:
         p.error("You must specify at least one bag file.")
-    from minros.bag.ops import bag_op
+    from minros.bag import ops
 
-    return bag_op(args, "reindex", "none", options.output_dir, bool(options.force), bool(options.quiet))
+    return ops.reindex(args, options.output_dir, bool(options.force), bool(options.quiet))
 
 
 def print_trans(old: Any, new: Any, indent: int) -> None:
@@ -572,119 +572,13 @@ def play_node_main() -> int:
 # ---------------------------------------------------------------------------------------------
 # rosbag.rosbag_main's Python API (the stand-in re-exports it): the commands above take
 # argv without the command name, as rosbag's do, and return the exit status; these are the
-# pieces they are built from
+# pieces they are built from (bag_op and its ops are minros.bag.ops')
 
 handle_split = _handle_split
 handle_topics = _collect("topics")
 handle_pause_topics = _collect("pause_topics")
 encrypt_cmd = COMMANDS["encrypt"]
 decrypt_cmd = COMMANDS["decrypt"]
-
-
-def bag_op(inbag_filenames: List[str], allow_unindexed: bool, open_inbag: bool,
-           copy_fn: Callable[[Any], bool], op: Callable[..., None],
-           output_dir: Optional[str] = None, force: bool = False, quiet: bool = False) -> None:
-    """Run ``op(inbag, outbag, quiet=quiet)`` on each bag, writing in place (the input kept
-    as ``NAME.orig.EXT``) or into ``output_dir``. ``copy_fn(bag)`` says whether to start
-    from a copy of the input (opened for appending) rather than an empty bag; without
-    ``open_inbag``, ``op`` gets the input's file name."""
-    import shutil
-
-    from minros.bag import Bag, ROSBagException, ROSBagUnindexedException
-
-    for name in inbag_filenames:
-        copy = False
-        if open_inbag:
-            try:
-                with Bag(name, "r", allow_unindexed=allow_unindexed) as inbag:
-                    copy = bool(copy_fn(inbag))
-            except ROSBagUnindexedException:
-                _fail(f"ERROR bag unindexed: {name}.  Run rosbag reindex.")
-                continue
-            except (ROSBagException, OSError) as exc:
-                _fail(f"ERROR reading {name}: {exc}")
-                continue
-        out_name = name if output_dir is None else os.path.join(output_dir, os.path.basename(name))
-        backup = None
-        source = name
-        if out_name == name:
-            root, ext = os.path.splitext(name)
-            backup = f"{root}.orig{ext}"
-            if not force and os.path.exists(backup):
-                if not quiet:
-                    _fail(f"Skipping {name}. Backup path {backup} already exists.")
-                continue
-            try:
-                (shutil.copy if copy else os.rename)(name, backup)
-            except OSError as exc:
-                _fail(f"ERROR {'copying' if copy else 'moving'} {name} to {backup}: {exc}")
-                continue
-            source = backup
-        elif copy:
-            shutil.copy(name, out_name)
-            source = out_name
-        try:
-            try:
-                outbag = Bag(out_name, "a" if copy else "w", allow_unindexed=allow_unindexed)
-            except (ROSBagException, OSError) as exc:
-                _fail(f"ERROR writing to {out_name}: {exc}")
-                continue
-            inbag = Bag(source, "r", allow_unindexed=allow_unindexed) if open_inbag else source
-            try:
-                op(inbag, outbag, quiet=quiet)
-            except ROSBagException as exc:
-                _fail(f"\nERROR operating on {source}: {exc}")
-            finally:
-                outbag.close()
-                if open_inbag:
-                    inbag.close()
-        except KeyboardInterrupt:
-            if backup is not None:
-                try:
-                    if copy:
-                        os.remove(backup)
-                    else:
-                        os.rename(backup, name)
-                except OSError:
-                    pass
-            raise
-        except (ROSBagException, OSError) as exc:
-            _fail(f"ERROR operating on {name}: {exc}")
-
-
-def change_compression_op(inbag: Any, outbag: Any, compression: str, quiet: bool) -> None:
-    """Copy every message of ``inbag`` into ``outbag`` with ``compression`` (as recorded:
-    raw bytes, connection headers kept), with rosbag's progress bar unless ``quiet``."""
-    from minros.bag.progress import ProgressMeter
-
-    outbag.compression = compression
-    meter = None if quiet else ProgressMeter(outbag.filename, inbag._uncompressed_size)
-    total = 0
-    for topic, msg, t, header in inbag.read_messages(raw=True, return_connection_header=True):
-        outbag.write(topic, msg, t, raw=True, connection_header=header)
-        if meter is not None:
-            total += len(msg[1])
-            meter.step(total)
-    if meter is not None:
-        meter.finish()
-
-
-def reindex_op(inbag: Any, outbag: Any, quiet: bool) -> None:
-    """Rebuild ``outbag``'s index (a copy of ``inbag`` opened for appending) from its chunks."""
-    from minros.bag import ROSBagEncryptException, ROSBagEncryptNotSupportedException
-    from minros.bag.progress import ProgressMeter
-
-    meter = None if quiet else ProgressMeter(outbag.filename, outbag.size)
-    try:
-        for offset in outbag.reindex():
-            if meter is not None:
-                meter.step(offset)
-    except (ROSBagEncryptNotSupportedException, ROSBagEncryptException):
-        raise
-    except Exception:  # noqa: BLE001 - damage past the last good chunk ends the scan, as in rosbag
-        pass
-    if meter is not None:
-        meter.finish()
 
 
 class RosbagCmds(collections.UserDict):

@@ -40,6 +40,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "master": ("minros.master", "run a ROS master alone, without rosout (rosmaster)"),
     "learn": ("minros.cli.learn", "exercises on the ROS wire that check themselves"),
     "zenoh": ("minros.cli.zenoh", "bridge topics and services with Zenoh (zenoh-bridge-ros1's wire)"),
+    "ros2": ("minros.cli.ros2", "bridge topics and services with a ROS 2 domain (ros1_bridge)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)

@@ -243,7 +243,7 @@ class Node:
                             check)
 
     def create_service(self, name: str, srv_type: str,
-                       handler: Callable[[bytes], Payload],
+                       handler: Callable[[bytes], Optional[Payload]],
                        qos: QoSProfile = SERVICES_DEFAULT, *, request_hash: Optional[str] = None,
                        response_hash: Optional[str] = None) -> Service:
         """A service server of ``srv_type`` (``std_srvs/srv/SetBool``): ``handler(request)``

@@ -73,10 +73,12 @@ def _related_identity(sample: Sample) -> Optional[Tuple[bytes, int]]:
 
 class Service:
     """A service server: ``handler(request)`` gets the serialized request (CDR, encapsulation
-    header first) and returns the serialized response, in the service's own thread."""
+    header first) and returns the serialized response, in the service's own thread; None
+    sends no reply (a handler that cannot answer, as a bridge whose far server failed: the
+    client's call times out, as with a server that is gone)."""
 
     def __init__(self, node: Any, name: str, srv_type: str,
-                 handler: Callable[[bytes], Payload], qos: QoSProfile,
+                 handler: Callable[[bytes], Optional[Payload]], qos: QoSProfile,
                  request_hash: Optional[str], response_hash: Optional[str]) -> None:
         self.node = node
         self.name = name
@@ -133,8 +135,11 @@ class Service:
                             self.name, g.guid_text(sample.writer))
                 return
             header = payload[4:4 + _CDDS_HEADER.size]
-            response = bytes(self.handler(payload[:4] + payload[4 + _CDDS_HEADER.size:]))
+            answer = self.handler(payload[:4] + payload[4 + _CDDS_HEADER.size:])
             self.handled += 1
+            if answer is None:
+                return  # the handler chose not to answer (it said why)
+            response = bytes(answer)
             if not self._wait_for_cyclone_client(sample.writer):
                 log.warning("ROS 2 service %s: the reply reader of client %s did not match "
                             "within %g s; its reply is dropped", self.name,
@@ -146,8 +151,11 @@ class Service:
         target = sample.writer
         if related is not None and related[0] != g.GUID_UNKNOWN:
             target = related[0]
-        response = bytes(self.handler(payload))
+        answer = self.handler(payload)
         self.handled += 1
+        if answer is None:
+            return  # the handler chose not to answer (it said why)
+        response = bytes(answer)
         if g.is_reader(target[12:]) and not self.reply_writer.wait_matched(
                 target, REPLY_MATCH_TIMEOUT):
             log.warning("ROS 2 service %s: the reply reader %s did not match within %g s; its "

@@ -68,6 +68,9 @@ FIRST_BURST = {g.VENDOR_FASTDDS: 3 * 64_000, g.VENDOR_CYCLONE: 8 * 64_000,
 #: a minros reader answers each burst at once: at most this much goes unanswered to it (its
 #: socket holds 8 MiB; a reader behind is waited for, not overflowed)
 MINROS_UNANSWERED = 2 << 20
+#: how long a writer that paces in its caller's thread sends bursts there (the timer thread
+#: sends what is left after)
+PACE_IN_CALLER_LIMIT = 0.05
 
 
 class RemoteParticipant:
@@ -139,6 +142,11 @@ class LocalWriter(LocalEndpoint):
         self.machine = machine
         #: in-process readers matched to this writer
         self.local_readers: List[LocalReader] = []
+        #: write() sends a fragmented sample's later bursts itself, sleeping between them,
+        #: instead of leaving them to the timer thread: the caller waits up to
+        #: PACE_IN_CALLER_LIMIT, and the bursts leave on time in a process whose other
+        #: threads hold the GIL for milliseconds (the bridge's, converting 6 MB images)
+        self.pace_in_caller = False
 
     def write(self, payload: bytes | bytearray | memoryview, *, inline_qos: bytes = b"",
               timestamp: Optional[int] = None) -> int:
@@ -163,6 +171,8 @@ class LocalWriter(LocalEndpoint):
             due = machine.next_deadline()
             local = list(self.local_readers)
         part._send(out)
+        if due is not None and self.pace_in_caller:
+            due = self._pace(due)
         if due is not None:
             part._wake_timer(due)
         if local:
@@ -170,6 +180,27 @@ class LocalWriter(LocalEndpoint):
             for reader in local:
                 reader._deliver_local(sample)
         return sn
+
+    def _pace(self, due: Optional[float]) -> Optional[float]:
+        """Send the bursts of a fragmented sample from the writing thread, each when it is
+        due (``pace_in_caller``), for at most PACE_IN_CALLER_LIMIT; the next deadline."""
+        part = self.participant
+        limit = time.monotonic() + PACE_IN_CALLER_LIMIT
+        while due is not None:
+            machine = self.machine
+            if not any(p.paced and not p.awaiting for p in machine.proxies.values()):
+                break
+            now = time.monotonic()
+            if now > limit:
+                break
+            if due > now:
+                time.sleep(due - now)
+            with self.lock:
+                now = time.monotonic()
+                out = machine.tick(now)
+                due = machine.next_deadline()
+            part._send(out)
+        return due
 
     def wait_acknowledged(self, sn: int, timeout: float) -> bool:
         """Wait until every reliable reader acknowledged ``sn``."""
