@@ -172,7 +172,7 @@ def main() -> int:
                     + "".join(f",\nexcept {p.partition('/')[2]}: from the {w} wheel ({n})"
                               for p, w, n in FROM_WHEELS[distro] if p.startswith(pkg + "/"))
                     + f".\nLicence: {licence_id}; its text is ../../LICENSES/{name}.\n")
-                rows.append(f"| {pkg} | {repo} | {branch} | `{commit[:12]}` | {version} | "
+                rows.append(f"| {pkg} | {repo} | {branch} | `{commit}` | {version} | "
                             f"{licence_id} | {count} |")
         for path, _wheel, _note in FROM_WHEELS[distro]:
             source = args.wheels / distro / "share" / path

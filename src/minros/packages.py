@@ -81,12 +81,13 @@ def _walk(root: Path, found: Dict[str, List[Path]]) -> None:
         _walk(Path(entry.path), found)
 
 
-def _search_roots() -> List[Path]:
+def search_roots() -> List[Path]:
+    """The folders packages are found under: ROS_PACKAGE_PATH's, then minros's own."""
     return ros_package_path() + list(BUILTIN_SHARE_DIRS)
 
 
 def _all_packages(refresh: bool = False) -> Dict[str, List[Path]]:
-    roots = _search_roots()
+    roots = search_roots()
     key = os.pathsep.join(str(r) for r in roots)
     with _cache_lock:
         if not refresh and key in _cache:
@@ -139,7 +140,7 @@ def rospack() -> Any:
     bundled packages): rospkg reads manifests and dependency lists as ROS's tools do."""
     import rospkg
 
-    return rospkg.RosPack(ros_paths=[str(p) for p in _search_roots()])
+    return rospkg.RosPack(ros_paths=[str(p) for p in search_roots()])
 
 
 _bootstrapped: List[str] = []

@@ -187,3 +187,22 @@ def test_a_master_uri_without_scheme_ends_init_node_at_once(ros_home, tmp_path):
     assert done.stdout == "caught: " + BAD_URI[len("ERROR: "):]
     assert done.stderr.rstrip().splitlines()[-1] == \
         "minros.rosenv.MasterURIError: " + BAD_URI[len("ERROR: "):].rstrip()
+
+
+@pytest.mark.parametrize("node", [
+    "rospy_tutorials talker", "rospy_tutorials listener", "rospy_tutorials add_two_ints_server",
+    "rosout rosout", "joint_state_publisher joint_state_publisher",
+    "robot_state_publisher robot_state_publisher", "tf2_ros buffer_server",
+    "tf2_web_republisher tf2_web_republisher", "rostest hztest",
+    "rosbridge_server rosbridge_websocket", "foxglove_bridge foxglove_bridge",
+    "rosapi rosapi_node", "turtlesim turtlesim_node"])
+def test_a_master_uri_without_scheme_is_named_by_every_built_in_node(node, ros_home, tmp_path):
+    """rosrun runs minros's nodes through one runner (python -m minros.nodes MODULE), which
+    turns init_node's ROSInitException into one line: the tutorials have no handler of their
+    own (they printed a traceback)."""
+    env = ros_env(None, ros_home, {"ROS_MASTER_URI": "localhost:11311"})
+    pkg, exe = node.split()
+    done = run([str(VENV_BIN / "rosrun"), pkg, exe], env=env, cwd=tmp_path, timeout=30)
+    assert done.returncode == 1, done
+    assert done.stderr == f"{exe}: {BAD_URI[len('ERROR: '):]}", done.stderr
+    assert "Traceback" not in done.stdout

@@ -95,3 +95,22 @@ def test_a_real_python_package_wins_over_a_ros_package_of_its_name(tmp_path: Pat
     out = _run("import json\nprint(json.dumps([1]))", tmp_path, ROS_PACKAGE_PATH=str(tmp_path / "ws"))
     assert out.stdout.strip() == "[1]", out.stderr
     assert sys.executable  # the venv's interpreter ran both sides
+
+
+def test_a_failed_import_does_not_crawl_the_package_path(tmp_path: Path):
+    """Python asks the hook about every import nothing else found (Debian's sitecustomize tries
+    ``apport_python_hook`` in every interpreter): such a miss must not crawl ROS_PACKAGE_PATH
+    (450 ms for /usr/share) nor import minros; a package deep in a workspace still imports."""
+    ws = tmp_path / "ws"
+    _package(ws / "a_repo" / "group", "deep_msgs")  # below the top level of the entry
+    code = ("import sys\n"
+            "for name in ('org', 'apport_python_hook', 'deep_msgs'):\n"
+            "    try:\n        __import__(name)\n    except ModuleNotFoundError:\n"
+            "        print('missing', name)\n"
+            "print('minros' in sys.modules)\n"
+            "from deep_msgs.msg import Num\nprint(Num._type)\n")
+    out = _run(code, tmp_path, ROS_PACKAGE_PATH=str(ws))
+    assert out.returncode == 0, out.stderr
+    # a bare name deep in a workspace is not a look (only as the parent of deep_msgs.msg)
+    assert out.stdout.split("\n")[:5] == ["missing org", "missing apport_python_hook",
+                                          "missing deep_msgs", "False", "deep_msgs/Num"]

@@ -115,7 +115,7 @@ def test_rosrun_builtin_tutorial_resolves_to_module():
     from minros.workspace import executables
 
     assert executables.resolve_executable("rospy_tutorials", "talker.py") == [
-        sys.executable, "-m", "minros.nodes.rospy_tutorials.talker"]
+        sys.executable, "-m", "minros.nodes", "minros.nodes.rospy_tutorials.talker"]
 
 
 def test_rospack_find_and_list(tmp_path, pkg_path):
@@ -235,7 +235,7 @@ def test_every_shipped_program_runs_under_its_ros_package_name() -> None:
                      ("rosservice", "rosservice"), ("rosmsg", "rosmsg"), ("rosbag", "rosbag"),
                      ("rosconsole", "rosconsole"), ("rostest", "rostest")):
         argv = executables.resolve_executable(pkg, exe)
-        assert argv[1:3] == ["-m", executables.BUILTIN_NODES[pkg][exe]]
+        assert argv[1:4] == ["-m", "minros.nodes", executables.BUILTIN_NODES[pkg][exe]]
         run = subprocess.run(argv + ["-h"], capture_output=True, text=True, timeout=60)
         assert pkg in (run.stdout + run.stderr).lower(), (pkg, run.stdout, run.stderr)
         assert "Traceback" not in run.stderr, run.stderr

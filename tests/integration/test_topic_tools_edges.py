@@ -102,32 +102,46 @@ def test_mux_services_as_ros_test_mux_services_uses_them(minros_master: int, ros
 
 
 # Counts what reaches /stealth_out while /orig_relay (the monitored topic) has a subscriber of
-# its own, and while it has none: a stealth relay forwards only in the first phase.
+# its own, and while it has none: a stealth relay forwards only in the first phase. The relay's
+# decisions are seen at the master (its subscription to /orig_relay, checked every 0.2 s:
+# _monitor_rate); a phase that proves something does NOT happen watches for WINDOW, five of
+# the relay's checks, failing at once when it happens (an absence has no event to wait for).
 STEALTH_PROBE = textwrap.dedent(r"""
-    import json, sys, threading, time
+    import json, os, threading, time, xmlrpc.client
     import rospy
     from std_msgs.msg import String
+    WINDOW = 5 * 0.2
     rospy.init_node("stealth_probe")
+    me = rospy.get_name()
+    master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+
+    def relay_subscribed():
+        subs = master.getSystemState(me)[2][1]
+        return any(node != me for topic, nodes in subs if topic == "/orig_relay" for node in nodes)
+
+    def until(done, seconds):
+        deadline = time.monotonic() + seconds
+        while not done() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        return done()
+
     out = []
     sub = rospy.Subscriber("/stealth_out", String, lambda m: out.append(time.monotonic()))
-    deadline = time.monotonic() + 20
-    while sub.get_num_connections() == 0 and time.monotonic() < deadline:
-        time.sleep(0.05)
-    phases = {"connected": sub.get_num_connections() > 0}
-    time.sleep(1.5)
+    phases = {"connected": until(lambda: sub.get_num_connections() > 0, 20)}
+    # its own subscriber (this probe) does not wake it: it stays off /orig_relay for WINDOW
+    phases["woke_before_monitor"] = until(lambda: out or relay_subscribed(), WINDOW)
     phases["before_monitor"] = len(out)
     came = threading.Event()
     monitor = rospy.Subscriber("/orig_relay", String, lambda m: came.set())
-    came.wait(10)
+    phases["monitor_fed"] = came.wait(10)
     start = len(out)
-    deadline = time.monotonic() + 10
-    while len(out) - start < 3 and time.monotonic() < deadline:
-        time.sleep(0.05)
+    until(lambda: len(out) - start >= 3, 10)
     phases["while_monitored"] = len(out) - start
     monitor.unregister()
-    time.sleep(1.0)  # the relay checks its monitored topic every 0.2 s
+    # it lets go of its input at its next check; then nothing more comes through
+    phases["let_go"] = until(lambda: not relay_subscribed(), 10)
     settled = len(out)
-    time.sleep(1.5)
+    until(lambda: len(out) - settled > 2, WINDOW)
     phases["after_monitor"] = len(out) - settled
     print("PHASES " + json.dumps(phases), flush=True)
 """)
@@ -153,10 +167,12 @@ def test_relay_lazy_and_stealth(minros_master: int, ros_home: Path, tmp_path: Pa
         import json
 
         phases = json.loads(line[len("PHASES "):])
-        assert phases["connected"], phases
-        assert phases["before_monitor"] == 0, phases  # its own subscriber does not wake it
+        assert phases["connected"] and phases["monitor_fed"], phases
+        assert not phases["woke_before_monitor"], phases  # its own subscriber does not wake it
+        assert phases["before_monitor"] == 0, phases
         assert phases["while_monitored"] >= 3, phases
-        assert phases["after_monitor"] <= 2, phases  # it let go of its input again
+        assert phases["let_go"], phases  # it let go of its input again
+        assert phases["after_monitor"] <= 2, phases  # at most what was in flight
     finally:
         for proc in procs:
             proc.stop()

@@ -128,6 +128,40 @@ def test_the_page_route_serves_package_meshes_and_nothing_else(system):
         assert text in body.decode(), body
 
 
+def _raw(port: int, request: bytes) -> bytes:
+    """Everything the server writes for ``request`` until it closes (raw: urllib reads no
+    body of a HEAD answer, so it could not see one sent)."""
+    import socket
+
+    with socket.create_connection(("127.0.0.1", port), timeout=10) as sock:
+        sock.sendall(request)
+        got = b""
+        while chunk := sock.recv(65536):
+            got += chunk
+    return got
+
+
+def test_a_head_request_gets_the_head_alone(system):
+    """HEAD /pkg/...: GET's head (its Content-Length the file's) and no body (RFC 9110); the
+    body was sent, and a keep-alive client would read it as the next answer."""
+    mesh = (PKG / "meshes" / "wedge.stl").read_bytes()
+    for path, status, length in [("/pkg/scene_pkg/meshes/wedge.stl", b"200", len(mesh)),
+                                 ("/pkg/scene_pkg/meshes/missing.stl", b"404", None),
+                                 ("/", b"200", None)]:
+        request = f"{{}} {path} HTTP/1.1\r\nHost: 127.0.0.1:{system.web_port}\r\n\r\n"
+        got = _raw(system.web_port, request.format("GET").encode())
+        head, _, body = got.partition(b"\r\n\r\n")
+        assert head.split(b" ")[1] == status, got[:300]
+        assert f"content-length: {len(body)}".encode() in head.lower(), head
+        if length is not None:
+            assert body == mesh
+        got = _raw(system.web_port, request.format("HEAD").encode())
+        head_only, _, rest = got.partition(b"\r\n\r\n")
+        assert rest == b"", (path, rest[:100])
+        assert head_only.split(b" ")[1] == status
+        assert f"content-length: {len(body)}".encode() in head_only.lower(), head_only
+
+
 def test_a_custom_allow_list_and_the_token_guard_the_route(system, tmp_path):
     home = tmp_path / "home"
     (home / "log").mkdir(parents=True)

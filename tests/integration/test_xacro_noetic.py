@@ -88,7 +88,7 @@ def _find_xacro(pkg: Path) -> list:
 
 @pytest.mark.parametrize("how", ["rosrun", "find", "command"])
 def test_namespaced_calls_as_noetic(package: Path, how: str):
-    argv = {"rosrun": [str(BIN / "rosrun"), "xacro", "xacro"], "command": [str(BIN / "xacro")],
+    argv = {"rosrun": [str(BIN / "rosrun"), "xacro", "xacro"], "command": [str(BIN / "xacro-noetic")],
             "find": None}[how] or _find_xacro(package)
     out = subprocess.run([*argv, str(package / "urdf" / "robot.xacro")], env=_env(package),
                          cwd=package / "urdf", capture_output=True, text=True, timeout=60)
@@ -104,3 +104,17 @@ def test_a_missing_package_is_named_with_the_package_path(package: Path):
     assert f"error: resource not found: no_such_package\nROS path [0]={package.parent}\n" \
         in out.stderr
     assert "<class" not in out.stderr
+
+
+def test_the_xacro_command_stays_pypis_and_finds_packages(package: Path):
+    """``xacro`` on PATH is PyPI's own script (minros's is ``xacro-noetic``: installing or
+    removing minros no longer overwrites or deletes it); its $(find pkg) still answers
+    through minros's package lookup (the ament_index_python stand-in)."""
+    assert "from xacro import main" in (BIN / "xacro").read_text()
+    (package / "urdf" / "plain.xacro").write_text(
+        '<robot name="p" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<link name="$(find xacro_pkg)"/></robot>\n')
+    out = subprocess.run([str(BIN / "xacro"), str(package / "urdf" / "plain.xacro")],
+                         env=_env(package), capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert f'<link name="{package}"/>' in out.stdout

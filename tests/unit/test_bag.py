@@ -298,13 +298,37 @@ def test_sink_size_without_split_ends_the_recording(tmp_path, monkeypatch):
         assert b.get_message_count() == 4
 
 
-def _run_sink(sink: BagSink, queue: RecordQueue, clock: list, ticks: list) -> threading.Thread:
-    """The writer thread on a clock the test moves: each tick once the sink is idle."""
+class _Clock:
+    """The sink's clock, moved by the test, which counts the writer's looks at it: the writer
+    reads it once an idle turn, before it checks the duration against it, so a second look
+    after a move says that the check with the new time is done."""
+
+    def __init__(self, ns: int) -> None:
+        self.ns = ns
+        self.looks = 0
+        self._changed = threading.Condition()
+
+    def __call__(self) -> int:
+        with self._changed:
+            self.looks += 1
+            self._changed.notify_all()
+            return self.ns
+
+    def move(self, seconds: float, writer: threading.Thread) -> None:
+        """Set the time, then wait (bounded) for two looks of the writer, or for its end."""
+        with self._changed:
+            self.ns = int(seconds * 1e9)
+            target = self.looks + 2
+            assert self._changed.wait_for(lambda: self.looks >= target or not writer.is_alive(),
+                                          timeout=5), "the writer did not look at the clock"
+
+
+def _run_sink(sink: BagSink, queue: RecordQueue, clock: _Clock, ticks: list) -> threading.Thread:
+    """The writer thread, the clock moved to each tick once the writer has checked the last."""
     writer = threading.Thread(target=sink.run, args=(queue,), daemon=True)
     writer.start()
     for t in ticks:
-        time.sleep(FLUSH_INTERVAL)  # two idle looks of the writer per tick
-        clock[0] = int(t * 1e9)
+        clock.move(t, writer)
     return writer
 
 
@@ -312,14 +336,13 @@ def test_sink_duration_ends_an_idle_recording(tmp_path, monkeypatch):
     """No message at all: the recording still ends DURATION after it began (ROS's recorder
     looks at the clock every quarter second), leaving the empty bag it opened at the start."""
     monkeypatch.chdir(tmp_path)
-    clock = [100_000_000_000]
-    sink = BagSink(RecordOptions(name="idle", duration="1"), lambda level, text: None,
-                   clock=lambda: clock[0])
-    sink.start(clock[0])
+    clock = _Clock(100_000_000_000)
+    sink = BagSink(RecordOptions(name="idle", duration="1"), lambda level, text: None, clock=clock)
+    sink.start(clock.ns)
     queue = RecordQueue(0)
     writer = _run_sink(sink, queue, clock, [100.5, 101.0])
     assert writer.is_alive()  # 1.0 s after the start is not more than the duration
-    clock[0] = 101_000_000_001
+    clock.move(101.000000001, writer)
     writer.join(5)
     assert not writer.is_alive() and sink.finished and not queue.closed
     assert sorted(p.name for p in tmp_path.iterdir()) == ["idle.bag"]
@@ -330,15 +353,13 @@ def test_sink_idle_split_by_duration_and_a_clock_leap(tmp_path, monkeypatch):
     """With --split an idle recording rotates files all the same (empty ones, as ROS's); a
     clock leaping a million periods ahead makes one new file, not a million."""
     monkeypatch.chdir(tmp_path)
-    clock = [100_000_000_000]
+    clock = _Clock(100_000_000_000)
     sink = BagSink(RecordOptions(name="part", split=True, duration="1"),
-                   lambda level, text: None, clock=lambda: clock[0])
-    sink.start(clock[0])
+                   lambda level, text: None, clock=clock)
+    sink.start(clock.ns)
     queue = RecordQueue(0)
     writer = _run_sink(sink, queue, clock, [101.5, 1_000_100.5])
-    wait = time.monotonic() + 5
-    while sink.split_index != 2 and time.monotonic() < wait:
-        time.sleep(0.05)
+    assert sink.split_index == 2
     queue.push(_item(0, 1_000_100.6))
     queue.close()
     writer.join(5)

@@ -40,9 +40,10 @@ def test_every_package_names_its_source_and_licence():
     for distro in DISTROS:
         sources = (SHARE / distro / "SOURCES.md").read_text()
         for package in sorted(p.name for p in (SHARE / distro).iterdir() if p.is_dir()):
-            row = re.search(rf"^\| {package} \| (\S+) \| (\S+) \| `([0-9a-f]{{12}})` \|", sources,
+            row = re.search(rf"^\| {package} \| (\S+) \| (\S+) \| `([0-9a-f]{{40}})` \|", sources,
                             re.M)
-            assert row, f"{distro}/{package} has no row in SOURCES.md"
+            # the whole commit: an abbreviation names nothing once the repository grows
+            assert row, f"{distro}/{package} has no row naming a full commit in SOURCES.md"
             copyright = (SHARE / distro / package / "COPYRIGHT").read_text()
             assert f"https://github.com/{row.group(1)}" in copyright
             assert f"commit {row.group(3)}" in copyright

@@ -247,6 +247,133 @@ def test_a_small_png_claiming_a_huge_picture_costs_no_memory(tmp_path):
     assert out.stderr == ""
 
 
+def png_zeros(width: int, height: int, colour: int = 6) -> bytes:
+    """A complete 8-bit PNG of ``width`` x ``height`` zeros, built fast: one deflate block of
+    rows ended by a full flush (so that it stands alone) repeated, and the Adler-32 of all."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return (struct.pack(">I", len(body)) + kind + body
+                + struct.pack(">I", zlib.crc32(kind + body)))
+
+    row = bytes(1 + width * {0: 1, 2: 3, 4: 2, 6: 4}[colour])
+    per = max(1, (1 << 22) // len(row))
+    whole, rest = divmod(height, per)
+    raw = zlib.compressobj(9, zlib.DEFLATED, -15)
+    block = raw.compress(row * per) + raw.flush(zlib.Z_FULL_FLUSH)
+    tail = zlib.compressobj(9, zlib.DEFLATED, -15)
+    last = tail.compress(row * rest) + tail.flush()
+    check = 1
+    for _ in range(whole):
+        check = zlib.adler32(row * per, check)
+    check = zlib.adler32(row * rest, check)
+    data = b"\x78\xda" + block * whole + last + struct.pack(">I", check)
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, colour, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", data)
+            + chunk(b"IEND", b""))
+
+
+#: loads a map in a fresh process and prints the MapError (or "loaded") and the growth of the
+#: peak RSS in bytes, measured after a first small decode (OpenCV's codecs are loaded lazily)
+PEAK_PROBE = (
+    "import os, resource, sys, tempfile\n"
+    "import cv2, numpy\n"
+    "from minros.sim import mapfile\n"
+    "warm = os.path.join(tempfile.mkdtemp(), 'w.png')\n"
+    "cv2.imwrite(warm, numpy.zeros((4, 4, 4), numpy.uint8)); cv2.imread(warm, -1)\n"
+    "before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+    "try:\n"
+    "    mapfile.load_map(sys.argv[1])\n"
+    "    print('loaded')\n"
+    "except mapfile.MapError as exc:\n"
+    "    print(exc)\n"
+    "print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) * 1024)\n")
+
+
+def _load_in_a_process(path: Path) -> tuple:
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", PEAK_PROBE, str(path)], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0 and out.stderr == "", out.stderr
+    message, grown = out.stdout.strip().splitlines()
+    return message, int(grown)
+
+
+def test_a_1mb_png_of_16384_square_rgba_is_refused_from_its_header(tmp_path):
+    """1 GiB decoded passed the old limit (MAX_CELLS and 1 GiB): map_server spent 2.1 GB and
+    34 s on it. A map needs what its grid needs as 8-bit gray: 256 MiB decoded."""
+    path = write_map(tmp_path, np.zeros((1, 1), np.uint8), name="rgba", image="rgba.png")
+    (tmp_path / "rgba.png").write_bytes(png_zeros(16384, 16384, colour=6))
+    assert (tmp_path / "rgba.png").stat().st_size < 1_100_000
+    message, grown = _load_in_a_process(path)
+    assert "is too large (16384 x 16384 PNG" in message and "256 MB decoded" in message
+    assert grown < 20 << 20, f"refusing it grew the peak RSS by {grown >> 20} MB"
+
+
+def test_the_load_peak_is_bounded_for_any_accepted_file():
+    """What the README says: at most 2 x 256 MiB + 32 MiB, whatever the file."""
+    assert mapfile.MAX_IMAGE_BYTES == 256 << 20
+    assert 2 * mapfile.MAX_IMAGE_BYTES + mapfile.LOAD_SCRATCH == 544 << 20
+    for width, height, pixel_bytes in [(16384, 16384, 1), (8192, 8192, 4), (1 << 28, 1, 1),
+                                       (8192, 4096, 8)]:
+        header = mapfile.ImageHeader("PNG", width, height, pixel_bytes)
+        assert width * height <= mapfile.MAX_CELLS
+        assert width * height * pixel_bytes <= mapfile.MAX_IMAGE_BYTES
+        assert mapfile.load_peak_bytes(header) <= 544 << 20
+
+
+@pytest.mark.parametrize("shape, dtype, mode, image", [
+    ((3000, 3000), np.uint8, "trinary", "m.png"),
+    ((2000, 2000, 4), np.uint8, "trinary", "m.png"),
+    ((2000, 2000, 3), np.uint8, "scale", "m.png"),
+    ((1500, 1500, 4), np.uint16, "scale", "m.png"),
+    ((16, 1 << 20), np.uint8, "raw", "m.pgm"),  # OpenCV's widest: bands cut in columns
+])
+def test_loading_peaks_within_load_peak_bytes(tmp_path, shape, dtype, mode, image):
+    """The peak RSS a load adds, measured, is within ``load_peak_bytes`` of the header (which
+    the limits keep under 544 MB): twice the decoded picture (OpenCV's buffer and numpy's copy)
+    and the scratch; the grid and the bands fit in the copy's place."""
+    rng = np.random.default_rng(3)
+    pixels = rng.integers(0, np.iinfo(dtype).max, shape, dtype=dtype)
+    path = write_map(tmp_path, pixels, mode=mode, image=image)
+    header = mapfile.image_header(str(tmp_path / image))
+    assert header.pixel_bytes == pixels.itemsize * (1 if pixels.ndim == 2 else shape[2])
+    message, grown = _load_in_a_process(path)
+    assert message == "loaded"
+    assert grown <= mapfile.load_peak_bytes(header), (
+        f"grew {grown >> 20} MB, the bound is {mapfile.load_peak_bytes(header) >> 20} MB")
+
+
+def test_png_headers_count_what_opencv_decodes(tmp_path):
+    """Gray + alpha decodes as BGRA, RGB with a tRNS chunk as BGRA: the header says so (it said
+    2 and 3 bytes a pixel, so a picture could decode to twice what the limit allowed)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return (struct.pack(">I", len(body)) + kind + body
+                + struct.pack(">I", zlib.crc32(kind + body)))
+
+    def png(colour: int, per_pixel: int, extra: bytes = b"") -> bytes:
+        ihdr = struct.pack(">IIBBBBB", 5, 3, 8, colour, 0, 0, 0)
+        return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + extra
+                + chunk(b"IDAT", zlib.compress(bytes(1 + 5 * per_pixel) * 3)) + chunk(b"IEND", b""))
+
+    cases = {"gray-alpha": png(4, 2), "rgb-trns": png(2, 3, chunk(b"tRNS", bytes(6))),
+             "rgb": png(2, 3), "gray-trns": png(0, 1, chunk(b"tRNS", bytes(2))),
+             "palette-trns": png(3, 1, chunk(b"PLTE", bytes(6)) + chunk(b"tRNS", b"\x00"))}
+    for name, data in cases.items():
+        path = tmp_path / f"{name}.png"
+        path.write_bytes(data)
+        decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        assert decoded is not None, name
+        per_pixel = decoded.nbytes // (5 * 3)
+        assert mapfile.image_header(str(path)).pixel_bytes == per_pixel, name
+
+
 def test_a_png_beyond_opencvs_own_limit_is_one_line(tmp_path):
     path = write_map(tmp_path, np.zeros((1, 1), np.uint8), name="vast", image="vast.png")
     (tmp_path / "vast.png").write_bytes(png_bytes(60000, 60000, rows=10))
@@ -362,3 +489,47 @@ def test_map_server_says_a_huge_map_in_one_line(tmp_path, capsys):
     assert map_server.main(["map_server", str(path)]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("map_server: image file ")
+
+
+def _alias_nest(levels: int = 8, width: int = 10) -> str:
+    """YAML's billion laughs: ``levels`` lists of ``width`` aliases of the one below, about
+    500 bytes that load (by reference) in milliseconds and stand for width**levels items."""
+    lines = ["n0: &n0 [" + ", ".join(["lol"] * width) + "]"]
+    lines += [f"n{i}: &n{i} [" + ", ".join([f"*n{i - 1}"] * width) + "]"
+              for i in range(1, levels + 1)]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("key", ["origin", "negate", "resolution", "mode", "occupied_thresh"])
+def test_a_nest_of_yaml_aliases_is_one_line_in_bounded_time_and_memory(tmp_path, key):
+    """An attacker's 569-byte map YAML whose ``origin`` (or any key an error names) is a nest
+    of aliases, 8 levels of 10: its repr is ~10**9 items (map_server hung, 1.46 GB in 30 s)."""
+    import subprocess
+    import sys
+    import time
+
+    base = {"image": "m.png", "resolution": "0.05", "origin": "[0, 0, 0]", "negate": "0",
+            "occupied_thresh": "0.65", "free_thresh": "0.196"}
+    base[key] = f"*n{8}"
+    path = tmp_path / "laughs.yaml"
+    path.write_text(_alias_nest() + "".join(f"{k}: {v}\n" for k, v in base.items()))
+    assert path.stat().st_size < 700
+    probe = ("import resource, sys\n"
+             "from minros.nodes.map_server import map_server\n"
+             "before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+             "code = map_server.main(['map_server', sys.argv[1]])\n"
+             "grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before\n"
+             "print(code, grown)\n")
+    start = time.monotonic()
+    try:
+        out = subprocess.run([sys.executable, "-c", probe, str(path)], capture_output=True,
+                             text=True, timeout=30)
+    except subprocess.TimeoutExpired:
+        pytest.fail("map_server did not answer a 600-byte YAML within 30 s")
+    elapsed = time.monotonic() - start
+    code, grown_kb = out.stdout.split()
+    assert code == "1", out.stderr
+    assert int(grown_kb) < 20_000, f"the YAML grew the peak RSS by {int(grown_kb) >> 10} MB"
+    assert out.stderr.count("\n") == 1 and out.stderr.startswith("map_server: ")
+    assert f"{key} tag" in out.stderr and len(out.stderr) < 400
+    assert elapsed < 20

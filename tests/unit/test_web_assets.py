@@ -207,3 +207,52 @@ def test_a_foxglove_fetch_is_one_message_made_while_it_is_sent(workspace):
     assert budget.used == 0 and not closed
     # all eight fetch slots are free again
     assert all(session._fetches.acquire(blocking=False) for _ in range(8))
+
+
+def _open_fds_of(path) -> int:
+    fds = []
+    for fd in os.listdir("/proc/self/fd"):
+        try:
+            fds.append(os.readlink(f"/proc/self/fd/{fd}"))
+        except OSError:
+            continue
+    return fds.count(str(path))
+
+
+def test_queued_foxglove_fetches_hold_no_file_descriptor(workspace):
+    """A fetch waiting in the client's queue holds no open file (eight a client, times 512
+    clients, was past the 1,024 descriptors of a process): the file is opened when the
+    writer comes to it, and one that went away by then is an error reply, not a success."""
+    import json
+
+    from minros.web.foxglove import MAX_FETCHES_IN_FLIGHT, FoxgloveSession
+    from minros.web.outbox import Outbox
+
+    mesh = workspace / "meshes" / "base.stl"
+    gone = workspace / "meshes" / "gone.stl"
+    gone.write_bytes(b"solid gone\nendsolid gone\n")
+    outbox = Outbox()
+    session = FoxgloveSession("127.0.0.1:5000#1", state=None, outbox=outbox,
+                              close_client=lambda why: None, run_async=lambda fn: fn(),
+                              asset_budget=assets.Budget())
+    for request_id in range(MAX_FETCHES_IN_FLIGHT - 1):
+        session.receive(json.dumps({"op": "fetchAsset", "requestId": request_id,
+                                    "uri": "package://robot_pkg/meshes/base.stl"}))
+    session.receive(json.dumps({"op": "fetchAsset", "requestId": 99,
+                                "uri": "package://robot_pkg/meshes/gone.stl"}))
+    assert _open_fds_of(mesh.resolve()) == 0 and _open_fds_of(gone.resolve()) == 0
+    gone.unlink()
+    replies = []
+    for _ in range(MAX_FETCHES_IN_FLIGHT):
+        _slot, item = outbox.get(timeout=1)
+        fragments = iter(item)
+        replies.append(bytes(next(fragments)))
+        assert _open_fds_of(mesh.resolve()) <= 1  # the one being sent
+        replies[-1] += b"".join(bytes(f) for f in fragments)
+    assert _open_fds_of(mesh.resolve()) == 0
+    assert replies[:-1] == [struct.pack("<BIBI", 4, i, 0, 0) + mesh.read_bytes()
+                            for i in range(MAX_FETCHES_IN_FLIGHT - 1)]
+    status, text = replies[-1][5], replies[-1][10:].decode()
+    assert status == 1 and "Failed to retrieve asset package://robot_pkg/meshes/gone.stl" in text
+    assert "cannot read" in text
+    assert all(session._fetches.acquire(blocking=False) for _ in range(MAX_FETCHES_IN_FLIGHT))

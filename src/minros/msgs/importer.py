@@ -14,11 +14,13 @@ Two mechanisms share one implementation (:func:`namespace_hooks`):
 from __future__ import annotations
 
 import importlib
+import os
 import sys
 import threading
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable, List, Sequence, Tuple
 
+from _minros_import_hook import worth_a_look
 from minros import packages
 
 if TYPE_CHECKING:
@@ -213,6 +215,10 @@ class MsgImportFinder:
 
     def _find(self, fullname: str, parts: List[str]) -> ModuleSpec | None:
         if len(parts) == 1:
+            # Python asks about every failed import of a module (``org``, ``apport_python_hook``):
+            # a bare name is looked for (a crawl, once) only where it can be a package served
+            if not worth_a_look(fullname, os.pathsep.join(str(r) for r in packages.search_roots())):
+                return None
             # only packages already discovered (no rescan per failed import of some module)
             package_dir = _serving(_package_dirs(parts[0], refresh=False), _SERVED,
                                    self.environment_only)

@@ -27,13 +27,25 @@ JPEG's SOF, BMP's, TIFF's first IFD, WebP's, GIF's, Sun raster's) before anythin
 so that a small file claiming a huge picture costs nothing; a format whose header minros does
 not read is refused rather than handed to the decoder blind. The grid is converted in bands of
 rows, so that the float temporaries stay small next to the decoded picture.
+
+What loading costs: OpenCV's Python binding decodes into a buffer of its own and copies it into
+the array it returns, so the peak is twice the decoded picture, plus :data:`LOAD_SCRATCH` (the
+grid, one byte a cell, is written while only the array is held, and never exceeds it). The
+decoded picture may take :data:`MAX_IMAGE_BYTES`, what the largest grid takes as 8-bit gray (a
+map is one value a cell; map_saver writes 8-bit gray), so the peak is at most
+:func:`load_peak_bytes` of the header: 544 MB for any file (a 1 MB PNG claiming 16384 x 16384
+RGBA, 1 GiB decoded, is refused from its header). Grayscale decoding would not save it: every
+mode averages the channels (trinary mode averages alpha in too, as map_server's image loader
+does), and OpenCV's gray is a weighted sum, not that mean.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import reprlib
 import struct
+import sys
 from dataclasses import dataclass
 from typing import Any, BinaryIO, Dict, Tuple
 
@@ -49,12 +61,15 @@ SAVER_YAML_OCCUPIED = 0.65
 SAVER_YAML_FREE = 0.196
 #: The largest image minros loads (cells): 16k x 16k, 256 MB of int8 grid.
 MAX_CELLS = 1 << 28
-#: The most the decoded picture may take (bytes): 16k x 16k RGBA, or 8k x 8k at 16 bits.
-MAX_IMAGE_BYTES = 1 << 30
+#: The most the decoded picture may take (bytes): the largest grid as 8-bit gray; 8k x 8k RGBA,
+#: 8k x 4k RGBA at 16 bits.
+MAX_IMAGE_BYTES = 1 << 28
+#: What loading needs beside the picture: the bands' temporaries and the decoder's rows.
+LOAD_SCRATCH = 32 << 20
 #: what the header readers accept, for the error that names them
 IMAGE_FORMATS = "PGM/PPM/PBM/PAM, PNG, JPEG, BMP, TIFF, WebP, GIF or Sun raster"
-#: rows converted at a time (bounds the float temporaries of occupancy_from_pixels)
-_BAND_CELLS = 1 << 20
+#: rows converted at a time (bounds the temporaries of occupancy_from_pixels: ~40 bytes a cell)
+_BAND_CELLS = 1 << 18
 
 
 class MapError(Exception):
@@ -84,12 +99,29 @@ def _finite(value: Any) -> bool:
         return False
 
 
+def _shown_repr() -> reprlib.Repr:
+    """A repr that stops at two levels, a few items and 40 characters a string: YAML's
+    aliases make a 500-byte file whose value, written out whole, is 10**9 items."""
+    shown = reprlib.Repr()  # attributes, not keywords: Python 3.10's Repr takes none
+    shown.maxlevel = 2
+    shown.maxlist = shown.maxtuple = shown.maxset = shown.maxfrozenset = 4
+    shown.maxdict = 3
+    shown.maxstring = shown.maxother = 40
+    shown.maxlong = 30
+    return shown
+
+
+_SHOWN = _shown_repr()
+
+
 def _shown(value: Any) -> str:
-    """``repr(value)``, cut short (an error names what it found, not all of it)."""
+    """``value`` written out, cut short (an error names what it found, not all of it).
+
+    Bounded in time and memory whatever the value is: a nest of aliases, a recursive list."""
     try:
-        text = repr(value)
-    except ValueError:  # an int beyond the interpreter's digit limit
-        return "a huge number"
+        text = _SHOWN.repr(value)
+    except (ValueError, RecursionError):  # an int beyond the interpreter's digit limit
+        return "a huge number" if isinstance(value, int) else f"a {type(value).__name__}"
     return text if len(text) <= 60 else text[:57] + "..."
 
 
@@ -164,8 +196,8 @@ def read_description(path: str) -> MapDescription:
 
 @dataclass
 class ImageHeader:
-    """What an image's header says: its size and, where the header tells, the bytes a decoded
-    pixel takes (otherwise the most the format's decoder produces)."""
+    """What an image's header says: its size and the most bytes a pixel takes once OpenCV has
+    decoded it (exact where the header tells, otherwise the most the format's decoder makes)."""
 
     format: str
     width: int
@@ -271,8 +303,10 @@ def _tiff_header(f: BinaryIO, order: str) -> ImageHeader:
                 (values[tag],) = struct.unpack(order + "I", entries[12 * k + 8:12 * k + 12])
     if 256 not in values or 257 not in values:
         raise _damaged("TIFF")
-    samples = max(1, min(4, values.get(277, 1)))
-    sample = 2 if values.get(258, 8) > 8 else 1  # the decoder widens 1..7 bits to 8
+    samples = values.get(277, 1)
+    samples = 1 if samples <= 1 else 3 if samples == 3 else 4  # gray + alpha decodes as BGRA
+    bits = values.get(258, 8)  # 1..7 bits are widened to 8; with 3 samples, this is an offset
+    sample = 1 if bits <= 8 else 2 if bits <= 16 else 4
     return ImageHeader("TIFF", values[256], values[257], samples * sample)
 
 
@@ -291,6 +325,30 @@ def _webp_header(head: bytes) -> ImageHeader:
     raise _damaged("WebP")
 
 
+def _png_has_trns(f: BinaryIO, most: int = 4096) -> bool:
+    """Whether a tRNS chunk comes before the image data (it must precede IDAT); a file with
+    more than ``most`` chunks before it is taken to have one (the larger estimate)."""
+    f.seek(8)
+    for _ in range(most):
+        raw = f.read(8)
+        if len(raw) < 8:
+            return False
+        length, kind = struct.unpack(">I4s", raw)
+        if kind == b"tRNS":
+            return True
+        if kind in (b"IDAT", b"IEND"):
+            return False
+        f.seek(length + 4, os.SEEK_CUR)  # the body and its CRC
+    return True
+
+
+def load_peak_bytes(header: ImageHeader) -> int:
+    """The most :func:`load_map` adds to the process's memory for an image of this header:
+    OpenCV's buffer and its copy into numpy, then the array and the grid, plus the scratch."""
+    decoded = header.width * header.height * header.pixel_bytes
+    return 2 * decoded + LOAD_SCRATCH
+
+
 def image_header(path: str) -> ImageHeader:
     """The size of the image at ``path`` from its header, without decoding it. Raises
     ValueError (saying what is wrong) for a format not listed in IMAGE_FORMATS or a
@@ -302,7 +360,14 @@ def image_header(path: str) -> ImageHeader:
                 if head[12:16] != b"IHDR":
                     raise _damaged("PNG")
                 width, height, depth, colour = struct.unpack(">IIBB", head[16:26])
-                channels = {0: 1, 2: 3, 3: 4, 4: 2, 6: 4}.get(colour, 4)
+                # OpenCV: gray stays one channel (with tRNS too), gray + alpha becomes BGRA,
+                # RGB and a palette become BGR, or BGRA with a tRNS chunk
+                if colour == 0:
+                    channels = 1
+                elif colour in (2, 3):
+                    channels = 4 if _png_has_trns(f) else 3
+                else:
+                    channels = 4
                 return ImageHeader("PNG", width, height, channels * (2 if depth > 8 else 1))
             if len(head) >= 2 and head[:1] == b"P" and head[1:2] in b"1234567":
                 f.seek(0)
@@ -332,9 +397,11 @@ def image_header(path: str) -> ImageHeader:
 
 
 def read_image(path: str) -> np.ndarray:
-    """The image's pixels: (H, W) gray or (H, W, C) in OpenCV's BGR(A) order, 8 bits.
+    """The image's pixels: (H, W) gray or (H, W, C) in OpenCV's BGR(A) order, 8 bits (a
+    16-bit picture's high bytes, as SDL_image gives map_server: a view, not a copy).
 
-    The header is checked first: no more than MAX_CELLS pixels and MAX_IMAGE_BYTES decoded."""
+    The header is checked first: no more than MAX_CELLS pixels and MAX_IMAGE_BYTES decoded,
+    so that loading costs at most ``load_peak_bytes(header)``."""
     import cv2
 
     if not os.path.exists(path):
@@ -355,7 +422,8 @@ def read_image(path: str) -> np.ndarray:
     if cells > MAX_CELLS or cells * header.pixel_bytes > MAX_IMAGE_BYTES:
         raise MapError(f'image file "{path}" is too large ({header.width} x {header.height} '
                        f"{header.format}, at most {MAX_CELLS} pixels and "
-                       f"{MAX_IMAGE_BYTES >> 20} MB decoded): scale it down and raise the "
+                       f"{MAX_IMAGE_BYTES >> 20} MB decoded, as 16384 x 16384 gray): scale it "
+                       "down or save it as 8-bit gray, and raise the "
                        "resolution in the YAML to match")
     try:
         pixels = _quiet_imread(cv2, path)
@@ -365,9 +433,14 @@ def read_image(path: str) -> np.ndarray:
     if pixels is None or pixels.size == 0:
         raise MapError(f'failed to open image file "{path}": not an image OpenCV can read '
                        "(PGM, PNG, BMP, JPEG, ...) or damaged")
+    if pixels.nbytes > cells * header.pixel_bytes:  # a header reader that undercounted
+        raise MapError(f'image file "{path}" decoded larger than its {header.format} header says '
+                       f"({pixels.nbytes} bytes): save it as 8-bit PNG or PGM")
     if pixels.dtype == np.uint16:  # SDL_image hands map_server 8 bits per channel
-        np.right_shift(pixels, 8, out=pixels)
-        pixels = pixels.astype(np.uint8)
+        # the high byte of each sample, in place: a strided view of the decoded buffer
+        high = 1 if sys.byteorder == "little" else 0
+        as_bytes = pixels.view(np.uint8)
+        pixels = as_bytes[:, high::2] if pixels.ndim == 2 else as_bytes[:, :, high::2]
     elif pixels.dtype != np.uint8:
         raise MapError(f'failed to open image file "{path}": {pixels.dtype} pixels are not supported')
     if pixels.shape[0] * pixels.shape[1] > MAX_CELLS:  # a header that undercounted
@@ -397,11 +470,13 @@ def occupancy_from_pixels(pixels: np.ndarray, negate: bool, occupied_thresh: flo
     width = max(1, pixels.shape[1]) if pixels.ndim >= 2 else 1
     out = np.empty(pixels.shape[:2], dtype=np.int8)
     band = max(1, _BAND_CELLS // width)
+    columns = min(width, _BAND_CELLS)  # a picture one row of a million pixels wide, too
     for top in range(0, height, band):
-        rows = _occupancy_band(pixels[top:top + band], negate, occupied_thresh, free_thresh,
-                               mode)
-        # picture rows top..top+n become grid rows height-top-n..height-top, flipped
-        out[height - top - rows.shape[0]:height - top] = rows[::-1]
+        for left in range(0, width, columns):
+            rows = _occupancy_band(pixels[top:top + band, left:left + columns], negate,
+                                   occupied_thresh, free_thresh, mode)
+            # picture rows top..top+n become grid rows height-top-n..height-top, flipped
+            out[height - top - rows.shape[0]:height - top, left:left + columns] = rows[::-1]
     return out
 
 
@@ -412,13 +487,7 @@ def _occupancy_band(pixels: np.ndarray, negate: bool, occupied_thresh: float,
     channels = img.shape[2]
     has_alpha = channels == 4
     averaged = channels if (mode == "trinary" or not has_alpha) else channels - 1
-    mean = img[:, :, :averaged].astype(np.float64).sum(axis=2) / averaged
-    if channels == 1:
-        alpha = np.ones(mean.shape)
-    elif channels == 3:
-        alpha = img[:, :, 0].astype(np.float64)  # the last byte of an R,G,B pixel in memory
-    else:
-        alpha = img[:, :, 3].astype(np.float64)
+    mean = img[:, :, :averaged].sum(axis=2, dtype=np.float64) / averaged  # exact: integers
     if negate:
         mean = 255.0 - mean
     if mode == "raw":
@@ -427,7 +496,10 @@ def _occupancy_band(pixels: np.ndarray, negate: bool, occupied_thresh: float,
     out = np.full(mean.shape, -1, dtype=np.int16)
     between = ~((occ > occupied_thresh) | (occ < free_thresh))
     if mode == "scale":
-        opaque = between & ~(alpha < 1.0)
+        if channels == 1:
+            opaque = between
+        else:  # alpha: the last byte of a pixel in memory (an R,G,B pixel's is blue)
+            opaque = between & (img[:, :, 0 if channels == 3 else channels - 1] >= 1)
         ratio = (occ[opaque] - free_thresh) / (occupied_thresh - free_thresh)
         out[opaque] = (1.0 + 98.0 * ratio).astype(np.int16)
     out[occ < free_thresh] = 0

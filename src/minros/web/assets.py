@@ -207,6 +207,18 @@ class Budget:
                      "timeout)")
 
 
+def check_size(path: Path, uri: str, max_bytes: int = MAX_ASSET_BYTES) -> int:
+    """The file's size, checked against ``max_bytes`` without opening it (a fetch that waits
+    its turn holds no descriptor; :func:`open_file` checks again when it is sent)."""
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise AssetError(f"{uri}: cannot read {path}: {exc.strerror or exc}", 404) from None
+    if size > max_bytes:
+        raise AssetError(f"{uri} is {size} bytes, more than the {max_bytes} served", 413)
+    return size
+
+
 def open_file(path: Path, uri: str, max_bytes: int = MAX_ASSET_BYTES) -> Tuple[BinaryIO, int]:
     """The open file and its size, checked against ``max_bytes``; AssetError otherwise."""
     try:

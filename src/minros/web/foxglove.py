@@ -421,26 +421,32 @@ class FoxgloveSession:
         def run() -> None:
             try:
                 path = assets.resolve(uri, self.asset_patterns)
-                stream, size = assets.open_file(path, uri)
+                assets.check_size(path, uri)
             except assets.AssetError as exc:
                 self._fetches.release()
                 self._asset_failed(request_id, uri, exc)
                 return
             if self._closed:
-                stream.close()
                 self._fetches.release()
                 return
             # one message, sent as fragments while the file is read (assets.chunks): the
-            # reply holds one chunk of the budget at a time, never the whole file
-            reply = assets.Fragments(lambda: self._asset_fragments(request_id, stream, size))
+            # reply holds one chunk of the budget at a time, never the whole file, and the
+            # file is opened when the writer comes to it, so that fetches waiting in the
+            # queue hold no file descriptor
+            reply = assets.Fragments(lambda: self._asset_fragments(request_id, uri, path))
             if not self.outbox.put_control(reply, assets.CHUNK_BYTES):
-                stream.close()
                 self._fetches.release()
                 self.close_client("the client does not read its messages")
         self.run_async(run)
 
-    def _asset_fragments(self, request_id: int, stream: Any, size: int) -> Iterator[bytes]:
+    def _asset_fragments(self, request_id: int, uri: str, path: Any) -> Iterator[bytes]:
         try:
+            try:
+                stream, size = assets.open_file(path, uri)
+            except assets.AssetError as exc:  # gone, or grown, since it was asked for
+                self._asset_failed(request_id, uri, exc, send=False)
+                yield fp.fetch_asset_response(request_id, error=f"Failed to retrieve asset {uri}: {exc}")
+                return
             with stream:
                 yield fp.fetch_asset_response(request_id, b"")
                 yield from assets.chunks(stream, size, self.asset_budget, self.peer,
@@ -448,10 +454,11 @@ class FoxgloveSession:
         finally:
             self._fetches.release()
 
-    def _asset_failed(self, request_id: int, uri: str, exc: assets.AssetError) -> None:
+    def _asset_failed(self, request_id: int, uri: str, exc: assets.AssetError,
+                      send: bool = True) -> None:
         minros.logwarn(f"[web] Foxglove client {self.client_id}: Failed to retrieve "
                        f"asset '{uri[:300]}': {exc}")
-        if not self._closed:
+        if send and not self._closed:
             self.send_binary(fp.fetch_asset_response(
                 request_id, error=f"Failed to retrieve asset {uri}: {exc}"))
 

@@ -497,13 +497,17 @@ class WebServer:
         if upgrade:
             return None
         cors = self.origins.cors_origin(origin, host)
+        # HEAD: the answer's head as GET's, without its body (RFC 9110 9.3.2)
+        head_only = getattr(request, "method", "GET") == "HEAD"
         try:
-            response = self._http(connection, path, query, cors)
+            response = self._http(connection, path, query, cors, head_only)
         except video.VideoError as exc:
             response = self._text(exc.status, f"minros web: {exc}")
         if cors is not None:  # a page that may use the server may read its answers
             response.headers["Access-Control-Allow-Origin"] = cors
             response.headers["Vary"] = "Origin"
+        if head_only:
+            response.body = b""  # Content-Length stays the GET answer's
         return response
 
     # -- plain HTTP ------------------------------------------------------------------------
@@ -512,7 +516,8 @@ class WebServer:
         token = urllib.parse.parse_qs(query).get("token", [""])[0]
         return "&token=" + urllib.parse.quote(token) if token else ""
 
-    def _http(self, connection: Any, path: str, query: str, cors: Optional[str]) -> Any:
+    def _http(self, connection: Any, path: str, query: str, cors: Optional[str],
+              head_only: bool = False) -> Any:
         """``cors``: the origin of a page allowed to read the answer, for the stream (whose
         head is written here); a page of another site may show the images, not read them."""
         if path == "/stream":
@@ -535,7 +540,7 @@ class WebServer:
             return self._response(200, video.viewer_page(params, query).encode(),
                                   "text/html; charset=utf-8")
         if path.startswith("/pkg/"):
-            return self._package_file(connection, path, cors)
+            return self._package_file(connection, path, cors, head_only)
         if path == "/streams":
             graph = self.state.refresh_graph()
             topics = [t for t, ty in graph.topic_types.items() if video.is_image_type(ty)]
@@ -558,11 +563,13 @@ class WebServer:
             content_type += "; charset=utf-8"
         return self._response(200, target.read_bytes(), content_type)
 
-    def _package_file(self, connection: Any, path: str, cors: Optional[str]) -> Any:
+    def _package_file(self, connection: Any, path: str, cors: Optional[str],
+                      head_only: bool = False) -> Any:
         """``/pkg/<package>/<path>``: the file ``package://<package>/<path>`` names, if the
         asset rules allow it (the path stays percent-encoded: the rules decode it), written
         on the socket as it is read (:func:`assets.chunks`), within admission's time for
-        its length; this runs in the connection's own thread."""
+        its length; this runs in the connection's own thread. ``head_only`` (HEAD): the
+        head alone."""
         uri = assets.PACKAGE_PREFIX + path[len("/pkg/"):]
         try:
             stream, size = assets.open_file(assets.resolve(uri, self.asset_patterns), uri)
@@ -582,8 +589,9 @@ class WebServer:
         try:
             with stream:
                 pending = ["".join(head).encode("latin-1") + b"\r\n"]
-                for chunk in assets.chunks(stream, size, self.asset_budget, peer,
-                                           self.send_timeout):
+                body = () if head_only else assets.chunks(  # HEAD: the length, no body
+                    stream, size, self.asset_budget, peer, self.send_timeout)
+                for chunk in body:
                     left = deadline - time.monotonic()
                     if left <= 0:
                         raise TimeoutError(f"{size} bytes take longer than "
@@ -591,7 +599,7 @@ class WebServer:
                     started = True
                     send_with_timeout(sock, [*pending, chunk], min(self.send_timeout, left))
                     pending = []
-                if pending:  # an empty file
+                if pending:  # an empty file, or HEAD
                     send_with_timeout(sock, pending, self.send_timeout)
         except assets.AssetError as exc:  # no room in the budget
             if not started:

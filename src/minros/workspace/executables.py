@@ -175,6 +175,12 @@ def builtin_module(pkg: str, executable: str) -> str | None:
     return BUILTIN_NODES.get(pkg, {}).get(executable)
 
 
+def builtin_command(module: str) -> List[str]:
+    """The argv that runs built-in node ``module``: through ``minros.nodes``'s runner, which
+    says in one line why a node could not start (ROS_MASTER_URI=localhost:11311)."""
+    return [sys.executable, "-m", "minros.nodes", module]
+
+
 def _module_exists(module: str) -> bool:
     try:
         return importlib.util.find_spec(module) is not None
@@ -203,7 +209,7 @@ def resolve_executable(pkg: str, executable: str) -> List[str]:
             raise ExecutableError(
                 [f"[rosrun] {executable} of package {pkg} is not available in this version of minros"],
                 3, f"{pkg}/{executable} is not available in this version of minros")
-        return [sys.executable, "-m", module]
+        return builtin_command(module)
     if pkg_dir is None:
         raise ExecutableError([f"[rospack] Error: package '{pkg}' not found"], 2,
                               f"package '{pkg}' not found")
@@ -219,7 +225,7 @@ def resolve_executable(pkg: str, executable: str) -> List[str]:
     if not unique and module and _module_exists(module):
         # the package's sources on ROS_PACKAGE_PATH (rosout's C++, say) have no program: as
         # ROS finds the installed one first, minros's built-in one runs
-        return [sys.executable, "-m", module]
+        return builtin_command(module)
     if not unique:
         lines = [f"[rosrun] Couldn't find executable named {executable} below {pkg_dir}"]
         others = _search(pkg_dir, executable, skip_build=False)

@@ -376,7 +376,7 @@ def rosstack() -> Any:
     """A ``rospkg.RosStack`` over the roots minros searches (stacks and metapackages)."""
     import rospkg
 
-    return rospkg.RosStack(ros_paths=[str(p) for p in packages._search_roots()])
+    return rospkg.RosStack(ros_paths=[str(p) for p in packages.search_roots()])
 
 
 def get_stack_dir(stack: str, env: Any = None) -> str:
