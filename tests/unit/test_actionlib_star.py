@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 import subprocess
 
+import pytest
+
 from support import PYTHON, REFERENCE_PYTHON, reference_env, require_reference
 
 STAR = ("import json\nns = {}\nexec('from actionlib import *', ns)\n"
@@ -31,6 +33,7 @@ def _names(python: str, env=None) -> list:
     return json.loads(out.stdout)
 
 
+@pytest.mark.slow
 def test_star_import_gives_ros_names():
     assert _names(PYTHON) == ROS_NAMES
 
@@ -44,6 +47,7 @@ def test_what_smach_ros_uses_after_a_star_import():
     assert ns["g_goal_id"] >= 0
 
 
+@pytest.mark.slow
 def test_the_names_are_debians():
     require_reference()
     assert _names(REFERENCE_PYTHON, reference_env({})) == ROS_NAMES

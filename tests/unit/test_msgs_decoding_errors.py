@@ -9,6 +9,8 @@ import logging
 import struct
 import subprocess
 
+import pytest
+
 from support import PYTHON, REFERENCE_PYTHON, reference_env, require_reference
 
 BAD = b"a\xffb\xfe"
@@ -43,6 +45,7 @@ def _run(python: str, env=None) -> list:
     return json.loads(out.stdout)
 
 
+@pytest.mark.slow
 def test_replacement_characters_and_one_error_per_type():
     values, records = _run(PYTHON)
     assert values == ["a\ufffdb\ufffd"] * 3 + ["\ufffd"] * 2
@@ -55,6 +58,7 @@ def test_replacement_characters_and_one_error_per_type():
                   "invalid start byte"]]
 
 
+@pytest.mark.slow
 def test_the_same_values_and_lines_as_debians_genpy():
     require_reference()
     assert _run(PYTHON) == _run(REFERENCE_PYTHON, reference_env({}))

@@ -384,6 +384,7 @@ def test_once_log_says_each_fault_once_and_is_bounded(monkeypatch):
                     "more than 3 distinct problems: the rest are not shown"]
 
 
+@pytest.mark.slow
 def test_a_service_handler_may_decline_to_answer():
     """rmw's Service sends no reply when its handler returns None (the bridge's, when the ROS
     1 server failed): the client times out, and nothing is logged as a failure."""
@@ -443,6 +444,7 @@ def _command(*args: str, env_extra=None):
                           text=True, timeout=60, env=env)
 
 
+@pytest.mark.slow
 def test_command_help_and_mistakes_are_one_line_before_anything_joins_dds(tmp_path):
     """--help; a bad configuration and a missing master each end the command with one line
     and a status, before any DDS participant exists (nothing is sent)."""
@@ -469,6 +471,7 @@ def test_command_help_and_mistakes_are_one_line_before_anything_joins_dds(tmp_pa
     assert "Traceback" not in out.stderr
 
 
+@pytest.mark.slow
 def test_print_pairs_lists_ros1_bridges_pairs():
     out = _command("--print-pairs")
     assert out.returncode == 0

@@ -109,6 +109,7 @@ def test_the_graph_joins_nodes_and_endpoints():
     assert graph.wait_until(lambda g: not g.endpoints("/chatter"), 1)
 
 
+@pytest.mark.slow
 def test_two_minros_contexts_pubsub_and_a_service():
     """minros to minros (no peer of another vendor): the same code paths, in one process."""
     from ros2_support import (

@@ -33,6 +33,7 @@ def test_md5_sums(type_name: str) -> None:
     assert (cls._type, cls._md5sum) == (type_name, MD5[type_name])
 
 
+@pytest.mark.slow
 def test_a_controller_switch_as_robot_code_writes_it() -> None:
     """Imported before rospy (the stand-ins), in a fresh interpreter, as a node's first lines."""
     code = ("from controller_manager_msgs.srv import SwitchController, SwitchControllerRequest\n"

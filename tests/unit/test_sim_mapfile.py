@@ -218,6 +218,7 @@ def png_bytes(width: int, height: int, rows: int | None = None, colour: int = 0)
             + chunk(b"IEND", b""))
 
 
+@pytest.mark.slow
 def test_a_small_png_claiming_a_huge_picture_costs_no_memory(tmp_path):
     """An attacker's 400 kB PNG of 20000 x 20000 zeros: refused from its header (it used to be
     decoded first, 400 MB, then refused)."""
