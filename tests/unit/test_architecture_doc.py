@@ -152,6 +152,5 @@ def test_the_trace_watch_sites_are_the_ones_named():
              if "trace.watch(" in p.read_text()}
     paragraph = DOC[DOC.index("The `trace.watch` sites"):]
     paragraph = paragraph[:paragraph.index("\n\n")]
-    named = _named([paragraph])
-    assert sites - GOING == named - NOT_YET, (sites, named)
-    assert named <= sites | NOT_YET
+    named = {n for n in _named([paragraph]) if n not in NOT_YET or (REPO / n).exists()}
+    assert sites - GOING == named, (sites, named)
