@@ -29,7 +29,9 @@ from support import (
     wait_for_master,
 )
 
-pytestmark = pytest.mark.interop
+# The module's fixture runs about 60 rosnode commands per master kind (each bounded by TIMEOUT):
+# on two loaded CPUs that setup alone took over pytest-timeout's 120 s, so the module gets 300.
+pytestmark = [pytest.mark.interop, pytest.mark.timeout(300)]
 
 DEMO = str(Path(__file__).resolve().parent.parent / "integration" / "cli_demo_node.py")
 BIN = Path(PYTHON).parent
