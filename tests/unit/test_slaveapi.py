@@ -1,8 +1,12 @@
 """The one node-API client (wire/slaveapi.py) against a node of this process and an in-process
 master: typed results, one error path (NodeError for -1, NodeFailure for 0, faults and
-malformed answers, OSError of its own class for the network)."""
+malformed answers, OSError of its own class for the network), and no raw callers left."""
 
 from __future__ import annotations
+
+import re
+import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -10,6 +14,8 @@ from minros.master import Master
 from minros.node import Node
 from minros.wire.slaveapi import NodeError, NodeFailure, RemoteError, SlaveClient
 from support import free_port
+
+SRC = Path(__file__).resolve().parents[2] / "src" / "minros"
 
 
 @pytest.fixture
@@ -64,3 +70,15 @@ def test_malformed_answers_are_node_failures(monkeypatch):
         client.request_topic("/t", [["TCPROS"]])
     with pytest.raises(NodeFailure, match="malformed ROS API result"):
         client.get_name()
+
+
+def test_no_raw_node_api_callers_are_left():
+    """One requestTopic caller (the client itself) and no call_node(uri, "method") strings
+    (roslaunch's process API, which is no node API, is the one call_node left)."""
+    found = subprocess.run(["grep", "-rnE", r'requestTopic\(|(call|raw)\("requestTopic"|call_node\(',
+                            str(SRC)], capture_output=True, text=True).stdout.splitlines()
+    callers = [line for line in found if "requestTopic" in line and "def requestTopic" not in line]
+    assert len(callers) == 1 and "wire/slaveapi.py" in callers[0], callers
+    strings = [line for line in found if re.search(r'call_node\([^,]+, "', line)
+               and "list_processes" not in line]
+    assert strings == [], strings
