@@ -54,7 +54,7 @@ def test_a_small_message_is_one_joined_frame():
     buff = client_msg._Parts(snapshot=False)
     String("hello").serialize(buff)
     assert buff.frame(b"") == tcpros.encode_frame(String("hello").serialize_to_bytes())
-    assert client_msg.frame_of(String("hello"), snapshot=False) == buff.frame(b"")
+    assert client_msg.serialize_frame(String("hello"), snapshot=False) == buff.frame(b"")
 
 
 def test_big_fields_are_kept_without_a_copy():
@@ -62,7 +62,7 @@ def test_big_fields_are_kept_without_a_copy():
 
     data = bytes(range(256)) * 4096  # 1 MB
     msg = Image(height=1, width=len(data), encoding="mono8", step=len(data), data=data)
-    for frame in (client_msg.frame_of(msg, b"\x01", snapshot=False),
+    for frame in (client_msg.serialize_frame(msg, b"\x01", snapshot=False),
                   _written(msg).frame(b"\x01")):
         assert any(part is data for part in frame)  # the field itself, not a copy
         assert len(frame) == 2  # ok byte, length and the small fields joined; then the data

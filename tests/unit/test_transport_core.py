@@ -35,7 +35,7 @@ SENDERS = ["tcpros", pytest.param("shm", marks=pytest.mark.skipif(
 
 def test_the_queue_drops_the_oldest_beyond_its_limit():
     queue = SendQueue(3)
-    assert [queue.put(n) for n in range(5)] == [[], [], [], [0], [1]]
+    assert [list(queue.put(n)) for n in range(5)] == [[], [], [], [0], [1]]
     assert list(queue.items) == [2, 3, 4] and queue.dropped == 2 and queue.full()
     unbounded = SendQueue(0)  # queue_size=0, as rospy's: nothing dropped
     for n in range(1000):

@@ -4,7 +4,7 @@ Header it stamps, and serialization into one length-prefixed frame, for topics a
 A frame is serialized once per publish and handed to every connection: ``bytes`` for a small
 message (one join), or a tuple of buffers (length prefix first) that a transport sends with
 ``sendmsg`` without joining them, so a big array goes out without a copy. A service request is
-the same frame, and a response the same after its ok byte (:func:`frame_of`).
+the same frame, and a response the same after its ok byte (:func:`serialize_frame`).
 """
 
 from __future__ import annotations
@@ -16,8 +16,7 @@ from minros.exceptions import ROSException, ROSSerializationException
 from minros.msgs.message import SERIALIZE_ERRORS
 from minros.names import ANYTYPE
 
-__all__ = ["AnyMsg", "args_kwds_to_message", "frame_len", "frame_of", "serialize_frame",
-           "stamp_header"]
+__all__ = ["AnyMsg", "args_kwds_to_message", "frame_len", "serialize_frame", "stamp_header"]
 
 #: frames up to this size are joined into one bytes object; larger keep their parts (no copy)
 _JOIN_LIMIT = 65536
@@ -151,12 +150,12 @@ class _Discard:
         pass
 
 
-def frame_of(msg: Any, head: bytes = b"", snapshot: bool = True) -> Any:
+def serialize_frame(msg: Any, head: bytes = b"", snapshot: bool = True) -> Any:
     """``msg`` serialized into one frame: ``head`` (a service response's ok byte), the length
-    prefix and the body; ``bytes`` for small messages, else a tuple of buffers (prefix first)
-    that ``sendmsg`` writes without joining them. ``snapshot``: big mutable pieces are copied
-    (see :class:`_Parts`). Raises what the message's serialization raises (genpy's
-    SerializationError, naming the field)."""
+    prefix and the body; ``bytes`` for small messages, else a tuple of buffers (the prefix at
+    the start of the first) that ``sendmsg`` writes without joining them. ``snapshot``: big
+    mutable pieces are copied (see :class:`_Parts`; a topic's frame may wait in a queue).
+    rospy's ROSSerializationException, naming the field, when one cannot be serialized."""
     parts_of = getattr(msg, "_serialize_parts", None)
     if parts_of is not None:
         parts: list = []
@@ -166,9 +165,8 @@ def frame_of(msg: Any, head: bytes = b"", snapshot: bool = True) -> Any:
             # a hand-written genpy-style class: it subclasses Message but only its
             # serialize() is real (the base _serialize_parts is a stub)
             parts_of = None
-        except SERIALIZE_ERRORS:
-            msg.serialize(_Discard)  # its error names the field
-            raise
+        except SERIALIZE_ERRORS as exc:
+            _raise_field_error(msg, exc)
         else:
             if not msg._zero_copy:
                 # no array fields that could be views of big buffers (strings, numbers, nested
@@ -180,8 +178,25 @@ def frame_of(msg: Any, head: bytes = b"", snapshot: bool = True) -> Any:
                 return (head + _U32.pack(size), body)
             return _frame(parts, head, snapshot)
     writer = _Parts(snapshot)
-    msg.serialize(writer)
+    try:
+        msg.serialize(writer)
+    except ROSSerializationException as exc:
+        if exc.__class__ is ROSSerializationException:
+            raise
+        raise ROSSerializationException(str(exc)) from None
+    except SERIALIZE_ERRORS as exc:
+        raise ROSSerializationException(str(exc)) from None
     return writer.frame(head)
+
+
+def _raise_field_error(msg: Any, exc: BaseException) -> None:
+    """Serialize ``msg`` again through serialize(), whose error names the bad field, and raise
+    that as ROSSerializationException."""
+    try:
+        msg.serialize(_Discard)
+    except SERIALIZE_ERRORS as named:
+        raise ROSSerializationException(str(named)) from None
+    raise ROSSerializationException(str(exc)) from None
 
 
 def _frame(parts: list, head: bytes, snapshot: bool) -> Any:
@@ -207,19 +222,6 @@ def _frame(parts: list, head: bytes, snapshot: bool) -> Any:
     if small:
         out.append(b"".join(small))
     return tuple(out)
-
-
-def serialize_frame(msg: Any) -> Any:
-    """A topic's frame of ``msg`` (:func:`frame_of`); rospy's ROSSerializationException when
-    a field cannot be serialized."""
-    try:
-        return frame_of(msg)
-    except ROSSerializationException as exc:
-        if exc.__class__ is ROSSerializationException:
-            raise
-        raise ROSSerializationException(str(exc)) from None
-    except SERIALIZE_ERRORS as exc:
-        raise ROSSerializationException(str(exc)) from None
 
 
 def frame_len(frame: Any) -> int:

@@ -150,7 +150,12 @@ class Publication:
                 return
             # Header auto-fill, then one serialization for every connection that takes frames
             self.seq += 1
-            stamp_header(msg, self.seq)
+            try:
+                has_header = msg._has_header
+            except AttributeError:  # not a message class of ours (rospy code's own)
+                has_header = False
+            if has_header:
+                stamp_header(msg, self.seq)
             frame = None
             for conn in conns:
                 if conn.takes_objects:  # an intra-process link: the object itself

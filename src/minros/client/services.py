@@ -17,7 +17,7 @@ without ``init_node`` (caller id ``/unnamed``). All error texts are rospy's.
 
 Both ends are transports of the seam, as a topic's are (``minros.transport.tcpros_service``:
 the stream, the header exchange, bounded sends, frames read under admission); requests and
-responses are serialized as topic frames are (``client.msg.frame_of``). This module holds what
+responses are serialized as topic frames are (``client.msg.serialize_frame``). This module holds what
 a service is: the handler's rules, the proxy's, and rospy's error texts.
 """
 
@@ -37,10 +37,12 @@ from typing import Any, Callable, Dict
 
 from minros import names, node
 from minros.client.log import logerr, loginfo, logwarn, logwarn_throttle
-from minros.client.msg import frame_of, stamp_header
+from minros.client.msg import serialize_frame, stamp_header
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
+    ROSSerializationException,
+    SerializationError,
     ServiceException,
     TransportException,
     TransportInitError,
@@ -248,7 +250,7 @@ class Service:
             self.seq = seq
             stamp_header(response, seq)
             # ok byte + length, then the response as serialized (big fields not copied)
-            return frame_of(response, _OK, snapshot=False)
+            return serialize_frame(response, _OK, snapshot=False)
         except ServiceException as exc:
             return tcpros.encode_service_error(f"service cannot process request: {exc}")
         except Exception as exc:
@@ -407,7 +409,11 @@ class ServiceProxy:
                 # as rospy: a request is numbered once connected, and sent in that order
                 self.seq += 1
                 stamp_header(request, self.seq)
-                reply = end.call(frame_of(request, snapshot=False))
+                try:
+                    frame = serialize_frame(request, snapshot=False)
+                except ROSSerializationException as exc:  # genpy's, as rospy raises it
+                    raise SerializationError(str(exc)) from None
+                reply = end.call(frame)
                 if reply is None:
                     raise TransportTerminated(_PEER_GONE)
             except TransportException as exc:

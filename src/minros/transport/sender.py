@@ -83,6 +83,8 @@ class QueuedSender(StreamTransport):
         self.room_wanted = 0  # publishers waiting on space
         self.busy = False  # the writer is sending out, without the lock
         self.on_close = on_close
+        #: None, or called (with the lock) with each item the full queue dropped unsent
+        self.on_drop: Callable[[Any], None] | None = None
         self.ended = False  # failed, or the subscriber left: on_close is due
         self.closing = False  # close() was called
 
@@ -138,9 +140,6 @@ class QueuedSender(StreamTransport):
         """With the lock: whether anything besides ``out`` and the queue waits to be sent."""
         return False
 
-    def _dropped(self, item: Any) -> None:
-        """With the lock: ``item`` left the queue unsent (the queue was full)."""
-
     def _watch(self) -> None:
         """Read what the subscriber sends until the stream ends (or the connection does)."""
         try:
@@ -191,7 +190,11 @@ class QueuedSender(StreamTransport):
         and take the CPU the writer and the subscriber need. False when the connection ended
         meanwhile."""
         queue = self.queue
-        if queue.full():
+        items = queue.items
+        if not queue.limit or len(items) < queue.limit:  # room: the usual case, no call
+            items.append(item)
+            return True
+        if frame.__class__ is not bytes or len(frame) >= sendqueue.BACKOFF_BYTES:
             wait = queue.backoff(frame_size(frame))
             if wait:
                 self.room_wanted += 1
@@ -199,16 +202,11 @@ class QueuedSender(StreamTransport):
                 self.room_wanted -= 1
                 if self.done:
                     return False
-        for old in queue.put(item):
-            self._dropped(old)
+        dropped = queue.put(item)
+        if self.on_drop is not None:
+            for old in dropped:
+                self.on_drop(old)
         return True
-
-    def _kick(self) -> None:
-        """After queueing behind a backlog: the writer takes it (told unless busy: a notify
-        costs a microsecond even with no one waiting), and gets the GIL now rather than after
-        the interpreter's switch interval (5 ms), or a publishing loop starves it."""
-        if not self.busy:
-            self.cond.notify()
 
     def _pump(self) -> None:
         """With the lock: send what may go now without blocking; what the socket does not

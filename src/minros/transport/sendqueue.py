@@ -21,9 +21,10 @@ drop and back off by the same rules:
 from __future__ import annotations
 
 import collections
-from typing import Any, Deque, List
+from typing import Any, Deque, Sequence, Tuple
 
-__all__ = ["BACKOFF_MAX", "BACKOFF_MIN", "BACKOFF_RATE", "SYNC_SEND_TIMEOUT", "SendQueue"]
+__all__ = ["BACKOFF_BYTES", "BACKOFF_MAX", "BACKOFF_MIN", "BACKOFF_RATE", "SYNC_SEND_TIMEOUT",
+           "SendQueue"]
 
 #: a synchronous (queue_size=None) publisher waits at most this long for a slow subscriber
 SYNC_SEND_TIMEOUT = 60.0
@@ -32,6 +33,9 @@ SYNC_SEND_TIMEOUT = 60.0
 BACKOFF_RATE = 1e9
 BACKOFF_MAX = 0.01
 BACKOFF_MIN = 50e-6
+#: frames smaller than this never wait (BACKOFF_MIN's worth at BACKOFF_RATE)
+BACKOFF_BYTES = int(BACKOFF_MIN * BACKOFF_RATE)
+_NONE: Tuple[Any, ...] = ()
 
 
 class SendQueue:
@@ -61,12 +65,12 @@ class SendQueue:
         wait = size / BACKOFF_RATE
         return min(wait, BACKOFF_MAX) if wait >= BACKOFF_MIN else 0.0
 
-    def put(self, item: Any) -> List[Any]:
+    def put(self, item: Any) -> Sequence[Any]:
         """Queue ``item``; the oldest items the limit dropped to make room (usually none)."""
         items = self.items
         items.append(item)
         if not self.limit or len(items) <= self.limit:
-            return []
+            return _NONE
         dropped = []
         while len(items) > self.limit:
             dropped.append(items.popleft())

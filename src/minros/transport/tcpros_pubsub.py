@@ -70,7 +70,8 @@ class TCPROSSender(QueuedSender):
             if self.sync:
                 self._drain()
                 return
-            self._kick()
+            if not self.busy:  # a busy writer takes it without being told (and a notify
+                self.cond.notify()  # costs a microsecond even with no one waiting)
         _yield_gil()
 
     def _next_out(self) -> bool:

@@ -45,6 +45,7 @@ class ShmSender(QueuedSender):
         self.on_fallback = on_fallback
         self.peer_pid = sockets.peer_pid(stream)
         self.done_reader = shm.DoneReader()  # read by the watcher, or a publisher (_more)
+        self.on_drop = self._dropped
 
     @property
     def segment(self) -> ShmSegment | None:
@@ -146,6 +147,7 @@ class ShmSender(QueuedSender):
             self.slots.abandon(item[1])
 
     def _dropped(self, item: Any) -> None:
+        """With the lock: the full queue dropped ``item``: a written slot is free again."""
         if item[0] == "slot":
             self.slots.abandon(item[1])
 
