@@ -211,3 +211,38 @@ def test_the_transport_layer_keeps_the_shape_the_review_asked_for():
     accepts = [(p.name, line) for p in (src / "node").glob("*.py")
                for line in p.read_text().splitlines() if ".accept()" in line]
     assert len(accepts) == 1 and accepts[0][0] == "tcpros_server.py", accepts
+
+
+# --------------------------------------------------------------------------- the seam's capabilities
+
+
+class _Node:
+    caller_id = "/talker"
+
+    @staticmethod
+    def is_shutdown() -> bool:
+        return False
+
+
+def test_an_intra_process_link_takes_objects_and_frames_alike():
+    """Transport declares what a publication asks of a connection, with defaults: an
+    intra-process link takes objects, and a frame sent to it (rospy code writing bytes to each
+    connection) is read into a message instead of raising TypeError."""
+    from minros.client.publication import Publication
+    from minros.transport import intraprocess
+    from minros.transport.base import Transport
+    from std_msgs.msg import String
+
+    pub = Publication(_Node(), "/chatter", "/chatter", String)
+    pub.queue_size = 10
+    pub.intraprocess = True
+    sub_end = intraprocess.link(pub, {"callerid": "/listener", "topic": "/chatter"})
+    pub_end = pub.connections[0]
+    assert pub_end.takes_objects and not Transport.takes_objects
+    sent = String("object")
+    pub.publish(sent)
+    pub_end.send(serialize_frame(String("frame")))
+    got = sub_end.receive()
+    assert got[0] is sent and got[1] == String("frame") and got[1] is not sent
+    assert pub_end.lend(100) is None and not pub_end.send_loaned(None, b"", b"")
+    pub.close()
