@@ -1053,7 +1053,7 @@ class Runner:
 
     def intra(self, who: str, kind: str):
         """Frames/s one minros process delivers to itself with intraprocess=True."""
-        if who != "minros":
+        if who not in ("minros", "baseline"):
             return None
         command, env = self.command(who, "intra-flood", ["--kind", kind, "--queue", "10",
                                                         "--seconds", str(self.args.seconds)])
@@ -1066,7 +1066,7 @@ class Runner:
     def bringup(self, who: str, nodes: int = 100, topics: int = 10):
         """Seconds from starting ``nodes`` nodes (``topics`` publishers and subscribers each, in a
         ring) until every one of their connections is made."""
-        if who not in ("minros", "rospy"):
+        if who not in ("minros", "rospy", "baseline"):
             return None
         procs = []
         start = time.time()
@@ -1101,16 +1101,18 @@ class Runner:
     def tool_cpu(self, who: str, verb: str):
         """% of one core ``rostopic hz|echo`` spends on a 10 kHz std_msgs/String topic (the same
         minros publisher for every tool)."""
-        if who not in ("minros", "rospy"):
+        if who not in ("minros", "rospy", "baseline"):
             return None
-        if who == "minros":
-            tool = [self.args.minros_python, "-m", "minros", "topic", verb, "/bench_rate"]
-        else:
+        tool_env = self.env(who == "rospy")
+        if who == "rospy":
             tool = [REFERENCE_PYTHON, "/usr/bin/rostopic", verb, "/bench_rate"]
+        else:  # minros's tool, of this tree or the baseline's (its interpreter and path)
+            (python, *_), tool_env = self.command(who, "", [])
+            tool = [python, "-m", "minros", "topic", verb, "/bench_rate"]
         seconds = max(self.args.seconds, 3.0)
         procs = []
         try:
-            procs.append(subprocess.Popen(tool, env=self.env(who == "rospy"), stdout=subprocess.DEVNULL,
+            procs.append(subprocess.Popen(tool, env=tool_env, stdout=subprocess.DEVNULL,
                                           stderr=subprocess.DEVNULL))
             pub_cmd = self.command("minros", "rate-pub", ["--kind", "small", "--hz", "10000",
                                                          "--seconds", str(seconds + 1.0)])
