@@ -428,6 +428,7 @@ def run(seconds: float, web_src: str | None = None) -> list:
         for t in stalled:
             t.start()
         time.sleep(1)
+        tap = tap_transport(master, "/camera/image_raw")  # the stalled clients' tap, live
         mjpeg: dict = {}
         viewer = threading.Thread(target=mjpeg_rate, args=(
             f"{http}/stream?topic=/camera/image_raw&quality=80", seconds, mjpeg))
@@ -439,7 +440,6 @@ def run(seconds: float, web_src: str | None = None) -> list:
         fox_line = [json.loads(x) for x in fox.stdout.splitlines() if x.startswith('{"bench"')]
         raw_hz = last_json(raw, seconds + 30)["hz"]
         pub_hz = last_json(pub, span + 30)["hz"]
-        tap = tap_transport(master, "/camera/image_raw")
         halt.set()
         fox_hz = fox_line[0]["bench"]["hz"] if fox_line else float("nan")
         decoded = fox_line[0]["bench"]["decodedOk"] if fox_line else False
