@@ -306,7 +306,7 @@ def test_large_messages_come_from_the_slot_small_ones_inline(pair):
     assert [f.__class__ for f in frames] == [memoryview, memoryview, memoryview, bytes]
     assert [bytes(f) for f in frames] == big + [b"small"]
     assert frames[0].readonly
-    seg = sender.segment
+    seg = sender.memory.segment
     assert seg is not None and seg.slots == shm.SLOTS and seg.slot_size == shm.page_round(300_004)
     assert settled(sender, lambda: sender.stat_msgs == 4)  # counted once wholly sent
     assert receiver.info().startswith("MINROSSHM connection")
@@ -373,7 +373,7 @@ def test_a_growing_message_gets_a_new_segment(pair):
     sender.send(serialize_frame(AnyMsg(payload(2, 500_000))))
     second = receive(receiver, 1)
     assert bytes(first[0]) == payload(1, 100_000) and second == [payload(2, 500_000)]
-    assert sender.segment.generation == 2
+    assert sender.memory.segment.generation == 2
     sender.send(serialize_frame(AnyMsg(b"x")))
     receive(receiver, 1)
     assert list(receiver.maps) == [2]  # the old mapping went once its frames were done
@@ -639,7 +639,7 @@ def test_a_loaned_array_is_published_from_its_slot_without_a_copy(pair, monkeypa
     sender, receiver, _ = pair
     pub = publication(sender)
     view = pub.loan(100_000)
-    seg = sender.segment
+    seg = sender.memory.segment
     assert seg is not None and not view.readonly and view.nbytes == 100_000
     assert seg.slot_size >= shm.LOAN_OFFSET + 100_000 + shm.LOAN_TAIL
     view[:] = payload(5, 100_000)  # filled in place: the slot's memory
@@ -682,7 +682,7 @@ def test_a_stale_loan_is_sent_as_any_message(pair):
     view = pub.loan(100_000)
     view[:] = payload(6, 100_000)
     sender.send(serialize_frame(AnyMsg(payload(1, 900_000))))
-    assert sender.segment.generation == 2
+    assert sender.memory.segment.generation == 2
     pub.publish(image(view))
     got = receive(receiver, 2)
     assert got[0] == payload(1, 900_000) and got[1][-100_000:] == payload(6, 100_000)
@@ -807,8 +807,8 @@ def test_a_subscriber_cannot_write_what_every_subscriber_reads():
         finally:
             os.close(fd)
         # the publisher itself still writes (its own mapping): the next frame arrives intact
-        assert sender.segment is not None
-        sender.segment.write(0, serialize_frame(AnyMsg(payload(2, 100_000))))
+        assert sender.memory.segment is not None
+        sender.memory.segment.write(0, serialize_frame(AnyMsg(payload(2, 100_000))))
     finally:
         sender.close()
         sub_sock.close()
@@ -831,9 +831,9 @@ def test_deaf_subscribers_hold_three_slots_each_not_their_queue():
         frames = 40
         for n in range(frames):  # 1 MB images, nobody reads
             pub.publish(image(payload(n, 1_000_000)))
-        slot_size = deaf[0][0].segment.slot_size
+        slot_size = deaf[0][0].memory.segment.slot_size
         for sender, _ in deaf:
-            blocks = os.fstat(sender.segment.fd).st_blocks * 512
+            blocks = os.fstat(sender.memory.segment.fd).st_blocks * 512
             assert blocks <= shm.HEADER_SIZE + shm.SLOTS * slot_size, blocks
             assert sender.slots.in_flight == shm.WINDOW and len(sender.queue) == 10
         queued = {id(item[1]) for sender, _ in deaf for item in sender.queue.items

@@ -19,9 +19,9 @@ found the failure: the failing thread closes the stream, which wakes the watcher
 publication's lock, taken before this one, is never taken under it, and a failure creates no
 thread (Python 3.12 refuses new threads at interpreter shutdown).
 
-A transport says only what goes on its wire: :meth:`QueuedSender._next_out` moves the next
-records from the queue into ``out``, :meth:`QueuedSender._transmit` sends them,
-:meth:`QueuedSender._watch` reads the subscriber.
+A transport says only what goes on its wire: ``send`` (its fast path, then the core's queue),
+:meth:`QueuedSender._next_out` moves the next records from the queue into ``out``,
+:meth:`QueuedSender._transmit` sends them, :meth:`QueuedSender._watch` reads the subscriber.
 """
 
 from __future__ import annotations
@@ -77,6 +77,11 @@ class QueuedSender(StreamTransport):
         self.out: List[Any] = []  # the unsent rest of what is being sent: never dropped
         self.out_count = 0  # the messages in out
         self.out_fd = -1  # a descriptor to pass with out's first byte (SCM_RIGHTS)
+        #: records to send before the queue, with the descriptor each carries (shared memory's
+        #: SEGM and FALL; none over TCPROS)
+        self.control: List[Tuple[bytes, int]] = []
+        #: why the transport failed while the connection lives on ("": it did not)
+        self.failed = ""
         self.lock = threading.Lock()  # C-level `with` on the hot path; the conditions share it
         self.cond = threading.Condition(self.lock)  # the writer waits here for out
         self.space = threading.Condition(self.lock)  # a publisher, for room in a full queue
@@ -136,10 +141,6 @@ class QueuedSender(StreamTransport):
         waiting). Shared memory reads the slots given back here."""
         return False
 
-    def _pending(self) -> bool:
-        """With the lock: whether anything besides ``out`` and the queue waits to be sent."""
-        return False
-
     def _watch(self) -> None:
         """Read what the subscriber sends until the stream ends (or the connection does)."""
         try:
@@ -158,30 +159,10 @@ class QueuedSender(StreamTransport):
 
     # -- sending --------------------------------------------------------------------------------
 
-    def _idle(self) -> bool:
-        """With the lock: nothing is waiting or being sent (a new message may go at once)."""
-        return not self.out and not self.busy and not self.queue.items and not self._pending()
-
-    def _send_idle(self, data: bytes) -> None:
-        """With the lock, the stream idle: ``data`` (one message) in one non-blocking send,
-        the usual case; what the kernel does not take waits in ``out`` for the writer (or is
-        sent before returning, for a synchronous publisher)."""
-        try:
-            sent = self.stream.send(data, MSG_DONTWAIT)
-        except BlockingIOError:
-            sent = 0
-        except OSError as exc:
-            self._fail(exc)
-            return
-        self.bytes_sent += sent
-        if sent == len(data):  # all of it in one call
-            self.stat_msgs += 1
-            return
-        self.out, self.out_count = [memoryview(data)[sent:]], 1
-        if self.sync:
-            self._drain()
-        else:
-            self.cond.notify()  # the writer sends the rest
+    # ``send`` is each transport's own: the fast path of its wire (one non-blocking send from
+    # the publishing thread when the stream is idle) is written out there, not called, since
+    # per-message Python on it is counted in tens of nanoseconds (docs/architecture.md's
+    # "latency path"); what follows is what both share once a frame has to wait.
 
     def _enqueue(self, item: Any, frame: Frame) -> bool:
         """With the lock: queue ``item`` (for ``frame``), oldest dropped when the queue is
@@ -258,7 +239,7 @@ class QueuedSender(StreamTransport):
         limit = sendqueue.SYNC_SEND_TIMEOUT
         deadline = time.monotonic() + limit
         progress = self.bytes_sent
-        while not self.done and (self.out or self.queue.items or self._pending()):
+        while not self.done and (self.out or self.queue.items or self.control):
             now = time.monotonic()
             if self.bytes_sent != progress:  # it is reading: keep waiting
                 progress, deadline = self.bytes_sent, now + limit

@@ -26,6 +26,7 @@ from minros.transport.sendqueue import (  # noqa: F401 - the numbers of TCPROS's
     BACKOFF_RATE,
     SYNC_SEND_TIMEOUT,
 )
+from minros.transport.streams import MSG_DONTWAIT
 from minros.transport.tcpros_base import TCPROS, TCPROSTransport, connect, negotiate, tcpros_info
 from minros.wire import tcpros
 from minros.wire.handshake import Handshake, Role, route
@@ -57,21 +58,42 @@ class TCPROSSender(QueuedSender):
         with self.lock:
             if not self.out and not self.busy and not self.queue.items:
                 # the socket is idle: hand the bytes to the kernel now, without blocking
-                if frame.__class__ is bytes:
-                    self._send_idle(frame)
+                if frame.__class__ is not bytes:  # a big frame: what the kernel takes
+                    self.out, self.out_count = list(frame), 1
+                    self._pump()  # the writer is told of the rest
+                    if self.sync:
+                        self._drain()
                     return
-                self.out, self.out_count = list(frame), 1
-                self._pump()  # sends out first
+                try:
+                    sent = self.stream.send(frame, MSG_DONTWAIT)
+                except BlockingIOError:
+                    sent = 0
+                except OSError as exc:
+                    self._fail(exc)
+                    return
+                self.bytes_sent += sent
+                if sent == len(frame):  # all of it in one call: the usual case
+                    self.stat_msgs += 1
+                    return
+                self.out, self.out_count = [memoryview(frame)[sent:]], 1
                 if self.sync:
                     self._drain()
+                else:
+                    self.cond.notify()  # the writer sends the rest
                 return
-            if not self._enqueue(frame, frame):
-                return
+            queue = self.queue
+            if queue.limit and len(queue.items) >= queue.limit:  # full: back off, drop the oldest
+                if not self._enqueue(frame, frame):
+                    return
+            else:  # room: the hot path of a flood, one append
+                queue.items.append(frame)
             if self.sync:
                 self._drain()
                 return
             if not self.busy:  # a busy writer takes it without being told (and a notify
                 self.cond.notify()  # costs a microsecond even with no one waiting)
+        # The writer thread is behind: let it have the GIL now rather than after the
+        # interpreter's switch interval (5 ms), or a publishing loop starves it.
         _yield_gil()
 
     def _next_out(self) -> bool:

@@ -205,12 +205,13 @@ class Memory:
     frame does not fit: the SEGM announcement, with its descriptor, waits in ``control``),
     and which of its slots are free, written, queued or the subscriber's (``slots``)."""
 
-    def __init__(self, topic: str) -> None:
+    def __init__(self, topic: str, control: List[Tuple[bytes, int]]) -> None:
         self.topic = topic
         self.segment: ShmSegment | None = None
         self.slots = shm.SlotTable()
-        #: records to send before any other (SEGM, FALL), with the descriptor each carries
-        self.control: List[Tuple[bytes, int]] = []
+        #: the connection's records to send before any other (SEGM here, FALL), with the
+        #: descriptor each carries (the sender's list, changed in place)
+        self.control = control
 
     def fit(self, size: int) -> bool:
         """Make the segment's slots hold ``size`` bytes: True when that took a new segment
@@ -222,7 +223,7 @@ class Memory:
         new = ShmSegment.for_frame(self.topic, size, seg)
         self.slots.resize(new.slots, new.generation)
         self.close_control()
-        self.control = [new.announcement()]
+        self.control.append(new.announcement())
         self.segment = new
         if seg is not None:
             seg.close()  # the subscriber's mapping keeps what it still reads
@@ -245,7 +246,7 @@ class Memory:
         for _record, fd in self.control:
             if fd >= 0:
                 os.close(fd)
-        self.control = []
+        self.control.clear()
 
     def close(self) -> None:
         self.close_control()

@@ -13,7 +13,7 @@ from typing import Any, Callable, List
 
 from minros.transport.base import Frame, Transport
 from minros.transport.sender import QueuedSender, frame_size
-from minros.transport.shm.segment import Loan, Memory, ShmSegment, once, why
+from minros.transport.shm.segment import Loan, Memory, once, why
 from minros.transport.streams import MSG_DONTWAIT, wait_readable
 from minros.wire import shm, sockets
 
@@ -26,11 +26,9 @@ _rosout = logging.getLogger("rosout")
 
 
 class ShmSender(QueuedSender):
-    """The publisher's end of one subscriber's MINROSSHM connection.
-
-    ``on_close(self)`` runs once, in the watcher thread, when the connection fails or the
-    subscriber leaves (not when :meth:`close` is called); ``on_fallback(topic, reason)`` when
-    shared memory failed for this topic (the handler then answers TCPROS to later offers)."""
+    """The publisher's end of one subscriber's MINROSSHM connection (``on_close`` as the
+    core's; ``on_fallback(topic, reason)`` when shared memory failed for this topic: the
+    handler then answers TCPROS to later offers)."""
 
     protocol = shm.PROTOCOL
     QUIET = (BrokenPipeError, ConnectionResetError, shm.ShmError)
@@ -39,33 +37,28 @@ class ShmSender(QueuedSender):
                  on_close: Callable[[Transport], Any],
                  on_fallback: Callable[[str, str], Any] | None = None) -> None:
         super().__init__(stream, topic, queue_size, on_close)
-        self.memory = Memory(topic)
+        self.memory = Memory(topic, self.control)
         self.slots = self.memory.slots
-        self.failed = ""  # why shared memory failed: nothing more is sent but the FALL
         self.on_fallback = on_fallback
         self.peer_pid = sockets.peer_pid(stream)
-        self.done_reader = shm.DoneReader()  # read by the watcher, or a publisher (_more)
+        self.done_reader = shm.DoneReader()  # read by the watcher, or by a publisher (_more)
         self.on_drop = self._dropped
 
-    @property
-    def segment(self) -> ShmSegment | None:
-        return self.memory.segment
-
     def info(self) -> str:
-        seg = self.segment
-        where = (f"{seg.slots} slots of {seg.slot_size} bytes" if seg is not None
-                 else "no segment yet")
+        seg = self.memory.segment
+        where = f"{seg.slots} slots of {seg.slot_size} bytes" if seg else "no segment yet"
         return (f"MINROSSHM connection (shared memory, {where}) on Unix socket {self.fileno} "
                 f"to [pid {self.peer_pid}]")
 
     # -- publishing ------------------------------------------------------------------------
 
     def send(self, frame: Frame) -> None:
-        """Queue ``frame`` and send what the window allows; a synchronous publisher waits
-        until it is handed over."""
+        """A small frame at once when the socket is idle, else queued; what the window allows
+        goes (a synchronous publisher waits until it is handed over)."""
         if self.done or self.failed:
             return
-        size = frame_size(frame)
+        small = frame.__class__ is bytes
+        size = len(frame) if small else frame_size(frame)
         with self.lock:
             if self.done or self.failed:
                 return
@@ -73,8 +66,25 @@ class ShmSender(QueuedSender):
                 if not self._fits(size):
                     return  # shared memory failed: the FALL record is on its way
                 item: Any = ("frame", frame, size)
-            elif frame.__class__ is bytes and self._idle():
-                self._send_idle(shm.INLINE + frame)
+            elif small and not self.out and not self.busy and not self.queue.items \
+                    and not self.control:  # the socket is idle: one send, as over TCPROS
+                data = shm.INLINE + frame  # type: ignore[operator]
+                try:
+                    sent = self.stream.send(data, MSG_DONTWAIT)
+                except BlockingIOError:
+                    sent = 0
+                except OSError as exc:
+                    self._fail(exc)
+                    return
+                self.bytes_sent += sent
+                if sent == len(data):
+                    self.stat_msgs += 1
+                    return
+                self.out, self.out_count = [memoryview(data)[sent:]], 1
+                if self.sync:
+                    self._drain()
+                else:
+                    self.cond.notify()  # the writer thread sends the rest
                 return
             else:
                 item = ("inline", frame)
@@ -84,7 +94,7 @@ class ShmSender(QueuedSender):
                     self._drain()
 
     def _next_out(self) -> bool:
-        control = self.memory.control
+        control = self.control
         if control:
             record, fd = control.pop(0)
             self.out, self.out_fd, self.out_count = [record], fd, 0
@@ -115,8 +125,8 @@ class ShmSender(QueuedSender):
         return True
 
     def _write_ahead(self) -> bool:
-        """With the lock: copy the frame at the queue's head into a free slot (the one copy it
-        costs); False when no slot is free (or no memory: shared memory failed)."""
+        """With the lock: the frame at the queue's head copied into a free slot (the one copy
+        it costs); False when none is free."""
         index = self._slot()
         if index is None:
             return False
@@ -127,8 +137,8 @@ class ShmSender(QueuedSender):
         return True
 
     def _slot(self, take_back: bool = False) -> int | None:
-        """With the lock: a free slot, its memory allocated (None: none is free, or shared
-        memory failed); ``take_back``: when none is free, the frame written ahead gives way."""
+        """With the lock: a free slot, allocated (None: none, or shared memory failed);
+        ``take_back``: when none is free, the frame written ahead gives way."""
         if take_back and not self.slots.counts()["free"]:
             self._drop_written(1)
         try:
@@ -138,30 +148,21 @@ class ShmSender(QueuedSender):
             return None
 
     def _drop_written(self, limit: int = -1) -> None:
-        """With the lock: frames written into slots and not announced give way (``limit``
-        of them, oldest first; all by default)."""
+        """With the lock: frames written and not announced give way (``limit``, oldest first)."""
         written = [i for i in self.queue.items if i[0] == "slot"]
         for item in written[:limit] if limit >= 0 else written:
             self.queue.items.remove(item)
             self.queue.dropped += 1
             self.slots.abandon(item[1])
 
-    def _dropped(self, item: Any) -> None:
-        """With the lock: the full queue dropped ``item``: a written slot is free again."""
+    def _dropped(self, item: Any) -> None:  # with the lock: the full queue dropped ``item``
         if item[0] == "slot":
             self.slots.abandon(item[1])
 
-    def _more(self) -> bool:
-        return bool(self.queue.items) and not self.slots.room() and not self.failed \
-            and self._take_done()
-
-    def _pending(self) -> bool:
-        return bool(self.memory.control)
 
     def _fits(self, size: int) -> bool:
-        """With the lock: a segment whose slots hold ``size`` bytes (a new, larger one when
-        needed: the frames written into the old one are announced no more, the frames waiting
-        keep their place); False when shared memory failed (the FALL record is on its way)."""
+        """With the lock: slots that hold ``size`` bytes (a new segment: the frames written
+        into the old one are dropped, those waiting stay); False when shared memory failed."""
         try:
             if self.memory.fit(size):
                 self._drop_written()
@@ -170,18 +171,18 @@ class ShmSender(QueuedSender):
             return False
         return True
 
-    def _unavailable(self, exc: OSError) -> None:
+    def _unavailable(self, exc: OSError) -> None:  # with the lock: the kernel said no
         self._fall_back(f"shared memory for [{self.topic}] unavailable: {why(exc)}")
 
     def _fall_back(self, reason: str) -> None:
-        """With the lock: shared memory failed; tell the subscriber (FALL), which connects
-        again over TCPROS. One log line per distinct reason."""
+        """With the lock: shared memory failed: FALL tells the subscriber to use TCPROS (one
+        log line per distinct reason)."""
         if self.failed:
             return
         self.failed = reason
         if once(reason):
             _rosout.warning("%s; its subscribers use TCPROS", reason)
-        self.memory.control.append((shm.fallback(reason), -1))
+        self.control.append((shm.fallback(reason), -1))
         self.queue.clear()
         self._pump()
         if self.on_fallback is not None:
@@ -190,29 +191,27 @@ class ShmSender(QueuedSender):
     # -- loans (Publisher.loan) --------------------------------------------------------------
 
     def lend(self, nbytes: int) -> Loan | None:
-        """A slot for a message whose large array (``nbytes``) the publisher fills in place.
-        None when there is none to lend (the connection ended, shared memory failed, a
-        synchronous publisher, the kernel)."""
+        """A slot for a message's large array of ``nbytes`` the publisher fills in place (None:
+        the connection ended, shared memory failed, a synchronous publisher, the kernel)."""
         with self.lock:
             if self.done or self.failed or self.sync or \
                     not self._fits(shm.LOAN_OFFSET + nbytes + shm.LOAN_TAIL):
                 return None
             index = self._slot(take_back=True)
-            seg = self.segment
+            seg = self.memory.segment
             return seg.lend(index, nbytes) if index is not None and seg is not None else None
 
     def give_back(self, loan: Any) -> None:
         """A loan not published after all: its slot is free again."""
         with self.lock:
-            if loan.segment is self.segment:
+            if loan.segment is self.memory.segment:
                 self.slots.abandon(loan.index)
 
     def send_loaned(self, loan: Any, head: bytes, tail: bytes) -> bool:
-        """Publish the message whose array is ``loan``'s memory, the fields written around it:
-        nothing is copied. False when the loan is stale (a new segment since, the connection
-        ended): the caller then sends the message as any other."""
+        """Publish the message whose array is ``loan``'s memory, its fields written around it
+        (no copy); False for a stale loan (a new segment since, the connection ended)."""
         with self.lock:
-            seg = self.segment
+            seg = self.memory.segment
             if self.done or self.failed or loan.segment is not seg or seg is None:
                 return False
             where = seg.write_around(loan, head, tail)
@@ -226,10 +225,11 @@ class ShmSender(QueuedSender):
 
     # -- the subscriber's DONE records -------------------------------------------------------
 
-    def _take_done(self) -> bool:
-        """With the lock: the DONE records already on the socket, read without waiting for
-        the watcher (a publisher copying frames holds the GIL: the watcher would wait up to
-        the switch interval for each slot); True when a slot came back."""
+    def _more(self) -> bool:
+        """With the lock, the window full: the DONE records on the socket, without waiting for
+        the watcher (a publisher copying frames holds the GIL); True when a slot came back."""
+        if not self.queue.items or self.slots.room() or self.failed:
+            return False
         try:
             return self._read_done() > 0
         except shm.ShmError as exc:
@@ -239,8 +239,8 @@ class ShmSender(QueuedSender):
         return False
 
     def _read_done(self) -> int:
-        """With the lock: read the DONE records there are, without blocking, and free their
-        slots; how many came (-1: the end of the stream)."""
+        """With the lock: the DONE records there are, their slots freed; how many (-1: the
+        end of the stream)."""
         n = self.stream.recv_into(self.done_reader.space(), 0, MSG_DONTWAIT)
         if not n:
             return -1
@@ -256,9 +256,9 @@ class ShmSender(QueuedSender):
         return len(records)
 
     def _watch(self) -> None:
-        """Reads the subscriber's DONE records until its end of the stream."""
+        """Reads the subscriber's DONE records until its end of the stream (waits of 1 s: a
+        descriptor closed meanwhile and reused is never waited on long)."""
         while not self.done:
-            # the timeout: a descriptor closed meanwhile and reused is never waited on long
             if wait_readable(self.stream, 1.0):
                 with self.cond:
                     try:
