@@ -17,6 +17,11 @@ play, Python Bag) in the same run, on one Debian rosmaster.
   rospy itself; minros's imports its node stack when the first timestamp is made, 30 ms that
   would otherwise be timed as reading).
 * info: ``rosbag info`` on that bag, the whole command (interpreter start included).
+* convert: a bag of ``--gigabytes`` GB of 640x480 rgb8 images at 30 Hz and 720-ray
+  sensor_msgs/LaserScan at 40 Hz, converted to a ROS 2 recording (rosbag2, MCAP, Jazzy types)
+  by ``minros bag convert`` and by ``rosbags-convert --dst-typestore ros2_jazzy``, each the
+  whole command (interpreter start included), page cache warm, interleaved; MB/s of the input
+  bag. ``--only convert`` runs this part alone (it needs no ROS 1 reference).
 
 The bag files are deleted at the end. This file is also the worker (``--role``), run by the
 venv's Python for minros and by /usr/bin/python3 for Debian's rosbag (``import rosbag``
@@ -170,6 +175,86 @@ def make_big_bag(path: str, gigabytes: float) -> int:
     return os.path.getsize(path)
 
 
+def make_convert_bag(path: str, gigabytes: float) -> int:
+    """Raw writes of one serialized 640x480 image and one 720-ray scan at 30 and 40 Hz."""
+    import io
+    import math
+
+    import minros
+    from minros.bag import Bag
+    from sensor_msgs.msg import Image, LaserScan
+
+    img = Image(height=480, width=640, encoding="rgb8", step=640 * 3,
+                data=bytes(range(256)) * (640 * 480 * 3 // 256))
+    img.header.frame_id = "camera"
+    scan = LaserScan(angle_min=-math.pi, angle_max=math.pi, angle_increment=2 * math.pi / 720,
+                     range_min=0.1, range_max=30.0, ranges=[1.0 + i / 100 for i in range(720)],
+                     intensities=[100.0] * 720)
+    scan.header.frame_id = "laser"
+    blobs = {}
+    for name, msg in (("image", img), ("scan", scan)):
+        buff = io.BytesIO()
+        msg.serialize(buff)
+        blobs[name] = (msg._type, buff.getvalue(), msg._md5sum, type(msg))
+    target = int(gigabytes * 1e9)
+    written = 0
+    t = 1_700_000_000 * 10**9
+    tick = 0
+    with Bag(path, "w") as bag:
+        while written < target:  # a 120 Hz tick: images every 4th, scans every 3rd
+            stamp = minros.Time(t // 10**9, t % 10**9)
+            if tick % 4 == 0:
+                bag.write("/camera/image_raw", blobs["image"], stamp, raw=True)
+                written += len(blobs["image"][1])
+            if tick % 3 == 0:
+                bag.write("/scan", blobs["scan"], stamp, raw=True)
+                written += len(blobs["scan"][1])
+            tick += 1
+            t += 1_000_000_000 // 120
+    return os.path.getsize(path)
+
+
+def convert_once(who: str, src: str, dst: str) -> float:
+    """Seconds of one whole conversion command (the output removed afterwards)."""
+    if who == "minros":
+        cmd = [VENV_PYTHON, "-m", "minros", "bag", "convert", "-q", src, dst]
+    else:
+        cmd = [os.path.join(os.path.dirname(VENV_PYTHON), "rosbags-convert"), "--src", src,
+               "--dst", dst, "--dst-storage", "mcap", "--dst-typestore", "ros2_jazzy"]
+    start = time.perf_counter()
+    result = subprocess.run(cmd, capture_output=True, text=True, timeout=1800)
+    elapsed = time.perf_counter() - start
+    if result.returncode != 0:
+        sys.exit(f"benchmarks/bag.py: {who} convert failed: {result.stderr[-2000:]}")
+    shutil.rmtree(dst, ignore_errors=True)
+    return elapsed
+
+
+def convert_rows(tmp: str, gigabytes: float, rounds: int) -> list:
+    src = os.path.join(tmp, "convert.bag")
+    size = make_convert_bag(src, gigabytes)
+    subprocess.run(["cat", src], stdout=subprocess.DEVNULL, check=True)  # warm the page cache
+    who = ("minros", "rosbags-convert")
+    times = {w: [] for w in who}
+    for _ in range(rounds):
+        for w in who:
+            times[w].append(convert_once(w, src, os.path.join(tmp, "converted")))
+    os.remove(src)
+    rate = {w: size / 1e6 / statistics.median(times[w]) for w in who}
+    secs = {w: statistics.median(times[w]) for w in who}
+    return [(f"convert a {size / 1e9:.2f} GB bag (images, scans) to ROS 2 MCAP: MB/s",
+             f"{rate['minros']:.0f}", f"{rate['rosbags-convert']:.0f}",
+             f"{rate['minros'] / rate['rosbags-convert']:.1f}x faster"),
+            ("  the same, seconds (whole command)", f"{secs['minros']:.2f}",
+             f"{secs['rosbags-convert']:.2f}", "")]
+
+
+def print_table(header: tuple, rows: list) -> None:
+    widths = [max(len(str(row[k])) for row in [header, *rows]) for k in range(4)]
+    for row in [header, tuple("-" * w for w in widths), *rows]:
+        print(" | ".join(str(c).ljust(w) for c, w in zip(row, widths)))
+
+
 class Bench:
     def __init__(self, args) -> None:
         self.args = args
@@ -295,11 +380,22 @@ def main() -> None:
     parser.add_argument("--path")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--gigabytes", type=float, default=1.0)
+    parser.add_argument("--only", choices=["convert"], help="run only this part")
     args = parser.parse_args()
     if args.role:
         {"publish": role_publish, "listen": role_listen, "read": role_read}[args.role](args)
         return
     byte_compile_minros()
+    if args.only == "convert":
+        tmp = tempfile.mkdtemp(prefix="minros-bag-bench-")
+        try:
+            rows = convert_rows(tmp, args.gigabytes, args.rounds)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+        print_table(("measure", "minros", "rosbags-convert", "minros vs rosbags"), rows)
+        print(f"\n{args.rounds} rounds (median), contenders interleaved; Python "
+              f"{sys.version.split()[0]}; {os.cpu_count()} cores")
+        return
     free = shutil.disk_usage(tempfile.gettempdir()).free
     need = args.gigabytes * 1e9 + 2 * 3.8e9 * args.seconds / 20
     if free < need * 1.5:
@@ -339,13 +435,14 @@ def main() -> None:
                      f"{r['debian']:.2f}", f"{r['debian'] / r['minros']:.1f}x faster"))
         rows.append(("rosbag info on it (s)", f"{i['minros']:.3f}", f"{i['debian']:.3f}",
                      f"{i['debian'] / i['minros']:.1f}x faster"))
+        os.remove(big)
+        converted = convert_rows(bench.tmp, args.gigabytes, args.rounds)
     finally:
         bench.close()
-    header = ("measure", "minros", "Debian rosbag", "minros vs Debian")
-    widths = [max(len(str(row[k])) for row in [header, *rows]) for k in range(4)]
-    for row in [header, tuple("-" * w for w in widths), *rows]:
-        print(" | ".join(str(c).ljust(w) for c, w in zip(row, widths)))
-    print(f"\n{args.rounds} rounds (median) for play/read/info, 1 for record; Python "
+    print_table(("measure", "minros", "Debian rosbag", "minros vs Debian"), rows)
+    print()
+    print_table(("measure", "minros", "rosbags-convert", "minros vs rosbags"), converted)
+    print(f"\n{args.rounds} rounds (median) for play/read/info/convert, 1 for record; Python "
           f"{sys.version.split()[0]}; {os.cpu_count()} cores")
 
 

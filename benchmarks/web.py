@@ -24,6 +24,12 @@ std_msgs/String topics each, every topic published at 1 Hz; one rosbridge client
 all 2,000 through ``minros web``. Once every topic has delivered a message, the server's threads
 and resident memory are read from /proc, and the delivered rate is measured.
 
+Scenario 4, package files (``--only assets``): an attacker's 30 parallel GETs of a 46 MiB mesh
+on ``/pkg/`` that it never reads, then six Foxglove clients asking for it eight times each
+(``fetchAsset``) without reading. The server's resident memory idle, at its highest during
+each flood and after the flood's clients closed, beside the time an honest client takes to
+download the whole file meanwhile.
+
 ``--baseline DIR`` runs every scenario a second time, right after the first, with the server
 from another source tree (an older commit: ``git archive COMMIT src stubs | tar -x -C DIR``),
 for before/after figures on one machine in one run.
@@ -237,6 +243,120 @@ def print_topics(rows: list, seconds: float) -> None:
         peak = f"{end['peak']:.0f}" if end else "-"
         print(f"| {who:<10} | {name:<56} | {topics:6d} | {all_text:>22} | {hz_text:>15} | "
               f"{threads:>14} | {rss:>6} | {peak:>11}")
+
+
+def _rss_peak(pid: int, seconds: float) -> float:
+    top, end = 0.0, time.monotonic() + seconds
+    while time.monotonic() < end:
+        top = max(top, proc_stats(pid)["rss"])
+        time.sleep(0.05)
+    return top
+
+
+def _honest_get(url: str) -> tuple:
+    start = time.monotonic()
+    with urllib.request.urlopen(url, timeout=120) as response:
+        size = len(response.read())
+    return size, time.monotonic() - start
+
+
+def _honest_fetch(ws_url: str, uri: str) -> tuple:
+    from websockets.sync.client import connect
+
+    start = time.monotonic()
+    with connect(ws_url, subprotocols=["foxglove.websocket.v1"], max_size=None) as ws:
+        ws.send(json.dumps({"op": "fetchAsset", "uri": uri, "requestId": 1}))
+        while True:
+            msg = ws.recv(timeout=120)
+            if isinstance(msg, bytes) and msg[0] == 4:
+                return len(msg) - 10, time.monotonic() - start
+
+
+def _flood_pkg(web_port: int) -> list:
+    unread = []
+    for _ in range(30):
+        sock = socket.create_connection(("127.0.0.1", web_port))
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        sock.sendall(f"GET /pkg/big_pkg/meshes/big.stl HTTP/1.1\r\nHost: 127.0.0.1:{web_port}"
+                     "\r\n\r\n".encode())
+        unread.append(sock)
+    return unread
+
+
+def _flood_foxglove(web_port: int) -> list:
+    import warnings
+
+    from websockets.sync.client import connect
+
+    clients = []
+    for _ in range(6):
+        with warnings.catch_warnings():  # kept open past this function, on purpose
+            warnings.simplefilter("ignore", DeprecationWarning)
+            ws = connect(f"ws://127.0.0.1:{web_port}", subprotocols=["foxglove.websocket.v1"],
+                         max_size=None)
+        ws.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        for request_id in range(8):
+            ws.send(json.dumps({"op": "fetchAsset", "requestId": request_id,
+                                "uri": "package://big_pkg/meshes/big.stl"}))
+        clients.append(ws.socket)
+    return clients
+
+
+def run_assets(web_src: str | None) -> list:
+    """Each flood on a server of its own (memory a flood leaves held would count twice)."""
+    home = tempfile.mkdtemp(prefix="minros-web-bench-")
+    pkg = os.path.join(home, "pkgs", "big_pkg")
+    os.makedirs(os.path.join(pkg, "meshes"))
+    with open(os.path.join(pkg, "package.xml"), "w") as f:
+        f.write("<package><name>big_pkg</name></package>")
+    with open(os.path.join(pkg, "meshes", "big.stl"), "wb") as f:
+        f.write(os.urandom(46 << 20))
+    master = free_port()
+    env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{master}", ROS_HOSTNAME="localhost",
+               ROS_HOME=home, ROS_LOG_DIR=home, PYTHONUNBUFFERED="1",
+               ROS_PACKAGE_PATH=os.path.join(home, "pkgs"))
+    procs = [spawn([PYTHON, "-m", "minros", "core", "-p", str(master)], env)]
+    rows = []
+    floods = [("30 unread GETs of a 46 MiB mesh on /pkg/", _flood_pkg, "GET"),
+              ("6 unread Foxglove clients x 8 fetchAsset of it", _flood_foxglove, "fetchAsset")]
+    try:
+        wait_for(lambda: master_up(master), 20, "the master")
+        for name, flood, honest in floods:
+            web_port = free_port()
+            web = spawn([PYTHON, "-m", "minros", "web", "--port", str(web_port)],
+                        web_env(env, web_src))
+            try:
+                wait_for(lambda port=web_port: port_open(port), 20, "minros web")
+                idle = proc_stats(web.pid)["rss"]
+                socks = flood(web_port)
+                peak = _rss_peak(web.pid, 5.0)
+                if honest == "GET":
+                    size, took = _honest_get(f"http://127.0.0.1:{web_port}/pkg/big_pkg/meshes/big.stl")
+                else:
+                    size, took = _honest_fetch(f"ws://127.0.0.1:{web_port}",
+                                               "package://big_pkg/meshes/big.stl")
+                for sock in socks:
+                    sock.close()
+                time.sleep(3)  # a measurement window: what is still held once they are gone
+                rows.append((name, idle, peak, proc_stats(web.pid)["rss"], size, took, honest))
+            finally:
+                stop(web)
+    finally:
+        for proc in reversed(procs):
+            stop(proc)
+    return rows
+
+
+def print_assets(rows: list) -> None:
+    print(f"minros web, package files under a flood of unread downloads ({os.cpu_count()} cores; "
+          "RSS of the server in MB)")
+    print(f"| {'server':<10} | {'flood':<48} | RSS before | RSS peak | RSS after close | "
+          "honest download meanwhile")
+    print(f"|{'-' * 12}|{'-' * 50}|------------|----------|-----------------|"
+          "--------------------------")
+    for who, (name, idle, peak, after, size, took, honest) in sorted(rows, key=lambda r: r[1][0]):
+        print(f"| {who:<10} | {name:<48} | {idle:10.0f} | {peak:8.0f} | {after:15.0f} | "
+              f"{honest} of {size / 2**20:.0f} MiB in {took:.2f} s")
 
 
 # -- clients ---------------------------------------------------------------------------------
@@ -482,8 +602,9 @@ def run(seconds: float, web_src: str | None = None) -> list:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=10.0)
-    parser.add_argument("--only", choices=("streams", "topics"),
-                        help="run scenarios 1-2 (streams) or 3 (topics) only (default: all)")
+    parser.add_argument("--only", choices=("streams", "topics", "assets"),
+                        help="run scenarios 1-2 (streams), 3 (topics) or 4 (assets) only "
+                             "(default: all)")
     parser.add_argument("--nodes", type=int, default=200, help="scenario 3: publisher nodes")
     parser.add_argument("--per-node", type=int, default=10, help="scenario 3: topics per node")
     parser.add_argument("--farms", type=int, default=4,
@@ -509,6 +630,10 @@ def main() -> int:
         return 0
     byte_compile_minros()
     contenders = [("this tree", None)] + ([("baseline", args.baseline)] if args.baseline else [])
+    if args.only in (None, "assets"):
+        print_assets([(who, row) for who, src in contenders for row in run_assets(src)])
+        if args.only == "assets":
+            return 0
     if args.only != "streams":
         rows = [(who, row) for who, src in contenders
                 for row in run_topics(args.seconds, args.nodes, args.per_node, args.farms, src)]

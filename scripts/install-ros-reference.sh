@@ -13,6 +13,11 @@
 #   bash scripts/install-ros-reference.sh --print-packages  print every apt package this
 #       script may install on this machine, one per line, and exit (tests/unit/
 #       test_install_script.py simulates installing all of them with apt-get -s)
+#   bash scripts/install-ros-reference.sh --sources DIR [SOURCE_PACKAGE ...]
+#       fetch Debian's source packages (default: ros-ros-comm, whose tests
+#       scripts/rostest_suites.py runs) into DIR and unpack their upstream tarballs there;
+#       apt reads a deb-src list of its own under DIR/apt, so the machine's apt setup is
+#       neither read for sources nor changed (no root needed; a second run fetches nothing)
 set -euo pipefail
 if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
 
@@ -40,7 +45,7 @@ ROS_DESKTOP_FULL="ros-desktop-full-python-dev python3-pykdl python3-tf2-sensor-m
   python3-tf-conversions python3-tf2-kdl python3-bondpy python3-nodelet python3-topic-tools
   python3-resource-retriever python3-smclib python3-actionlib-tools
   libbond-dev libnodelet-dev libnodeletlib-tools topic-tools
-  ros-robot-state-publisher joint-state-publisher image-transport-tools
+  ros-robot-state-publisher joint-state-publisher joint-state-publisher-gui image-transport-tools
   python3-camera-calibration-parsers python3-map-msgs
   python3-pcl-msgs python3-polled-camera python3-roswtf
   python3-rosclean python3-rosmake python3-rospkg"
@@ -50,6 +55,52 @@ ROS_DESKTOP_FULL="ros-desktop-full-python-dev python3-pykdl python3-tf2-sensor-m
 # graphviz for view_frames' frames.pdf; iproute2 for the two-host tests' network namespaces;
 # tshark opens the capture files `minros trace pcap` writes.
 TEST_TOOLS="xvfb zsh python3-venv python3-tk graphviz iproute2 tshark"
+
+# Debian's sources (--sources): apt with lists, cache and a deb-src entry of its own under DIR/apt.
+fetch_sources() {  # dest package...
+  local dest=$1 apt_dir codename pkg orig
+  shift
+  mkdir -p "$dest"
+  dest=$(cd "$dest" && pwd)
+  apt_dir=$dest/apt
+  mkdir -p "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial" "$apt_dir/sources.list.d"
+  codename=$(. /etc/os-release 2>/dev/null && echo "${VERSION_CODENAME:-}")
+  printf '%s\n' "Types: deb-src" "URIs: http://deb.debian.org/debian" \
+    "Suites: ${codename:-bookworm}" "Components: main" \
+    "Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg" \
+    > "$apt_dir/sources.list.d/debian-src.sources"
+  local opts=(-q -o "Dir::Etc::SourceList=/dev/null" -o "Dir::Etc::SourceParts=$apt_dir/sources.list.d"
+              -o "Dir::State::Lists=$apt_dir/lists" -o "Dir::Cache=$apt_dir/cache")
+  # as root apt hands downloads to its _apt user, who may not enter DIR (under /root)
+  [ "$(id -u)" -ne 0 ] || opts+=(-o "APT::Sandbox::User=root")
+  if ! ls "$apt_dir/lists/"*_Sources* >/dev/null 2>&1; then
+    apt-get "${opts[@]}" update >&2
+  fi
+  for pkg in "$@"; do
+    if ! ls "$dest/${pkg}"_*.orig.tar.* >/dev/null 2>&1; then
+      # only the upstream tarball is used: a Debian part that fails to download does not matter
+      (cd "$dest" && apt-get "${opts[@]}" source --download-only "$pkg" >&2) ||
+        ls "$dest/${pkg}"_*.orig.tar.* >/dev/null 2>&1 ||
+        { echo "error: apt-get source $pkg fetched no upstream tarball" >&2; exit 1; }
+    fi
+    for orig in "$dest/${pkg}"_*.orig.tar.*; do
+      tar -xf "$orig" -C "$dest"
+    done
+    echo "$pkg: unpacked in $dest"
+  done
+}
+
+if [ "${1:-}" = "--sources" ]; then
+  if [ -z "${2:-}" ]; then
+    echo "usage: $0 --sources DIR [SOURCE_PACKAGE ...]" >&2
+    exit 2
+  fi
+  dest=$2
+  shift 2
+  [ "$#" -gt 0 ] || set -- ros-ros-comm
+  fetch_sources "$dest" "$@"
+  exit 0
+fi
 
 # On a machine whose package lists were never fetched, apt knows no package at all.
 if ! apt-cache show ros-core >/dev/null 2>&1; then $SUDO apt-get update -q >&2; fi
@@ -86,7 +137,7 @@ if [ "${1:-}" = "--print-packages" ]; then
   candidates
   exit 0
 elif [ -n "${1:-}" ]; then
-  echo "usage: $0 [--print-packages]" >&2
+  echo "usage: $0 [--print-packages | --sources DIR [SOURCE_PACKAGE ...]]" >&2
   exit 2
 fi
 

@@ -44,7 +44,8 @@ build() {  # name packages...
   rm -rf "$dir"
   mkdir -p "$ROOT"
   "$PY" -m venv "$dir"
-  "$dir/bin/python" -m pip install -q --disable-pip-version-check "$@"
+  # (this image's pip configuration names local indexes that may be absent: their warnings go)
+  "$dir/bin/python" -m pip install -q --disable-pip-version-check "$@" 2>&1 | { grep -v "^WARNING: Location" || true; }
   printf '%s\n' "$want" > "$dir/.minros-stamp"
   echo "ROS 2 reference: $name installed in $dir"
 }

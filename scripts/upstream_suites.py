@@ -2,14 +2,19 @@
 """Run ROS's own Python unit suites against minros and against Debian's ROS 1; print both counts.
 
     .venv/bin/python scripts/upstream_suites.py --ros-comm DIR --genpy DIR --genmsg DIR \\
-        [--geometry DIR] [--diagnostics DIR] [--urdf-parser-py DIR] [--only SUITE ...] \\
+        [--geometry DIR] [--diagnostics DIR] [--urdf-parser-py DIR] [--vision-opencv DIR] \\
+        [--only SUITE ...] \\
         [--side minros|debian|both] [--diff] [--keep DIR]
 
 Each DIR is a checkout of the public repository (ros/ros_comm, ros/genpy, ros/genmsg,
 ros/geometry, ros/diagnostics, ros/urdf_parser_py; the fetch tool or git clone gives one; the
 tags of Debian's versions are 1.15.15, 0.6.16, 0.6.0, 1.13.2 and 1.11.0; urdf_parser_py, which
-Debian lacks, at noetic's 0.4.6). The tests are run where they are, unedited; nothing of them is
-copied into this repository. A suite whose checkout is not given is left out.
+Debian lacks, at noetic's 0.4.6; ros-perception/vision_opencv, whose cv_bridge tests Debian's
+source package ros-vision-opencv 1.16.2 carries too: ``bash scripts/install-ros-reference.sh
+--sources DIR ros-vision-opencv`` unpacks it). The tests are run where they are, unedited;
+nothing of them is copied into this repository. A suite whose checkout is not given is left out.
+
+The integration tests (rostest, live master) are scripts/rostest_suites.py's.
 
 Both sides run the same files through pytest, each in a fresh process:
 - minros: this interpreter (the venv), whose rospy, genpy, roslib, ... are minros's. The test
@@ -100,6 +105,10 @@ SUITES: List[Suite] = [
     # a library Debian lacks: its "Debian" column is upstream's own code under Debian's Python
     Suite("urdf_parser_py", "urdf_parser_py", ["test"], target=False,
           shadowed=["urdf_parser_py"], debian_pythonpath=["src"]),
+    # cv_bridge's Python tests (its C++ tests need a build)
+    Suite("cv_bridge", "vision_opencv", ["cv_bridge/test/enumerants.py",
+                                         "cv_bridge/test/conversions.py",
+                                         "cv_bridge/test/python_bindings.py"], target=False),
 ]
 
 #: Test-only modules the upstream tests import that neither side installs, on both sides'
@@ -289,7 +298,8 @@ def count(outcomes: Optional[Dict[str, str]]) -> str:
 def main(argv: Optional[Sequence[str]] = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    for repo in ("ros-comm", "genpy", "genmsg", "geometry", "diagnostics", "urdf-parser-py"):
+    for repo in ("ros-comm", "genpy", "genmsg", "geometry", "diagnostics", "urdf-parser-py",
+                 "vision-opencv"):
         parser.add_argument(f"--{repo}", metavar="DIR", type=Path,
                             help=f"checkout of ros/{repo.replace('-', '_')}")
     parser.add_argument("--only", nargs="+", metavar="SUITE",
@@ -310,7 +320,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
     roots = {"ros_comm": args.ros_comm, "genpy": args.genpy, "genmsg": args.genmsg,
              "geometry": args.geometry, "diagnostics": args.diagnostics,
-             "urdf_parser_py": args.urdf_parser_py}
+             "urdf_parser_py": args.urdf_parser_py, "vision_opencv": args.vision_opencv}
     for key, root in roots.items():
         if root is not None and not root.is_dir():
             parser.error(f"--{key.replace('_', '-')} {root}: no such folder")

@@ -9,6 +9,8 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+# the page tests' harness (tests/web/page_support.py) beside the pages' sources
+sys.path.insert(0, str(Path(__file__).resolve().parent / "web"))
 
 #: a ROS package the rostest tests run: its test_*.py are rostest's test nodes, not pytest's
 collect_ignore_glob = ["integration/rostest_pkgs/*"]
@@ -86,12 +88,132 @@ def tf_oracle():
 __all__ = ["PYTHON", "REFERENCE_PYTHON", "Proc", "free_port", "reference_env", "ros_env"]
 
 
+#: the fixtures above that start processes: a test using one is `slow` (below)
+PROCESS_FIXTURES = {"debian_rosmaster", "minros_master", "minros_core", "tf_oracle"}
+#: tests per xdist group: a longer file (parametrized property tests) is cut into groups
+GROUP_SIZE = 200
+
+
 def pytest_collection_modifyitems(config, items) -> None:
     """Every hypothesis test is in the `fuzz` tier (property and fuzz tests, many examples
-    each): `pytest tests/unit -m "not fuzz"` is the quick run, and CI runs every tier."""
+    each): `pytest tests/unit -m "not slow and not fuzz"` is the quick run, and CI runs every
+    tier. A test using a fixture that starts a process is `slow`; every test of tests/unit is
+    `unit` (the other Pythons' runs in scripts/test.sh select `unit or smoke`)."""
     for item in items:
         if getattr(getattr(item, "obj", None), "is_hypothesis_test", False):
             item.add_marker(pytest.mark.fuzz)
+        if PROCESS_FIXTURES.intersection(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.slow)
+        if UNIT in item.path.parents:
+            item.add_marker(pytest.mark.unit)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """--dist loadfile (scripts/test.sh), with files cut: a test file is one unit of work, so
+    that it runs in one worker, in its order, with its module fixtures set up once; a file of
+    more than GROUP_SIZE tests (parametrized property tests) is cut into units of GROUP_SIZE
+    consecutive tests, so that it does not hold one worker while the others are idle.
+    (xdist's own loadgroup cannot do it under pytest 9: its group suffix on the test ids is
+    lost.)"""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class FileUnits(LoadFileScheduling):
+        def __init__(self, config, log) -> None:
+            super().__init__(config, log)
+            self.units: dict = {}
+
+        def _split_scope(self, nodeid: str) -> str:
+            if not self.units and self.collection:
+                counts: dict = {}
+                for test in self.collection:
+                    name = test.split("::", 1)[0]
+                    counts[name] = counts.get(name, 0) + 1
+                seen: dict = {}
+                for test in self.collection:
+                    name = test.split("::", 1)[0]
+                    index = seen[name] = seen.get(name, -1) + 1
+                    self.units[test] = (name if counts[name] <= GROUP_SIZE
+                                        else f"{name}#{index // GROUP_SIZE}")
+            return self.units.get(nodeid) or super()._split_scope(nodeid)
+
+    return FileUnits(config, log)
+
+
+# The quick tier runs in one process: a test of tests/unit that starts one (a node, a master,
+# Debian's Python as an oracle, a command) is marked `slow`. Every way a process starts is
+# patched while such a test sets up, runs and tears down; an attempt fails the test, naming
+# the program, even when the code under test catches the error the attempt raises.
+UNIT = Path(__file__).resolve().parent / "unit"
+
+
+class ProcessStartedError(OSError):
+    """Raised where a quick-tier test starts a process."""
+
+
+class _NoProcesses:
+    def __init__(self) -> None:
+        import multiprocessing.util
+        import subprocess
+
+        self.targets = [(subprocess.Popen, "_execute_child"), (multiprocessing.util, "spawnv_passfds")]
+        self.targets += [(os, name) for name in ("fork", "forkpty", "posix_spawn", "posix_spawnp",
+                                                 "system", "spawnv", "spawnve", "spawnvp", "spawnvpe")
+                         if hasattr(os, name)]
+        self.started: list[str] = []
+        self._saved: list = []
+
+    def _refuse(self, what: str):
+        def refuse(*args, **kwargs):
+            argv = next((a for a in args if isinstance(a, (list, tuple, str, bytes))), "")
+            self.started.append(f"{what}({str(argv)[:200]})")
+            raise ProcessStartedError(f"a quick-tier test started a process: {self.started[-1]}")
+        return refuse
+
+    def __enter__(self) -> _NoProcesses:
+        for owner, name in self.targets:
+            self._saved.append((owner, name, owner.__dict__[name]))
+            setattr(owner, name, self._refuse(name))
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for owner, name, value in self._saved:
+            setattr(owner, name, value)
+        self._saved.clear()
+
+
+def _quick(item) -> bool:
+    return UNIT in item.path.parents and item.get_closest_marker("slow") is None
+
+
+def _guarded(item):
+    if not _quick(item):
+        outcome = yield
+        return
+    with _NoProcesses() as guard:
+        outcome = yield
+    if guard.started:
+        outcome.force_exception(pytest.fail.Exception(
+            f"{item.nodeid} starts a process ({', '.join(guard.started)}): a test of the quick "
+            "tier runs in the pytest process; mark it @pytest.mark.slow (see README.md)",
+            pytrace=False))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_setup(item):
+    yield from _guarded(item)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_call(item):
+    yield from _guarded(item)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_teardown(item):
+    yield from _guarded(item)
 
 
 # scripts/test.sh runs again, alone, a test that failed in the parallel run (MINROS_FAILED_LIST

@@ -116,11 +116,12 @@ class Site:
 class Pair:
     """Sites ``a`` (its bridge listens on a loopback port) and ``b`` (its bridge connects)."""
 
-    def __init__(self, home: Path) -> None:
+    def __init__(self, home: Path, extra_args: Optional[List[str]] = None) -> None:
         self.endpoint = f"tcp/127.0.0.1:{free_port()}"
-        self.a = Site("a", home, ["--listen", self.endpoint])
+        extra = list(extra_args or [])
+        self.a = Site("a", home, ["--listen", self.endpoint, *extra])
         try:
-            self.b = Site("b", home, ["--connect", self.endpoint])
+            self.b = Site("b", home, ["--connect", self.endpoint, *extra])
         except BaseException:
             self.a.close()
             raise

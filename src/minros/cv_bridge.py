@@ -7,6 +7,7 @@ between bit depths, a scaled ``convertTo`` the way cv_bridge's C++ core scales t
 
 from __future__ import annotations
 
+import functools
 import mmap
 import re
 import sys
@@ -17,7 +18,9 @@ import numpy as np
 _DEPTHS = {"8U": np.uint8, "8S": np.int8, "16U": np.uint16, "16S": np.int16,
            "32S": np.int32, "32F": np.float32, "64F": np.float64}
 _DTYPE_TO_DEPTH = {np.dtype(v).name: k for k, v in _DEPTHS.items()}
-# OpenCV's type codes: depth index + (channels - 1) * 8.
+# OpenCV's type codes: depth index + (channels - 1) << CV_CN_SHIFT, the shift the installed
+# OpenCV uses (3 up to OpenCV 4, 5 from OpenCV 5, which has more depths): cv_bridge's codes are
+# the cv2 module's (ROS's tests compare getCvType("32FC4") with cv2.CV_32FC4)
 _DEPTH_CODES = {"8U": 0, "8S": 1, "16U": 2, "16S": 3, "32S": 4, "32F": 5, "64F": 6}
 _CODE_DEPTHS = {v: k for k, v in _DEPTH_CODES.items()}
 
@@ -31,7 +34,10 @@ _NAMED_ENCODINGS: Dict[str, Tuple[str, int]] = {
     "bayer_gbrg16": ("16U", 1), "bayer_grbg16": ("16U", 1),
     "yuv422": ("8U", 2), "yuv422_yuy2": ("8U", 2),
 }
-_GENERIC = re.compile(r"^(8U|8S|16U|16S|32S|32F|64F)C([1-4])$")
+# cv_bridge's generic encodings: a depth with any number of channels (8UC5, 32FC10: OpenCV
+# allows up to 512), or a bare depth, which is one channel (getCvType("8U") == CV_8UC1)
+_GENERIC = re.compile(r"^(8U|8S|16U|16S|32S|32F|64F)(?:C([0-9]+))?$")
+_MAX_CHANNELS = 512  # OpenCV's CV_CN_MAX
 # Colour layout of the named encodings, for cv2.cvtColor.
 _LAYOUT = {"rgb8": "RGB", "rgb16": "RGB", "bgr8": "BGR", "bgr16": "BGR", "rgba8": "RGBA",
            "rgba16": "RGBA", "bgra8": "BGRA", "bgra16": "BGRA", "mono8": "GRAY", "mono16": "GRAY"}
@@ -46,14 +52,28 @@ def _depth_channels(encoding: str) -> Tuple[str, int]:
         return _NAMED_ENCODINGS[encoding]
     match = _GENERIC.match(encoding)
     if match:
-        return match.group(1), int(match.group(2))
+        channels = int(match.group(2) or 1)
+        if not 1 <= channels <= _MAX_CHANNELS:
+            raise CvBridgeError(f"image encoding [{encoding}]: OpenCV images have 1 to "
+                                f"{_MAX_CHANNELS} channels")
+        return match.group(1), channels
     raise CvBridgeError(f"Unrecognized image encoding [{encoding}]")
 
 
+@functools.cache
+def _cn_shift() -> int:
+    """CV_CN_SHIFT of the installed OpenCV (CV_8UC2 is 1 << it); OpenCV 4's without one."""
+    try:
+        import cv2
+    except ImportError:
+        return 3
+    return int(cv2.CV_8UC2).bit_length() - 1
+
+
 def getCvType(encoding: str) -> int:  # noqa: N802 - cv_bridge's name
-    """The OpenCV type code (e.g. CV_8UC3 == 16) of an image encoding."""
+    """The OpenCV type code (cv2.CV_8UC3, ...) of an image encoding."""
     depth, channels = _depth_channels(encoding)
-    return _DEPTH_CODES[depth] + (channels - 1) * 8
+    return _DEPTH_CODES[depth] + ((channels - 1) << _cn_shift())
 
 
 class CvBridge:
@@ -76,10 +96,10 @@ class CvBridge:
             raise CvBridgeError(f"numpy type {np.dtype(dtype).name} has no OpenCV equivalent") from None
 
     def cvtype2_to_dtype_with_channels(self, cvtype: int) -> Tuple[str, int]:
-        depth = _CODE_DEPTHS.get(cvtype & 7)
+        depth = _CODE_DEPTHS.get(CV_MAT_DEPTHWrap(cvtype))
         if depth is None:
             raise CvBridgeError(f"unsupported OpenCV type {cvtype}")
-        return np.dtype(_DEPTHS[depth]).name, (cvtype >> 3) + 1
+        return np.dtype(_DEPTHS[depth]).name, CV_MAT_CNWrap(cvtype)
 
     def encoding_to_cvtype2(self, encoding: str) -> int:
         return getCvType(encoding)
@@ -137,7 +157,7 @@ class CvBridge:
             img_msg.encoding = cv_type
         else:
             img_msg.encoding = encoding
-            if self.cvtype_to_name[self.encoding_to_cvtype2(encoding)] != cv_type:
+            if self.encoding_to_cvtype2(encoding) != getCvType(cv_type):
                 raise CvBridgeError(
                     f"encoding specified as {encoding}, but image has incompatible type {cv_type}")
         if cvim.dtype.byteorder == ">":
@@ -220,12 +240,12 @@ class CvBridgeBoostError(RuntimeError):
 
 def CV_MAT_CNWrap(cvtype: int) -> int:  # noqa: N802 - cv_bridge_boost's name
     """The number of channels of an OpenCV type code."""
-    return ((cvtype >> 3) & 511) + 1
+    return ((cvtype >> _cn_shift()) & 511) + 1
 
 
 def CV_MAT_DEPTHWrap(cvtype: int) -> int:  # noqa: N802 - cv_bridge_boost's name
     """The depth code (0 = 8U ... 6 = 64F) of an OpenCV type code."""
-    return cvtype & 7
+    return cvtype & ((1 << _cn_shift()) - 1)
 
 
 _COLOR = ("rgb8", "bgr8", "rgba8", "bgra8", "rgb16", "bgr16", "rgba16", "bgra16")

@@ -62,3 +62,18 @@ class DeserializationError(MessageException, ROSSerializationException):
 
 class SerializationError(MessageException, ROSSerializationException):
     """A message could not be turned into bytes; the text names the offending field."""
+
+
+# A traceback names an exception by its class's module: name them as ROS does, so a script's
+# uncaught exception reads as under ROS (rospy.exceptions.ROSInterruptException, ...), and
+# pickles point at the stand-ins in stubs/ that re-export them.
+for _module, _classes in (
+        ("rospy.exceptions", (ROSException, ROSSerializationException, ROSInitException,
+                              ROSInterruptException, ROSTimeMovedBackwardsException,
+                              ROSInternalException, TransportException, TransportTerminated,
+                              TransportInitError)),
+        ("rospy.service", (ServiceException,)),
+        ("genpy.message", (MessageException, DeserializationError, SerializationError))):
+    for _cls in _classes:
+        _cls.__module__ = _module
+del _module, _classes, _cls

@@ -9,6 +9,11 @@ so a workspace can override them: message definitions, turtlesim, rospy_tutorial
 ``package.xml`` (with Debian's ROS version) for each ROS package whose Python API, nodes or
 tools minros provides (rospy, roslaunch, rosbag, ...), so ``rosversion``, ``rospack find`` and
 ``roslib.load_manifest`` know them as on a real install.
+
+The packages a first one hides stay known (:func:`package_folders`): an overlay package that
+lacks a message, a service or a whole ``msg/``/``srv/`` folder does not hide its underlay's
+(the message system looks in every folder of a name, in order), as ROS falls back to the
+underlay for the messages an overlay does not have.
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ BUILTIN_SHARE_DIRS: List[Path] = [Path(__file__).resolve().parent / "msgs" / "sh
 
 _NAME_RE = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
 _VERSION_RE = re.compile(rb"<version(?:\s[^>]*)?>\s*([^<\s]+)\s*</version>")
-_cache: Dict[str, Dict[str, Path]] = {}
+_cache: Dict[str, Dict[str, List[Path]]] = {}
 _cache_lock = threading.Lock()
 
 
@@ -55,15 +60,15 @@ def manifest_version(package_dir: Path) -> Optional[str]:
     return match.group(1).decode("utf-8", "replace") if match else None
 
 
-def _walk(root: Path, found: Dict[str, Path]) -> None:
-    """Add every package below ``root`` to ``found`` (first one under a name wins)."""
+def _walk(root: Path, found: Dict[str, List[Path]]) -> None:
+    """Add every package below ``root`` to ``found`` (each name's folders in search order)."""
     try:
         if (root / "package.xml").is_file():
             name = manifest_name(root) or root.name
-            found.setdefault(name, root)
+            found.setdefault(name, []).append(root)
             return
         if (root / "manifest.xml").is_file():  # a rosbuild package: named by its folder
-            found.setdefault(root.name, root)
+            found.setdefault(root.name, []).append(root)
             return
         if (root / "CATKIN_IGNORE").exists():
             return
@@ -80,27 +85,44 @@ def _search_roots() -> List[Path]:
     return ros_package_path() + list(BUILTIN_SHARE_DIRS)
 
 
-def list_packages(refresh: bool = False) -> Dict[str, Path]:
-    """All packages visible now: ``{name: folder}``, ROS_PACKAGE_PATH first, then built-ins."""
+def _all_packages(refresh: bool = False) -> Dict[str, List[Path]]:
     roots = _search_roots()
     key = os.pathsep.join(str(r) for r in roots)
     with _cache_lock:
         if not refresh and key in _cache:
-            return dict(_cache[key])
-    found: Dict[str, Path] = {}
+            return _cache[key]
+    found: Dict[str, List[Path]] = {}
     for root in roots:
         _walk(root, found)
     with _cache_lock:
         _cache[key] = found
-    return dict(found)
+    return found
+
+
+def list_packages(refresh: bool = False) -> Dict[str, Path]:
+    """All packages visible now: ``{name: folder}``, ROS_PACKAGE_PATH first, then built-ins."""
+    return {name: folders[0] for name, folders in _all_packages(refresh).items()}
 
 
 def find_package(name: str) -> Optional[Path]:
     """The folder of package ``name``, or None. Re-scans once on a miss (new packages)."""
-    path = list_packages().get(name)
-    if path is None:
-        path = list_packages(refresh=True).get(name)
-    return path
+    folders = package_folders(name)
+    return folders[0] if folders else None
+
+
+def known_package_folders(name: str) -> List[Path]:
+    """:func:`package_folders` among the packages already discovered (no re-scan on a miss:
+    for the import hook, asked about every module nothing else found)."""
+    return list(_all_packages().get(name) or ())
+
+
+def package_folders(name: str) -> List[Path]:
+    """Every folder of a package named ``name``, in search order (the first is the package;
+    the others are the underlays it hides). Re-scans once on a miss."""
+    folders = _all_packages().get(name)
+    if folders is None:
+        folders = _all_packages(refresh=True).get(name)
+    return list(folders or ())
 
 
 def is_builtin(package_dir: Path) -> bool:

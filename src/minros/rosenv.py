@@ -17,18 +17,68 @@ import socket
 import sys
 from pathlib import Path
 from typing import Iterable, Mapping, Optional, Sequence, Tuple, Union
+from urllib.parse import urlparse
+
+from minros.exceptions import ROSInitException
 
 DEFAULT_MASTER_PORT = 11311
 DEFAULT_MASTER_URI = f"http://localhost:{DEFAULT_MASTER_PORT}/"
 
 
+class MasterURIError(ROSInitException, ValueError):
+    """ROS_MASTER_URI (or ``__master:=``) is not a master's URI; the text names the value and
+    the fix. A ValueError, as rosgraph raises for it, and init_node's ROSInitException."""
+
+
+def _master_uri_problem(uri: str) -> Optional[str]:
+    """What is wrong with ``uri`` as a master's URI (rosgraph's test: a scheme and a host, and
+    the scheme one XML-RPC speaks), or None."""
+    try:
+        parsed = urlparse(uri)
+        parsed.port  # noqa: B018 - ValueError when the port is not a number in range
+    except ValueError:
+        return "its port is not a number from 0 to 65535"
+    if "://" not in uri:
+        return "it lacks the scheme http://"
+    if parsed.scheme not in ("http", "https"):
+        return f"its scheme is '{parsed.scheme}', where the master speaks http"
+    if not parsed.hostname:
+        return "it names no host"
+    return None
+
+
+def check_master_uri(uri: str, source: str = "ROS_MASTER_URI") -> str:
+    """``uri`` if it is a master's URI, else MasterURIError naming ``source`` (the variable or
+    the ``__master:=`` argument it came from) and the fix."""
+    problem = _master_uri_problem(uri)
+    if problem is None:
+        return uri
+    fix = None
+    if "://" not in uri:
+        fix = "http://" + uri
+    elif urlparse(uri).scheme not in ("http", "https"):
+        fix = "http://" + uri.split("://", 1)[1]
+    if fix is None or _master_uri_problem(fix) is not None:
+        fix = f"http://HOST:PORT, as {DEFAULT_MASTER_URI.rstrip('/')}"
+    if source == "__master":
+        raise MasterURIError(f"__master:={uri} is not a master URI ({problem}): use "
+                             f"__master:={fix}")
+    raise MasterURIError(f"{source} is '{uri}', which is not a master URI ({problem}): "
+                         f"set {source}={fix}")
+
+
 def get_master_uri(env: Optional[Mapping[str, str]] = None,
-                   remapped: Optional[str] = None) -> str:
-    """The master's URI: a ``__master:=`` value (``remapped``), else ROS_MASTER_URI, else default."""
+                   remapped: Optional[str] = None, check: bool = True) -> str:
+    """The master's URI: a ``__master:=`` value (``remapped``), else ROS_MASTER_URI, else default.
+
+    Every reader of the master URI comes here: one that is not a URI (``localhost:11311``) is
+    MasterURIError naming it and the fix, unless ``check`` is False (roswtf reports it itself).
+    """
     if remapped:
-        return remapped
+        return check_master_uri(remapped, "__master") if check else remapped
     env = os.environ if env is None else env
-    return env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+    uri = env.get("ROS_MASTER_URI") or DEFAULT_MASTER_URI
+    return check_master_uri(uri) if check else uri
 
 
 def remapped_master(argv: Iterable[str]) -> Optional[str]:

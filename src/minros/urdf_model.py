@@ -75,12 +75,17 @@ def _float(element: ET.Element, attr: str, where: str) -> Optional[float]:
         raise URDFError(f"{where}: {attr}='{text}' is not a number") from None
 
 
-def parse_joints(description: str) -> List[Joint]:
-    """The joints of a URDF ``<robot>``, in document order."""
+def parse_joints(description: str, robot_anywhere: bool = False) -> List[Joint]:
+    """The joints of a URDF ``<robot>``, in document order. The root must be the ``<robot>``
+    (urdfdom's rule, robot_state_publisher's), or with ``robot_anywhere`` the first ``<robot>``
+    in the document is taken, as joint_state_publisher's ``getElementsByTagName('robot')[0]``
+    does (a ``<urdf>`` root holding a ``<robot>``)."""
     try:
         root = ET.fromstring(description)
     except ET.ParseError as exc:
         raise URDFError(f"the robot description is not XML: {exc}") from None
+    if root.tag != "robot" and robot_anywhere:
+        root = next(root.iter("robot"), root)
     if root.tag != "robot":
         raise URDFError(f"the robot description's root element is <{root.tag}>, not <robot>")
     joints = []

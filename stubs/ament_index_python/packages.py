@@ -10,12 +10,18 @@ __all__ = ["PackageNotFoundError", "get_package_share_directory", "get_package_p
 class PackageNotFoundError(KeyError):
     """No package of that name on ROS_PACKAGE_PATH nor among minros's own."""
 
+    def __init__(self, message: str, package_name: str | None = None) -> None:
+        super().__init__(message)
+        #: the package looked for (minros's xacro says "resource not found" with it)
+        self.package_name = package_name
+
 
 def get_package_share_directory(package_name: str, print_warning: bool = True) -> str:
     found = packages.find_package(package_name)
     if found is None:
         raise PackageNotFoundError(
-            f"package '{package_name}' not found: is its folder on ROS_PACKAGE_PATH?")
+            f"package '{package_name}' not found: is its folder on ROS_PACKAGE_PATH?",
+            package_name)
     return str(found)
 
 

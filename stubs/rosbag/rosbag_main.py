@@ -11,11 +11,10 @@ from minros.bag import (  # noqa: F401
     ROSBagUnindexedException,
 )
 from minros.bag.migration import MessageMigrator, checkbag, fixbag2  # noqa: F401
+from minros.bag.ops import bag_op, change_compression_op, reindex_op  # noqa: F401
 from minros.bag.progress import ProgressMeter  # noqa: F401
 from minros.cli.bag import (  # noqa: F401
     RosbagCmds,
-    bag_op,
-    change_compression_op,
     check_cmd,
     compress_cmd,
     decompress_cmd,
@@ -31,6 +30,5 @@ from minros.cli.bag import (  # noqa: F401
     print_trans,
     record_cmd,
     reindex_cmd,
-    reindex_op,
     rosbagmain,
 )

@@ -1,3 +1,3 @@
 """rosmaster.exceptions."""
 
-from minros.master import InternalException  # noqa: F401
+from minros.master.registrations import InternalException  # noqa: F401

@@ -1,4 +1,4 @@
-"""rosmaster.main: the rosmaster command (minros.master.main)."""
+"""rosmaster.main: the rosmaster command (minros.master.server.main)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import os
 import sys
 from typing import IO, Mapping, Sequence
 
-from minros import master as _master
+from minros.master import server as _master
 
 
 def rosmaster_main(argv: Sequence[str] = sys.argv, stdout: IO[str] = sys.stdout,

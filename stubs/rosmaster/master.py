@@ -1,10 +1,10 @@
-"""rosmaster.master: a running master (minros.master.Master)."""
+"""rosmaster.master: a running master (minros.master.server.Master)."""
 
 from __future__ import annotations
 
 from typing import Optional
 
-from minros import master as _master
+from minros.master import server as _master
 
 from .master_api import NUM_WORKERS
 

@@ -1,10 +1,11 @@
-"""rosmaster.master_api: the Master and Parameter Server XML-RPC API (minros.master)."""
+"""rosmaster.master_api: the Master and Parameter Server XML-RPC API (minros.master.handler)."""
 
 from __future__ import annotations
 
 import logging
 
-from minros.master import CallbackPool, MasterHandler
+from minros.master.callbacks import CallbackPool
+from minros.master.handler import MasterHandler
 from minros.wire.rosapi import api as apivalidate  # noqa: F401 - rosmaster's decorator name
 
 NUM_WORKERS = 3  # rosmaster's default number of threads calling nodes back

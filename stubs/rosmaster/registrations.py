@@ -1,12 +1,12 @@
 """rosmaster.registrations: publishers, subscribers, services, parameter subscriptions and
-the node table (minros.master)."""
+the node table (minros.master.registrations)."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from minros import master as _master
-from minros.master import NodeRef, Registrations  # noqa: F401
+from minros.master import registrations as _registrations
+from minros.master.registrations import NodeRef, Registrations  # noqa: F401
 
 
 def shutdown_node_task(api: str, caller_id: str, reason: str) -> None:
@@ -19,7 +19,7 @@ def shutdown_node_task(api: str, caller_id: str, reason: str) -> None:
         pass
 
 
-class RegistrationManager(_master.RegistrationManager):
+class RegistrationManager(_registrations.RegistrationManager):
     """rosmaster's constructor: a node that registers again from a new URI has its old process
     told to shut down through ``thread_pool.queue_task(api, task, args)``."""
 

@@ -1,6 +1,6 @@
-"""Stand-in for rostopic's Python API (minros.cli.topic: the code the command runs)."""
+"""Stand-in for rostopic's Python API (minros.cli.topic_api: the code the command runs)."""
 
-from minros.cli.topic import (  # noqa: F401
+from minros.cli.topic_api import (  # noqa: F401
     NAME,
     SUBSCRIBER_TIMEOUT,
     CallbackEcho,
@@ -28,10 +28,10 @@ from minros.cli.topic import (  # noqa: F401
     stdin_yaml_arg,
     wait_for_subscriber,
 )
-from minros.cli.topic import check_master_api as _check_master  # noqa: F401
-from minros.cli.topic import get_nested_attribute as _get_nested_attribute  # noqa: F401
-from minros.cli.topic import get_topic_list_api as get_topic_list  # noqa: F401
-from minros.cli.topic import get_topic_type_now as _get_topic_type  # noqa: F401
-from minros.cli.topic import master_get_topic_types_api as _master_get_topic_types  # noqa: F401
-from minros.cli.topic import str_plot as _str_plot  # noqa: F401
-from minros.cli.topic import str_plot_fields as _str_plot_fields  # noqa: F401
+from minros.cli.topic_api import check_master_api as _check_master  # noqa: F401
+from minros.cli.topic_api import get_nested_attribute as _get_nested_attribute  # noqa: F401
+from minros.cli.topic_api import get_topic_list_api as get_topic_list  # noqa: F401
+from minros.cli.topic_api import get_topic_type_now as _get_topic_type  # noqa: F401
+from minros.cli.topic_api import master_get_topic_types_api as _master_get_topic_types  # noqa: F401
+from minros.cli.topic_api import str_plot as _str_plot  # noqa: F401
+from minros.cli.topic_api import str_plot_fields as _str_plot_fields  # noqa: F401

@@ -29,6 +29,7 @@ def run_client(env, *args: str, timeout: float = 30) -> subprocess.CompletedProc
                           timeout=timeout)
 
 
+@pytest.mark.smoke
 def test_client_prints_sum_and_server_prints_returning(server):
     proc, env = server
     done = run_client(env, "4", "5")

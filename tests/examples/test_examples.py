@@ -7,6 +7,8 @@ from __future__ import annotations
 import re
 import subprocess
 
+import pytest
+
 from support import EXAMPLES, PYTHON, Proc, ros_env
 
 README = (EXAMPLES / "README.md").read_text()
@@ -107,6 +109,7 @@ def test_a_node_prints_its_own_trace(minros_core, ros_home):
     assert '= {"data": "to myself 2"}' in out, out
 
 
+@pytest.mark.smoke
 def test_webcam_publisher_with_the_fake_camera(minros_core, ros_home):
     env = ros_env(minros_core, ros_home)
     sub = Proc([PYTHON, str(EXAMPLES / "video/video_sub.py")], env)

@@ -12,6 +12,7 @@ SEED_DIR = EXAMPLES / "pubsub"
 LOG_LINE = r"\[INFO\] \[\d+\.\d+\]: "
 
 
+@pytest.mark.smoke
 @pytest.mark.parametrize("publisher, subscriber, pub_text, sub_name", [
     # seed 001: "hello world <rospy.get_time()>"
     ("publisher.py", "subscriber.py", r"hello world \d+\.\d+", "subscriber"),

@@ -10,6 +10,8 @@ import subprocess
 import time
 from pathlib import Path
 
+import pytest
+
 from integration.pubsub_scripts import TALKER
 from support import PYTHON, Proc, ros_env
 
@@ -133,6 +135,7 @@ def test_play_pause_and_step_keys(minros_core, ros_home, tmp_path):
     assert times[1] - times[0] > 0.5  # the step came alone, the rest after the space
 
 
+@pytest.mark.smoke
 def test_record_regex_exclude_and_drops(minros_core, ros_home, tmp_path):
     script = tmp_path / "talker.py"
     script.write_text(TALKER)
@@ -176,3 +179,47 @@ def test_record_buffer_overflow_counts_drops_per_topic(minros_core, ros_home, tm
 
     with Bag(str(tmp_path / "small.bag")) as bag:
         assert bag.get_message_count() + int(m.group(1)) <= 40
+
+
+def _span(path: Path) -> tuple:
+    """(message count, receive times' span in seconds) of a bag."""
+    from minros.bag import Bag
+
+    with Bag(str(path)) as bag:
+        times = [t.to_sec() for _topic, _msg, t in bag.read_messages()]
+    return len(times), (times[-1] - times[0]) if times else 0.0
+
+
+def test_record_duration_ends_the_recording(minros_core, ros_home, tmp_path):
+    """rosbag record --duration 2: the recorder stops by itself, with 2 s of messages."""
+    script = tmp_path / "talker.py"
+    script.write_text(TALKER)
+    env = ros_env(minros_core, ros_home)
+    talker = Proc([PYTHON, str(script), "/chatter", "string", "100000", "20", "0"], env)
+    try:
+        began = time.monotonic()
+        rec = subprocess.run([PYTHON, "-m", "minros", "bag", "record", "--duration", "2", "-O",
+                              "short", "/chatter"], env=env, cwd=tmp_path, capture_output=True,
+                             text=True, timeout=30)
+        took = time.monotonic() - began
+    finally:
+        talker.stop()
+    assert rec.returncode == 0 and "Traceback" not in rec.stderr, rec.stdout + rec.stderr
+    assert took >= 2.0
+    count, span = _span(tmp_path / "short.bag")
+    assert 20 <= count <= 41 and span <= 2.0, (count, span)  # 20 Hz for at most 2 s
+
+
+def test_record_duration_ends_an_idle_recording(minros_core, ros_home, tmp_path):
+    """Nothing published: the recording still ends after --duration (0.02m: 1.2 s), leaving
+    the empty bag it opened at the start, as ROS's recorder does; a bad unit is one line."""
+    env = ros_env(minros_core, ros_home)
+    rec = subprocess.run([PYTHON, "-m", "minros", "bag", "record", "--duration", "0.02m", "-O",
+                          "idle", "/nothing"], env=env, cwd=tmp_path, capture_output=True,
+                         text=True, timeout=30)
+    assert rec.returncode == 0 and "Traceback" not in rec.stderr, rec.stdout + rec.stderr
+    assert _span(tmp_path / "idle.bag") == (0, 0.0)
+    bad = subprocess.run([PYTHON, "-m", "minros", "bag", "record", "--duration", "3d", "/x"],
+                         env=env, cwd=tmp_path, capture_output=True, text=True, timeout=30)
+    assert bad.returncode == 1 and bad.stderr.startswith("Error reading options: Duration '3d'")
+    assert "Traceback" not in bad.stderr and bad.stderr.count("\n") == 1, bad.stderr

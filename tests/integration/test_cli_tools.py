@@ -124,6 +124,7 @@ def test_hz_bw_on_type_not_installed(graph: dict) -> None:
     assert "average: " in text and "B/s" in text
 
 
+@pytest.mark.smoke
 def test_pub_modes_and_echo(graph: dict, tmp_path: Path) -> None:
     echo = Proc([str(BIN / "rostopic"), "echo", "-n", "3", "/counts"], graph)
     pub = Proc([str(BIN / "rostopic"), "pub", "-r", "50", "/counts", "std_msgs/Int32", "{data: 5}"], graph)

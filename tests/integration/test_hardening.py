@@ -19,6 +19,8 @@ import time
 import xmlrpc.client
 from pathlib import Path
 
+import pytest
+
 from support import PYTHON, Proc, free_port, ros_env, wait_for_master, wait_until
 
 HUGE_BODY = b"POST / HTTP/1.1\r\nContent-Type: text/xml\r\nContent-Length: 67108864\r\n\r\n<?xml"
@@ -77,6 +79,7 @@ class Trickler:
             s.close()
 
 
+@pytest.mark.smoke
 def test_announced_huge_bodies_do_not_stall_the_master(minros_master):
     """Defect 1: four requests announcing 64 MiB, then a byte a second: every other call to
     the master waited (0 of 3 getSystemState answered in 5 s; rosmaster 12 of 12)."""

@@ -79,3 +79,27 @@ def test_an_unknown_argument_is_refused():
 def test_the_full_desktop_python_surface_is_part_of_the_reference(package):
     apt_machine()
     assert package in print_packages()
+
+
+def test_sources_needs_a_folder():
+    out = subprocess.run([BASH, str(SCRIPT), "--sources"], capture_output=True, text=True,
+                         timeout=60)
+    assert out.returncode == 2 and "usage:" in out.stderr and "--sources DIR" in out.stderr
+
+
+def test_sources_fetches_ros_comm_without_touching_the_machines_apt(tmp_path):
+    """What scripts/rostest_suites.py runs: Debian's ros-ros-comm source package, fetched
+    through a deb-src list of the script's own; the machine's apt lists stay as they were."""
+    apt_machine()
+    before = {p: p.read_bytes() for p in Path("/etc/apt").rglob("*") if p.is_file()}
+    out = subprocess.run([BASH, str(SCRIPT), "--sources", str(tmp_path), "ros-ros-comm"],
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stdout + out.stderr
+    tree = tmp_path / "ros_comm-1.15.15"
+    assert (tree / "test" / "test_rospy" / "test" / "rostest" / "rosout.test").is_file()
+    assert (tree / "tools" / "topic_tools" / "test" / "relay_stealth.test").is_file()
+    after = {p: p.read_bytes() for p in Path("/etc/apt").rglob("*") if p.is_file()}
+    assert after == before
+    again = subprocess.run([BASH, str(SCRIPT), "--sources", str(tmp_path)], capture_output=True,
+                           text=True, timeout=120)
+    assert again.returncode == 0 and "Fetched" not in again.stderr  # nothing fetched again

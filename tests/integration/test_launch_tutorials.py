@@ -46,6 +46,7 @@ def test_turtlemimic_launch_wires_the_mimic_between_two_turtlesims(tmp_path):
         assert f"[{name}] killing on exit" in out
 
 
+@pytest.mark.smoke
 def test_multisim_launch_starts_two_turtlesims(tmp_path):
     port = free_port()
     env = ros_env(port, tmp_path / "home", {"MINROS_HEADLESS": "1"})

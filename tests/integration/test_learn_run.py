@@ -426,6 +426,7 @@ def test_without_eclipse_zenoh_the_zenoh_variant_is_refused_in_one_line(tmp_path
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.smoke
 def test_a_process_that_fails_to_start_is_named_and_the_others_are_stopped(tmp_path):
     from minros.learn.model import Exercise, Process
     from minros.learn.session import LearnError, Runner

@@ -6,6 +6,8 @@ import json
 import re
 from pathlib import Path
 
+import pytest
+
 from support import PYTHON, Proc, ros_env
 
 TALKER = r'''
@@ -44,6 +46,7 @@ rospy.spin()
 '''
 
 
+@pytest.mark.smoke
 def test_rosout_messages_reach_a_subscriber(minros_master: int, ros_home: Path, tmp_path: Path):
     env = ros_env(minros_master, ros_home)
     talker_py, watcher_py = tmp_path / "talker.py", tmp_path / "watcher.py"

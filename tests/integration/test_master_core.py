@@ -137,6 +137,7 @@ def test_core_refuses_to_start_beside_a_running_master(minros_master, ros_home):
     assert "already running" in done.stderr and len(done.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.smoke
 def test_shutdown_api_stops_the_master(ros_home):
     port = free_port()
     proc = Proc([PYTHON, "-m", "minros.master", "-p", str(port)], ros_env(port, ros_home))

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from support import PYTHON, Proc, ros_env
 
 ACTIONS = r'''
@@ -135,6 +137,7 @@ def _run(tmp_path: Path, port: int, home: Path, name: str, text: str, last: str)
         proc.stop()
 
 
+@pytest.mark.smoke
 def test_many_quick_goals_and_status_list_timeout(tmp_path: Path, minros_core: int, ros_home: Path):
     out = _run(tmp_path, minros_core, ros_home, "actions", ACTIONS, "polled")
     lines = [line for line in out.splitlines() if not line.startswith("[")]
@@ -142,6 +145,7 @@ def test_many_quick_goals_and_status_list_timeout(tmp_path: Path, minros_core: i
                      "polled ('SUCCEEDED', 40) PREEMPTED -5 stopped [True]"], out
 
 
+@pytest.mark.smoke
 def test_synchronizers_on_subscriber_filters(tmp_path: Path, minros_core: int, ros_home: Path):
     out = _run(tmp_path, minros_core, ros_home, "filters", FILTERS, "topic")
     lines = [line for line in out.splitlines() if not line.startswith("[")]

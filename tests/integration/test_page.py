@@ -17,42 +17,23 @@ import json
 import os
 import shutil
 import time
-import xmlrpc.client
-from pathlib import Path
 
+import page_support
 import pytest
+from page_support import Page, browser_fixture, shots_fixture, system_fixture
 
-from support import (
-    CHROMIUM,
-    PYTHON,
-    REPO,
-    Proc,
-    free_port,
-    launch_chromium,
-    need,
-    ros_env,
-    wait_for_master,
-    wait_until,
-)
+from support import PYTHON, REPO, free_port, wait_until
 
 WEB = REPO / "tests" / "web"
 TUTORIALS = REPO / "tests" / "examples" / "library_tutorials"
 SOAK_SECONDS = float(os.environ.get("MINROS_PAGE_SOAK", "20"))
 
-try:
-    from playwright import sync_api as playwright_api
-except ImportError:
-    playwright_api = None
 
-
-class System:
+class System(page_support.System):
     """The ROS side every test of this module looks at."""
 
-    def __init__(self, tmp: Path) -> None:
-        self.tmp = tmp
-        self.home = tmp / "ros_home"
-        (self.home / "log").mkdir(parents=True)
-        workspace = tmp / "ws" / "dynamic_tutorials"
+    def up(self) -> None:
+        workspace = self.tmp / "ws" / "dynamic_tutorials"
         workspace.mkdir(parents=True)
         shutil.copytree(TUTORIALS / "dynamic_tutorials" / "cfg", workspace / "cfg")
         (workspace / "package.xml").write_text(
@@ -60,106 +41,26 @@ class System:
             "<version>0.0.0</version><description>page test</description>"
             '<maintainer email="test@example.com">test</maintainer><license>BSD</license>'
             "<buildtool_depend>catkin</buildtool_depend></package>")
-        self.port = free_port()
-        self.procs = []
-        self.start([PYTHON, "-m", "minros", "core", "-p", str(self.port)])
-        wait_for_master(self.port)
+        self.start_core()
         self.start([PYTHON, "-m", "minros", "run", "turtlesim", "turtlesim_node"],
                    {"MINROS_HEADLESS": "1"}).read_until("Spawning turtle [turtle1]", timeout=30)
         self.start([PYTHON, "-m", "minros", "run", "rospy_tutorials", "talker"])
         self.start([PYTHON, "-m", "minros", "run", "rospy_tutorials", "listener"])
         self.start([PYTHON, str(TUTORIALS / "dynamic_tutorials" / "nodes" / "server.py")],
-                   {"ROS_PACKAGE_PATH": str(tmp / "ws")}).read_until("Reconfigure Request", timeout=30)
+                   {"ROS_PACKAGE_PATH": str(self.tmp / "ws")}).read_until("Reconfigure Request", timeout=30)
         self.start([PYTHON, str(WEB / "page_sources.py"), "--image", "10", "--imshow", "--logs"]
                    ).read_until("READY", timeout=30)
-        self.web_port = free_port()
-        self.web = self.start([PYTHON, "-m", "minros", "web", "--port", str(self.web_port)])
-        self.web.read_until("listening on", timeout=30)
-        self.master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{self.port}/")
-
-    def env(self, extra: dict | None = None) -> dict:
-        return ros_env(self.port, self.home, extra)
-
-    def start(self, argv: list, extra: dict | None = None) -> Proc:
-        proc = Proc(argv, self.env(extra))
-        self.procs.append(proc)
-        return proc
-
-    @property
-    def url(self) -> str:
-        return f"http://127.0.0.1:{self.web_port}/"
+        self.start_web()
 
     def param(self, name: str):
         code, msg, value = self.master.getParam("/page_test", name)
         assert code == 1, msg
         return value
 
-    def stop(self) -> str:
-        return "".join(proc.stop() for proc in reversed(self.procs))
 
-
-@pytest.fixture(scope="module")
-def system(tmp_path_factory):
-    need(playwright_api is not None, "playwright is needed for the page tests (the test extra)")
-    need(Path(CHROMIUM).exists(), "Debian's chromium is needed for the page tests")
-    sys_ = System(tmp_path_factory.mktemp("page"))
-    try:
-        yield sys_
-    finally:
-        out = sys_.stop()
-        assert "Traceback" not in out, out[-4000:]
-
-
-@pytest.fixture(scope="module")
-def browser(system):
-    with playwright_api.sync_playwright() as p:
-        browser = launch_chromium(p, "--enable-precise-memory-info")
-        try:
-            yield browser
-        finally:
-            browser.close()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory) -> Path:
-    folder = Path(os.environ.get("MINROS_SCREENSHOTS") or tmp_path_factory.mktemp("screenshots"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
-
-
-class Page:
-    """One tab on the page, with its console errors collected."""
-
-    def __init__(self, browser, system: System, shots: Path, width: int = 1280, height: int = 800) -> None:
-        self.context = browser.new_context(viewport={"width": width, "height": height})
-        self.page = self.context.new_page()
-        self.errors: list = []
-        self.page.on("pageerror", lambda exc: self.errors.append(str(exc)))
-        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
-        self.system = system
-        self.shots = shots
-
-    def open(self, hash_: str) -> None:
-        self.page.goto(self.system.url + "#" + hash_)
-        self.page.wait_for_function("window.minrosPage && minrosPage.conn.state === 'connected' "
-                                    "&& minrosPage.graph.version > 0", timeout=20_000)
-
-    def view(self, name: str):
-        return self.page.locator(f'.view[data-view="{name}"]')
-
-    def shot(self, name: str) -> Path:
-        self.page.evaluate("document.querySelectorAll('.view').forEach((v) => { v.scrollTop = 0; })")
-        path = self.shots / f"{name}.png"
-        self.page.screenshot(path=str(path))
-        assert path.stat().st_size > 10_000
-        return path
-
-    def js(self, expression: str):
-        return self.page.evaluate(expression)
-
-    def close(self) -> None:
-        self.context.close()
-        assert not self.errors, self.errors
+system = system_fixture(System, "page")
+browser = browser_fixture("--enable-precise-memory-info")
+shots = shots_fixture()
 
 
 @pytest.fixture
@@ -173,6 +74,7 @@ def page(browser, system, shots):
 
 # -- graph -------------------------------------------------------------------------------------
 
+@pytest.mark.smoke
 def test_graph_shows_the_running_nodes_and_their_info(page):
     page.open("graph")
     graph = page.view("graph")
@@ -431,6 +333,44 @@ def test_parameter_edit_reaches_the_parameter_server(page, system):
 
 
 # -- console -------------------------------------------------------------------------------------
+
+def test_a_urdf_parameter_reads_as_text_folded_under_its_first_line(page, system):
+    """A long multi-line string (a URDF, as /robot_description holds) used to be one line of
+    escaped "\\n"s; now it is folded under its first line and its size, opens as preformatted
+    text, stays open while the tree is redrawn, and is edited in a text box."""
+    urdf = (WEB / "scene_pkg" / "urdf" / "robot.urdf").read_text()
+    name = "/page_test/robot_description"
+    assert system.master.setParam("/t", name, urdf)[0] == 1
+    page.open("params")
+    view = page.view("params")
+    view.locator("summary", has_text="page_test/").click()  # a new tab: the tree is folded
+    row = view.locator(f'[data-param="{name}"]')
+    text = row.locator("details.param-text")
+    text.wait_for(timeout=10_000)
+    lines = urdf.count("\n") + (0 if urdf.endswith("\n") else 1)
+    summary = text.locator("summary").inner_text()
+    assert summary.startswith('<?xml version="1.0"?>') and f"{lines} lines" in summary, summary
+    pre = text.locator("pre")
+    assert not pre.is_visible()  # folded: the tree stays readable
+    text.locator("summary").click()
+    assert pre.is_visible() and pre.text_content() == urdf
+    # a string that is one line and its newline ("noetic\\n", as ROS sets it) stays a line
+    distro = view.locator('[data-param="/rosdistro"]')
+    assert distro.locator(".param-yaml").inner_text() == '"noetic\\n"'
+    page.shot("params_urdf")
+    # a change elsewhere redraws the tree: the text stays open
+    assert system.master.setParam("/t", "/page_test/redraw", 1)[0] == 1
+    view.locator('[data-param="/page_test/redraw"]').wait_for(timeout=10_000)
+    assert row.locator("details.param-text pre").is_visible()
+    row.locator("button", has_text="Edit").click()
+    area = row.locator("textarea.param-edit-text")
+    assert area.input_value() == urdf
+    edited = urdf.replace('<robot name="scene_bot">', '<robot name="renamed_bot">')
+    area.fill(edited)
+    row.locator("button", has_text="Save").click()
+    wait_until(lambda: system.param(name) == edited, timeout=10, what="the edited URDF")
+    row.locator("details.param-text pre", has_text="renamed_bot").wait_for(timeout=10_000)
+
 
 def test_console_filters_by_level_and_regex(page):
     page.open("console")

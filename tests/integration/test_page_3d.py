@@ -25,115 +25,46 @@ import time
 import xmlrpc.client
 from pathlib import Path
 
+import page_support
 import pytest
+from page_support import browser_fixture, playwright_api, shots_fixture, system_fixture
 
-from support import (
-    CHROMIUM,
-    PYTHON,
-    REFERENCE_PYTHON,
-    Proc,
-    free_port,
-    launch_chromium,
-    need,
-    reference_env,
-    require_reference,
-    ros_env,
-    wait_for_master,
-)
+from support import PYTHON, REFERENCE_PYTHON, require_reference
 
 WEB = Path(__file__).resolve().parent.parent / "web"
 PERF_SECONDS = float(os.environ.get("MINROS_3D_SECONDS", "20"))
 PERF_MAX_POINTS = os.environ.get("MINROS_3D_MAX_POINTS")
 V = "minrosPage.view('3d')"
 
-try:
-    from playwright import sync_api as playwright_api
-except ImportError:
-    playwright_api = None
 
+class System(page_support.System):
+    """minros core, what Rviz would show (scene_sources.py --all), and minros web."""
 
-class System:
     def __init__(self, tmp: Path) -> None:
-        self.home = tmp / "ros_home"
-        (self.home / "log").mkdir(parents=True)
-        self.port = free_port()
-        self.procs = []
-        self.start([PYTHON, "-m", "minros", "core", "-p", str(self.port)])
-        try:
-            wait_for_master(self.port)
-            self.sources = self.start([PYTHON, str(WEB / "scene_sources.py"), "--all"])
-            self.sources.read_until("READY", timeout=30)
-            self.web_port = free_port()
-            self.web = self.start([PYTHON, "-m", "minros", "web", "--port", str(self.web_port)])
-            self.web.read_until("listening on", timeout=30)
-        except BaseException:
-            self.stop()  # no fixture stops what never came up
-            raise
+        super().__init__(tmp, {"ROS_PACKAGE_PATH": str(WEB)})
 
-    def env(self) -> dict:
-        return ros_env(self.port, self.home, {"ROS_PACKAGE_PATH": str(WEB)})
-
-    def start(self, argv: list, reference: bool = False) -> Proc:
-        proc = Proc(argv, reference_env(self.env()) if reference else self.env())
-        self.procs.append(proc)
-        return proc
-
-    def stop(self) -> str:
-        return "".join(proc.stop() for proc in reversed(self.procs))
+    def up(self) -> None:
+        self.start_core()
+        self.sources = self.start([PYTHON, str(WEB / "scene_sources.py"), "--all"])
+        self.sources.read_until("READY", timeout=30)
+        self.start_web()
 
 
-@pytest.fixture(scope="module")
-def system(tmp_path_factory):
-    need(playwright_api is not None, "playwright is needed for the page tests (the test extra)")
-    need(Path(CHROMIUM).exists(), "Debian's chromium is needed for the page tests")
-    sys_ = System(tmp_path_factory.mktemp("page3d"))
-    try:
-        yield sys_
-    finally:
-        out = sys_.stop()
-        assert "Traceback" not in out, out[-4000:]
+system = system_fixture(System, "page3d")
+# software WebGL (SwiftShader) on a machine without a GPU
+browser = browser_fixture("--use-angle=swiftshader", "--enable-unsafe-swiftshader")
+shots = shots_fixture()
 
 
-@pytest.fixture(scope="module")
-def browser(system):
-    with playwright_api.sync_playwright() as p:
-        # software WebGL (SwiftShader) on a machine without a GPU
-        browser = launch_chromium(p, "--use-angle=swiftshader", "--enable-unsafe-swiftshader")
-        try:
-            yield browser
-        finally:
-            browser.close()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory) -> Path:
-    folder = Path(os.environ.get("MINROS_SCREENSHOTS") or tmp_path_factory.mktemp("screenshots"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
-
-
-class Page:
+class Page(page_support.Page):
     """One tab on the 3D view, its console errors collected."""
 
-    def __init__(self, browser, system: System, shots: Path) -> None:
-        self.context = browser.new_context(viewport={"width": 1280, "height": 800})
-        self.page = self.context.new_page()
-        self.errors: list = []
-        self.page.on("pageerror", lambda exc: self.errors.append(str(exc)))
-        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
-        self.system = system
-        self.shots = shots
+    MIN_SHOT_BYTES = 20_000
 
     def open(self) -> None:
         self.page.goto(f"http://127.0.0.1:{self.system.web_port}/#3d")
         self.page.wait_for_function("window.minrosPage && minrosPage.conn.state === 'connected' "
                                     f"&& {V}.ready && {V}.scene3d.frames.size > 5", timeout=30_000)
-
-    def js(self, expression: str, arg=None):
-        return self.page.evaluate(expression, arg)
-
-    def wait(self, expression: str, timeout: float = 20_000) -> None:
-        self.page.wait_for_function(expression, timeout=timeout)
 
     def displays(self) -> dict:
         return {d["source"] or d["kind"]: d for d in self.js(f"{V}.summary()")}
@@ -173,16 +104,6 @@ class Page:
         mouse.down()
         mouse.move(*end, steps=steps)
         mouse.up()
-
-    def shot(self, name: str) -> Path:
-        path = self.shots / f"{name}.png"
-        self.page.screenshot(path=str(path))
-        assert path.stat().st_size > 20_000
-        return path
-
-    def close(self) -> None:
-        self.context.close()
-        assert not self.errors, self.errors
 
 
 @pytest.fixture

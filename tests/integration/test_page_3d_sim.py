@@ -9,22 +9,20 @@ Screenshots as in test_page_3d.py (``MINROS_SCREENSHOTS``).
 from __future__ import annotations
 
 import math
-import os
 import time
 import urllib.request
-from pathlib import Path
 
 import pytest
-from test_page_3d import Page, V, playwright_api
+from page_support import playwright_api, require_browser, shots_fixture
+from test_page_3d import Page, V
 
 from sim_support import READY, Sim
-from support import CHROMIUM, free_port, launch_chromium, need, wait_until
+from support import free_port, launch_chromium, wait_until
 
 
 @pytest.fixture(scope="module")
 def sim(tmp_path_factory):
-    need(playwright_api is not None, "playwright is needed for the page tests (the test extra)")
-    need(Path(CHROMIUM).exists(), "Debian's chromium is needed for the page tests")
+    require_browser()
     home = tmp_path_factory.mktemp("sim3d")
     (home / "log").mkdir()
     web_port = free_port()
@@ -50,11 +48,7 @@ def yaw_of(pose: list) -> float:
     return math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
 
 
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory) -> Path:
-    folder = Path(os.environ.get("MINROS_SCREENSHOTS") or tmp_path_factory.mktemp("screenshots"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
+shots = shots_fixture()
 
 
 def test_a_nav_goal_clicked_in_the_3d_view_drives_the_simulated_robot(sim, shots):

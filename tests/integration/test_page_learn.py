@@ -15,22 +15,12 @@ import os
 import subprocess
 from pathlib import Path
 
-import pytest
-from test_page import Page, playwright_api
+import page_support
+from page_support import Page, browser_fixture, shots_fixture, system_fixture
 
 from minros import learn
 from minros.web.learning import OWNER_GRACE
-from support import (
-    CHROMIUM,
-    PYTHON,
-    Proc,
-    free_port,
-    launch_chromium,
-    need,
-    ros_env,
-    wait_for_master,
-    wait_until,
-)
+from support import PYTHON, wait_until
 from zenoh_support import require_zenoh
 
 
@@ -57,64 +47,31 @@ def _left_in(folder: Path) -> list:
     return found
 
 
-class Server:
+class Server(page_support.System):
     """A master for the server's own node, and ``minros web`` keeping exercises in ``learn``."""
 
     def __init__(self, tmp: Path, option: bool = False) -> None:
         """``option``: the folder named by ``--learn-dir``, which wins over $MINROS_LEARN_DIR."""
-        home = tmp / "ros_home"
-        (home / "log").mkdir(parents=True)
         self.base = tmp / "learn"
-        self.port = free_port()
-        self.env = ros_env(self.port, home, {"MINROS_LEARN_DIR": str(tmp / "not_here" if option else self.base)})
-        self.procs = [Proc([PYTHON, "-m", "minros", "core", "-p", str(self.port)], self.env)]
-        wait_for_master(self.port)
-        self.web_port = free_port()
-        self.web = Proc([PYTHON, "-m", "minros", "web", "--port", str(self.web_port)]
-                        + (["--learn-dir", str(self.base)] if option else []), self.env)
-        self.procs.append(self.web)
-        self.web.read_until("listening on", timeout=30)
+        self.option = option
+        super().__init__(tmp, {"MINROS_LEARN_DIR": str(tmp / "not_here" if option else self.base)})
 
-    @property
-    def url(self) -> str:
-        return f"http://127.0.0.1:{self.web_port}/"
+    def up(self) -> None:
+        self.start_core()
+        self.start_web(*(["--learn-dir", str(self.base)] if self.option else []))
 
     def facts(self, number: int) -> dict:
         folder = next(self.base.glob(f"{number:02d}-*"))
         return json.loads((folder / "state.json").read_text())
 
-    def stop(self) -> str:
-        return "".join(proc.stop() for proc in reversed(self.procs))
+    def check_stopped(self, output: str) -> None:
+        super().check_stopped(output)
+        assert not _left_in(self.base), "minros web left an exercise's processes behind"
 
 
-@pytest.fixture(scope="module")
-def server(tmp_path_factory):
-    need(playwright_api is not None, "playwright is needed for the page tests (the test extra)")
-    need(Path(CHROMIUM).exists(), "Debian's chromium is needed for the page tests")
-    made = Server(tmp_path_factory.mktemp("page_learn"))
-    try:
-        yield made
-    finally:
-        out = made.stop()
-        assert "Traceback" not in out, out[-4000:]
-        assert not _left_in(made.base), "minros web left an exercise's processes behind"
-
-
-@pytest.fixture(scope="module")
-def browser(server):
-    with playwright_api.sync_playwright() as p:
-        browser = launch_chromium(p)
-        try:
-            yield browser
-        finally:
-            browser.close()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory) -> Path:
-    folder = Path(os.environ.get("MINROS_SCREENSHOTS") or tmp_path_factory.mktemp("screenshots"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
+server = system_fixture(Server, "page_learn")
+browser = browser_fixture(after="server")
+shots = shots_fixture()
 
 
 def _running(view, number: int, timeout: float = 60_000) -> None:

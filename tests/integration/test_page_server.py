@@ -8,6 +8,7 @@ import json
 import time
 import xmlrpc.client
 
+import pytest
 from websockets.sync.client import connect
 
 from support import PYTHON, Proc, free_port, ros_env
@@ -32,6 +33,7 @@ def frames_until(ws, predicate, timeout: float) -> dict:
             return msg
 
 
+@pytest.mark.smoke
 def test_the_master_pushes_graph_changes_to_the_page(minros_core, ros_home):
     web, port = start_web(minros_core, ros_home, "--graph-interval", "60")
     master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{minros_core}/")

@@ -14,21 +14,10 @@ import json
 import shutil
 from pathlib import Path
 
-import pytest
-from test_page import Page, playwright_api
+import page_support
+from page_support import Page, browser_fixture, shots_fixture, system_fixture
 
-from support import (
-    CHROMIUM,
-    EXAMPLES,
-    PYTHON,
-    Proc,
-    free_port,
-    launch_chromium,
-    need,
-    ros_env,
-    wait_for_master,
-    wait_until,
-)
+from support import EXAMPLES, PYTHON, free_port, wait_until
 
 STRING_MD5 = "992ce8a1687cec8c8bd883ec73ca41d1"
 
@@ -41,69 +30,23 @@ def _events(path: Path) -> list:
     return [json.loads(line) for line in path.read_text().splitlines()]
 
 
-class Run:
+class Run(page_support.System):
     """The traced core, the web server following the trace directory, then the nodes."""
 
     def __init__(self, tmp: Path) -> None:
-        self.tmp = tmp
-        home = tmp / "ros_home"
-        (home / "log").mkdir(parents=True)
         self.traces = tmp / "traces"
         self.traces.mkdir()
-        self.port = free_port()
         # the Wire view shows TCPROS (a minros pair of one host would take shared memory)
-        self.env = ros_env(self.port, home, {"MINROS_SHM": "0"})
-        self.procs: list = []
-        self.start(_traced(self.traces / "core.jsonl",
-                           [PYTHON, "-m", "minros", "core", "-p", str(self.port)]))
-        wait_for_master(self.port)
-        self.web_port = free_port()
-        self.web = self.start([PYTHON, "-m", "minros", "web", "--port", str(self.web_port),
-                               "--trace", str(self.traces)])
-        self.web.read_until("listening on", timeout=30)
+        super().__init__(tmp, {"MINROS_SHM": "0"})
 
-    def start(self, argv: list) -> Proc:
-        proc = Proc(argv, self.env)
-        self.procs.append(proc)
-        return proc
-
-    @property
-    def url(self) -> str:
-        return f"http://127.0.0.1:{self.web_port}/"
-
-    def stop(self) -> str:
-        return "".join(proc.stop() for proc in reversed(self.procs))
+    def up(self) -> None:
+        self.start_core(lambda argv: _traced(self.traces / "core.jsonl", argv))
+        self.start_web("--trace", str(self.traces))
 
 
-@pytest.fixture(scope="module")
-def run(tmp_path_factory):
-    need(playwright_api is not None, "playwright is needed for the page tests (the test extra)")
-    need(Path(CHROMIUM).exists(), "Debian's chromium is needed for the page tests")
-    run_ = Run(tmp_path_factory.mktemp("page_wire"))
-    try:
-        yield run_
-    finally:
-        out = run_.stop()
-        assert "Traceback" not in out, out[-4000:]
-
-
-@pytest.fixture(scope="module")
-def browser(run):
-    with playwright_api.sync_playwright() as p:
-        browser = launch_chromium(p)
-        try:
-            yield browser
-        finally:
-            browser.close()
-
-
-@pytest.fixture(scope="module")
-def shots(tmp_path_factory) -> Path:
-    import os
-
-    folder = Path(os.environ.get("MINROS_SCREENSHOTS") or tmp_path_factory.mktemp("screenshots"))
-    folder.mkdir(parents=True, exist_ok=True)
-    return folder
+run = system_fixture(Run, "page_wire")
+browser = browser_fixture(after="run")
+shots = shots_fixture()
 
 
 def _section(page: Page, name: str):
@@ -270,7 +213,7 @@ def test_missing_cut_and_foreign_trace_files_are_reported_and_the_server_keeps_g
     missing = tmp_path / "later.jsonl"
     web_port = free_port()
     web = run.start([PYTHON, "-m", "minros", "web", "--port", str(web_port), "--trace",
-                     str(missing), str(cut), str(foreign)])
+                     str(missing), str(cut), str(foreign), "__name:=web_bad_traces"])
     web.read_until("listening on", timeout=30)
 
     class Where:

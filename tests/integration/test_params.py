@@ -27,6 +27,7 @@ def master(env):
     return xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])
 
 
+@pytest.mark.smoke
 def test_set_get_has_delete_without_a_node(master_env):
     minros.set_param("/test/int", 5)
     minros.set_param("test/float", 1.5)  # relative to /unnamed -> /test/float

@@ -106,6 +106,7 @@ print("GOT", sorted(got), "CONNECTIONS", len([c for c in info if c[4] == "/latch
     assert "GOT [('a', 'msg 0'), ('b', 'msg 0')] CONNECTIONS 1" in out
 
 
+@pytest.mark.smoke
 def test_slave_api_answers_and_errors(latched_talker, scripts, minros_master, ros_home):
     name, uri, proc = latched_talker
     node = xmlrpc.client.ServerProxy(uri)

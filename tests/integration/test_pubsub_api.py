@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from support import PYTHON, Proc, ros_env
 
 SCRIPT = r'''
@@ -114,6 +116,7 @@ print("ALL DONE", flush=True)
 '''
 
 
+@pytest.mark.smoke
 def test_topic_api(tmp_path: Path, minros_master, ros_home):
     script = tmp_path / "api.py"
     script.write_text(SCRIPT)

@@ -28,6 +28,7 @@ rospy.spin()
 '''
 
 
+@pytest.mark.smoke
 def test_graph_follows_nodes_topics_and_connections(minros_core: int, ros_home: Path, tmp_path: Path,
                                                    monkeypatch: pytest.MonkeyPatch):
     from rosgraph.impl.graph import Edge, Graph, topic_node

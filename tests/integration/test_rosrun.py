@@ -96,6 +96,7 @@ def test_rosrun_unknown_executable_and_package(tmp_path, pkg_path):
     assert "Traceback" not in out.stderr + out.stdout
 
 
+@pytest.mark.smoke
 def test_rosrun_usage(tmp_path, pkg_path):
     out = _run(["rosrun", "demo_pkg"], _env(tmp_path, pkg_path))
     assert out.returncode == 0 and out.stdout.startswith("Usage: rosrun [--prefix cmd]")

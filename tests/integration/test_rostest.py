@@ -7,6 +7,8 @@ import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import pytest
+
 from support import PYTHON, ros_env
 
 PKGS = Path(__file__).resolve().parent / "rostest_pkgs"
@@ -64,6 +66,7 @@ def test_rostest_by_path_reports_a_failing_check(ros_home: Path) -> None:
     assert "41" in failure.text and "42" in failure.text
 
 
+@pytest.mark.smoke
 def test_text_mode_prints_the_cases(ros_home: Path) -> None:
     out = _rostest(ros_home, "--text", "rostest_demo", "counter.test")
     assert out.returncode == 0, out.stdout + out.stderr

@@ -59,6 +59,7 @@ def value(line: str, key: str) -> float:
     return float(line.split(f"{key}=")[1].split()[0])
 
 
+@pytest.mark.smoke
 def test_node_follows_clock_topic(minros_master: int, ros_home: Path, tmp_path: Path):
     env = ros_env(minros_master, ros_home)
     master = xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])

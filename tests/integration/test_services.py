@@ -203,6 +203,7 @@ def test_proxy_persistent_reuses_one_connection(adder, master_env):
     assert proxy._end is None
 
 
+@pytest.mark.smoke
 def test_proxy_errors(adder, master_env, monkeypatch):
     with pytest.raises(ServiceException, match=r"^service \[/nope\] unavailable$"):
         minros.ServiceProxy("/nope", _srv())(1, 2)

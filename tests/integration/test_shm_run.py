@@ -120,6 +120,7 @@ def _line(text: str, pattern: str) -> str:
     return lines[-1]
 
 
+@pytest.mark.smoke
 def test_images_go_through_shared_memory_and_sigkill_leaves_nothing(scripts, minros_master,
                                                                    ros_home):
     pub_script, sub_script = scripts

@@ -47,6 +47,7 @@ def test_topics_frames_and_map_are_turtlebot3s(sim):
         assert line in types
 
 
+@pytest.mark.smoke
 def test_map_saver_writes_what_map_server_serves(sim, tmp_path):
     from minros.sim import mapfile
     from minros.sim.world import DEFAULT_WORLD
@@ -137,6 +138,30 @@ def test_invalid_quaternion_is_aborted_as_move_base_does(sim):
     result = sim.python("-c", code)
     assert result.stdout.strip() == ("4 Aborting on goal because it was sent with an invalid "
                                      "quaternion")
+
+
+@pytest.mark.parametrize("position", ["float('nan'), 1.0", "1.0, float('inf')"])
+def test_non_finite_goal_position_is_refused_in_one_line(sim, position):
+    code = (
+        "import actionlib, rospy\n"
+        "from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal\n"
+        "rospy.init_node('nan_goal')\n"
+        "c = actionlib.SimpleActionClient('move_base', MoveBaseAction)\n"
+        "c.wait_for_server(rospy.Duration(20))\n"
+        "g = MoveBaseGoal(); g.target_pose.header.frame_id = 'map'\n"
+        f"g.target_pose.pose.position.x, g.target_pose.pose.position.y = {position}\n"
+        "g.target_pose.pose.orientation.w = 1.0\n"
+        "c.send_goal(g); c.wait_for_result(rospy.Duration(20))\n"
+        "print(c.get_state(), c.get_goal_status_text())\n")
+    result = sim.python("-c", code)
+    state, _, text = result.stdout.strip().partition(" ")
+    assert state == "4", result.stdout + result.stderr
+    assert text.startswith("Aborting on goal because it was sent with a non-finite position "
+                           "(x="), text
+    # move_base said so in one line, with no traceback
+    out = sim.proc.read_until("non-finite position", timeout=10)
+    assert "Traceback" not in out and "cannot convert" not in out
+    assert sim.proc.alive()
 
 
 def test_simple_goal_from_rostopic_pub(sim):
@@ -262,6 +287,47 @@ def test_two_robots_are_namespaced_and_navigate_at_once(tmp_path_factory):
     finally:
         out = sim.stop()
     assert "Bump!" not in out and "Traceback" not in out
+
+
+def test_a_robot_stuck_by_a_wall_recovers_then_aborts_with_the_reason(tmp_path_factory):
+    """5 cm from the west wall, the follower finds no valid command (the wall is in its safety
+    corridor). It used to replan "plan of 0.6 m" every second, ACTIVE forever; move_base's
+    executive runs its recovery behaviours, then aborts saying why."""
+    home = tmp_path_factory.mktemp("sim_stuck_home")
+    (home / "log").mkdir()
+    sim = Sim(home, "--no-nav", "--robot=-4.75,0,1.5708", wait_for=("Hz steps",))
+    nav = Proc([PYTHON, "-m", "minros", "run", "move_base", "move_base", "map:=/map",
+                "_controller_patience:=3.0", "_oscillation_timeout:=0"], sim.env)
+    try:
+        nav.read_until(READY, timeout=30)
+        code = (
+            "import actionlib, rospy, time\n"
+            "from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal\n"
+            "rospy.init_node('stuck_goal')\n"
+            "c = actionlib.SimpleActionClient('move_base', MoveBaseAction)\n"
+            "c.wait_for_server(rospy.Duration(20))\n"
+            "g = MoveBaseGoal(); g.target_pose.header.frame_id = 'map'\n"
+            "g.target_pose.pose.position.x, g.target_pose.pose.position.y = -4.7, 0.6\n"
+            "g.target_pose.pose.orientation.z = g.target_pose.pose.orientation.w = 0.5 ** 0.5\n"
+            "start = time.monotonic()\n"
+            "c.send_goal(g); c.wait_for_result(rospy.Duration(60))\n"
+            "print(c.get_state(), round(time.monotonic() - start), c.get_goal_status_text())\n")
+        result = sim.python("-c", code, timeout=90)
+        state, seconds, text = result.stdout.strip().split(" ", 2)
+        assert state == "4", result.stdout + result.stderr  # ABORTED, not 1 (ACTIVE)
+        assert text.startswith("Failed to find a valid control. Even after executing recovery "
+                               "behaviors. (no valid velocity command for "), text
+        assert "is in its way)" in text
+        # 3 s of patience, two turns of 2 pi at 1 rad/s: well within the minute
+        assert int(seconds) < 40
+    finally:
+        log = nav.stop()
+        sim.stop()
+    tried = [line.rsplit(": ", 1)[-1] for line in log.splitlines() if "; recovery " in line]
+    assert tried == ["conservative_reset", "rotate_recovery", "aggressive_reset",
+                     "rotate_recovery"], log
+    # a first plan, one a second while blocked within the patience, one after each recovery
+    assert log.count("plan of") <= 10 and "Traceback" not in log
 
 
 def test_simulated_time_as_fast_as_possible(tmp_path_factory):

@@ -91,6 +91,7 @@ def test_tools_report_bad_command_lines_in_one_line():
     assert all("Traceback" not in d.stderr for d in (done,))
 
 
+@pytest.mark.smoke
 def test_same_frame_twice_is_refused(minros_core, ros_home):
     proc = rosrun(minros_core, ros_home, "tf2_ros", "static_transform_publisher",
                   "0", "0", "0", "0", "0", "0", "a", "a")

@@ -84,6 +84,7 @@ def traced_run(tmp_path_factory):
                 proc.stop()
 
 
+@pytest.mark.smoke
 def test_show_prints_the_sequence_with_the_values_of_the_run(traced_run):
     files, env, port, live = traced_run
     talker_events, listener_events = _events(files["talker"]), _events(files["listener"])

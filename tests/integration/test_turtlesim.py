@@ -57,6 +57,7 @@ def turtlesim(minros_core, ros_home, tmp_path):
         proc.stop()
 
 
+@pytest.mark.smoke
 def test_startup_lines_and_headless_notice(minros_core, ros_home, tmp_path):
     snapshot = tmp_path / "shot.png"
     # Private parameters from the command line: a background colour and the ~snapshot file.

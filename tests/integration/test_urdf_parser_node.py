@@ -9,6 +9,8 @@ import subprocess
 import xmlrpc.client
 from pathlib import Path
 
+import pytest
+
 from support import PYTHON, Proc, ros_env
 
 ROBOT = """<robot name="arm">
@@ -34,6 +36,7 @@ except KeyError as exc:
 '''
 
 
+@pytest.mark.smoke
 def test_from_parameter_server_in_a_node(tmp_path: Path, minros_core: int, ros_home: Path) -> None:
     env = ros_env(minros_core, ros_home)
     master = xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])

@@ -450,6 +450,7 @@ def next_status(ws) -> dict:
             return msg
 
 
+@pytest.mark.smoke
 def test_bad_input_gets_status_and_leaves_others_alone(graph):
     with raw_client(graph.ws) as bystander, raw_client(graph.ws) as ws:
         bystander.send(json.dumps({"op": "subscribe", "topic": "/chatter", "id": "keep"}))
@@ -785,6 +786,44 @@ def test_port_in_use_is_one_line(minros_core, ros_home):
     assert "Traceback" not in done.stderr
 
 
+
+
+def test_a_second_minros_web_refuses_the_name_the_first_holds(minros_core, ros_home):
+    """It used to take /minros_web and so shut the first server down (ROS's rule for a node
+    name), silently. Now it says so in one line, and the first keeps serving; under a name of
+    its own it runs beside it, and a name whose holder died (SIGKILL, no unregistration) is
+    free again."""
+    import signal
+    import urllib.request
+
+    first, first_port = start_web(minros_core, ros_home)
+    try:
+        done = subprocess.run([PYTHON, "-m", "minros", "web", "--port", str(free_port())],
+                              env=ros_env(minros_core, ros_home), capture_output=True,
+                              text=True, timeout=30)
+        assert done.returncode == 1, done.stdout + done.stderr
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and "Traceback" not in done.stderr
+        assert lines[0].startswith("minros web: error: a node named /minros_web is already "
+                                   f"running (pid {first.pid}, ")
+        assert "minros web --name minros_web2" in lines[0]
+        assert first.alive()
+        with urllib.request.urlopen(f"http://127.0.0.1:{first_port}/", timeout=10) as page:
+            assert page.status == 200
+        second, _port = start_web(minros_core, ros_home, "--name", "minros_web2")
+        try:
+            nodes = subprocess.run([PYTHON, "-m", "minros", "node", "list"],
+                                   env=ros_env(minros_core, ros_home), capture_output=True,
+                                   text=True, timeout=30).stdout.split()
+            assert {"/minros_web", "/minros_web2"} <= set(nodes) and first.alive()
+        finally:
+            second.stop()
+    finally:
+        first.popen.send_signal(signal.SIGKILL)
+        first.popen.wait(10)
+    again, _port = start_web(minros_core, ros_home)
+    out = again.stop()
+    assert "Traceback" not in out
 
 
 def test_a_latched_message_reaches_every_client_that_subscribes_later(graph):

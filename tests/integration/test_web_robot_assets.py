@@ -11,6 +11,8 @@ get foxglove_bridge's error status; a token guards /pkg/ like every other piece 
 from __future__ import annotations
 
 import hashlib
+import json
+import os
 import urllib.error
 import urllib.request
 import xmlrpc.client
@@ -129,7 +131,7 @@ def test_the_page_route_serves_package_meshes_and_nothing_else(system):
 def test_a_custom_allow_list_and_the_token_guard_the_route(system, tmp_path):
     home = tmp_path / "home"
     (home / "log").mkdir(parents=True)
-    web, port = start_web(system.port, home, "--token", "s3cret",
+    web, port = start_web(system.port, home, "--token", "s3cret", "--name", "web_allowlist",
                           "_asset_uri_allowlist:=['^package://scene_pkg/meshes/wedge\\.stl$']",
                           env=system.extra)
     try:
@@ -141,3 +143,111 @@ def test_a_custom_allow_list_and_the_token_guard_the_route(system, tmp_path):
     finally:
         out = web.stop()
     assert "Traceback" not in out, out
+
+
+# -- an attacker's downloads hold chunks, not files ------------------------------------------
+
+
+def rss_mb(pid: int) -> int:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) >> 10
+    raise AssertionError(f"no VmRSS for {pid}")
+
+
+def peak_mb(pid: int, seconds: float, bound: int) -> int:
+    """The highest RSS seen in a window of ``seconds`` (a measurement window: nothing to wait
+    for), ending early once it crosses ``bound``."""
+    import time
+
+    top, end = 0, time.monotonic() + seconds
+    while time.monotonic() < end and top <= bound:
+        top = max(top, rss_mb(pid))
+        time.sleep(0.05)
+    return top
+
+
+def foxglove_fetch(port: int, uri: str, request_id: int, timeout: float = 60) -> bytes:
+    """An honest Foxglove client's fetchAsset (the reply's data, status checked)."""
+    import json
+    import struct
+
+    from websockets.sync.client import connect
+
+    with connect(f"ws://127.0.0.1:{port}", subprotocols=["foxglove.websocket.v1"],
+                 max_size=None, open_timeout=10) as ws:
+        ws.send(json.dumps({"op": "fetchAsset", "uri": uri, "requestId": request_id}))
+        while True:
+            msg = ws.recv(timeout=timeout)
+            if isinstance(msg, bytes) and msg[0] == 4:
+                _op, rid, status, length = struct.unpack_from("<BIBI", msg)
+                assert rid == request_id and status == 0, msg[10:10 + length]
+                return msg[10 + length:]
+
+
+def test_unread_downloads_of_a_big_mesh_hold_no_memory(tmp_path):
+    """An attacker's script: 30 parallel GETs of a 46 MB mesh that it never reads, then six
+    Foxglove clients asking for it eight times each without reading. minros web used to grow
+    from 48 MB to 2.8 GB (held after they closed), and by 812 MB for the Foxglove clients.
+    Now each connection holds one 64 kB chunk within a 32 MB budget, and honest clients get
+    the whole file meanwhile."""
+    import contextlib
+    import socket
+
+    from websockets.sync.client import connect
+
+    pkg = tmp_path / "pkgs" / "big_pkg"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>big_pkg</name></package>")
+    data = os.urandom(46 << 20)
+    (pkg / "meshes" / "big.stl").write_bytes(data)
+    digest = hashlib.sha256(data).hexdigest()
+    del data
+    home = tmp_path / "home"
+    (home / "log").mkdir(parents=True)
+    master_port = free_port()  # a master of its own: the others' private parameters stay there
+    procs = [Proc([PYTHON, "-m", "minros", "core", "-p", str(master_port)],
+                  ros_env(master_port, home))]
+    try:
+        wait_for_master(master_port)
+        web, port = start_web(master_port, home, env={"ROS_PACKAGE_PATH": str(tmp_path / "pkgs")})
+        procs.append(web)
+        request = (f"GET /pkg/big_pkg/meshes/big.stl HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n"
+                   .encode())
+        start = rss_mb(web.pid)
+        bound = start + 100
+        unread = []
+        for _ in range(30):
+            sock = socket.create_connection(("127.0.0.1", port), timeout=10)
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+            sock.sendall(request)
+            unread.append(sock)
+        peak = peak_mb(web.pid, 4.0, bound)
+        assert peak <= bound, f"30 unread downloads took minros web from {start} to {peak} MB"
+        status, kind, body = get(f"http://127.0.0.1:{port}/pkg/big_pkg/meshes/big.stl")
+        assert status == 200 and kind == "model/stl", body[:300]
+        assert hashlib.sha256(body).hexdigest() == digest
+        del body
+        for sock in unread:
+            sock.close()
+        with contextlib.ExitStack() as clients:
+            for _ in range(6):
+                ws = clients.enter_context(connect(
+                    f"ws://127.0.0.1:{port}", subprotocols=["foxglove.websocket.v1"],
+                    max_size=None, open_timeout=10))
+                ws.socket.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+                for request_id in range(8):
+                    ws.send(json.dumps({"op": "fetchAsset", "requestId": request_id,
+                                        "uri": "package://big_pkg/meshes/big.stl"}))
+                clients.callback(ws.socket.close)  # gone without a closing handshake
+            peak = peak_mb(web.pid, 4.0, bound)
+            assert peak <= bound, (f"six unread Foxglove clients took minros web from {start} "
+                                   f"to {peak} MB")
+            fetched = foxglove_fetch(port, "package://big_pkg/meshes/big.stl", 99)
+            assert hashlib.sha256(fetched).hexdigest() == digest
+            del fetched
+        after = peak_mb(web.pid, 1.0, bound)
+        assert after <= start + 60, f"{after} MB after the clients closed (from {start} MB)"
+    finally:
+        out = "".join(proc.stop() for proc in reversed(procs))
+    assert "Traceback" not in out, out[-3000:]

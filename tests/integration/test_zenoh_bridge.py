@@ -165,6 +165,7 @@ def test_definition_and_latching_travel_to_a_site_without_the_msg_file(pair, tmp
         assert "geometry_msgs/Point where" in definition and "MSG: geometry_msgs/Point" in definition
 
 
+@pytest.mark.smoke
 def test_plain_zenoh_publisher_feeds_a_subscriber_only_topic(pair, session):
     from minros.zenoh import keys
 
@@ -312,3 +313,92 @@ def test_without_the_extra_the_bridge_says_how_to_get_it_and_keys_still_work(tmp
                             "import minros.zenoh.keys, minros.zenoh.plan, minros.cli.zenoh; "
                             "print('ok')"], env=env, capture_output=True, text=True, timeout=60)
     assert plain.stdout.strip() == "ok", plain.stderr
+
+
+def _threads(pid: int) -> int:
+    from pathlib import Path
+
+    status = Path(f"/proc/{pid}/status").read_text()
+    return int(next(line for line in status.splitlines() if line.startswith("Threads:")).split()[1])
+
+
+def test_a_beacon_flood_is_bounded_and_honest_topics_keep_flowing(tmp_path):
+    """An attacker's script on the Zenoh link: beacons for 2,000 publishers, 500 subscribers
+    and 200 services in 10 s, repeated as a bridge repeats them. Bridge b used to make a ROS
+    publisher and a thread for each (1,167 publications and 1,204 threads); now at most
+    --max-remote bridges for beacons alone, made at a bounded rate, no thread of their own,
+    each bound said once, while a real topic a -> b keeps flowing and a new one is bridged."""
+    from minros.zenoh import keys
+    from zenoh_support import Pair
+
+    require_zenoh()
+    cap = 150
+    pair = Pair(tmp_path, extra_args=["--max-remote", str(cap)])
+    session = None
+    try:
+        talker = pair.a.python(TALKER, "honest_9", "20")
+        listener = pair.b.python(LISTENER, "honest_9")
+        listener.read_until("I heard", 30)
+        bridge = pair.b.bridge
+        threads_before = _threads(bridge.pid)
+        heard: list = []
+        stop = threading.Event()
+
+        def count() -> None:
+            while not stop.is_set():
+                try:
+                    listener.read_until("I heard", 0.5)
+                except AssertionError:
+                    continue
+                heard.append(time.monotonic())
+        counter = threading.Thread(target=count, daemon=True)
+        counter.start()
+        session = zenoh_session(pair.endpoint)
+        flood = ([keys.discovery_key("pub", f"/flood_9/p{i}", "std_msgs/String", STRING_MD5)
+                  for i in range(2000)]
+                 + [keys.discovery_key("sub", f"/flood_9/s{i}", "std_msgs/String", STRING_MD5)
+                    for i in range(500)]
+                 + [keys.discovery_key("srv", f"/flood_9/v{i}", "std_srvs/SetBool", SETBOOL_MD5)
+                    for i in range(200)])
+        started = time.monotonic()
+        peak = threads_before
+        second = None
+        while time.monotonic() - started < 16.0:
+            elapsed = time.monotonic() - started
+            for key in flood[:min(len(flood), int((elapsed + 1) * len(flood) / 10))]:
+                session.put(key, b"")  # each beacon once a second, as a bridge sends them
+            peak = max(peak, _threads(bridge.pid))
+            if second is None and elapsed > 6.0:  # a new honest topic in the thick of it
+                pair.a.python(TALKER, "honest_9b", "20")
+                second = pair.b.python(LISTENER, "honest_9b")
+                second_started = time.monotonic()
+            time.sleep(max(0.0, 1.0 - (time.monotonic() - started) % 1.0))
+        flood_end = time.monotonic()
+        master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{pair.b.port}/")
+        pubs, subs, srvs = master.getSystemState("/probe")[2]
+        made = (sum(1 for t, _n in pubs if t.startswith("/flood_9"))
+                + sum(1 for t, _n in subs if t.startswith("/flood_9"))
+                + sum(1 for s, _n in srvs if s.startswith("/flood_9")))
+        assert peak <= threads_before + 8, (threads_before, peak)
+        assert 0 < made <= cap, made
+        # the honest topic: 20 Hz throughout, no silence of a second
+        stop.set()
+        counter.join(2)
+        during = [t for t in heard if started <= t <= flood_end]
+        assert len(during) >= 0.8 * 20 * (flood_end - started), len(during)
+        gaps = [b - a for a, b in zip(during, during[1:])]
+        assert max(gaps) < 1.0, max(gaps)
+        second.read_until("I heard", 10)
+        assert time.monotonic() - second_started < 12.0
+        session.close()
+        session = None
+        out = bridge.stop()
+        talker.stop()
+    finally:
+        if session is not None:
+            session.close()
+        pair.close()
+    assert "Traceback" not in out
+    assert count_lines(out, "remote bridges are at their bound of 150") == 1
+    assert count_lines(out, "bridges for remote beacons are made at most") == 1
+    assert len(out.splitlines()) < 400, len(out.splitlines())

@@ -132,6 +132,27 @@ def test_minros_split_read_by_debian(talker, debian_rosmaster, ros_home, tmp_pat
     assert numbers == list(range(numbers[0], numbers[0] + len(numbers)))  # no gap between files
 
 
+@pytest.mark.parametrize("recorder", ["debian", "minros"])
+def test_record_duration_ends_as_debians(talker, debian_rosmaster, ros_home, tmp_path, recorder):
+    """rosbag record --duration 2, Debian's and minros's on the same talker: each stops by
+    itself with 0, after at most 2 s of messages; nothing published, each leaves an empty bag."""
+    run = debian_rosbag if recorder == "debian" else minros_bag
+    began = time.monotonic()
+    rec = run(debian_rosmaster, ros_home, tmp_path, "record", "--duration", "2", "-O", "short",
+              "/chatter", timeout=30)
+    took = time.monotonic() - began
+    assert rec.returncode == 0, rec.stdout + rec.stderr
+    _no_traceback(rec.stderr)
+    messages = debian_read(tmp_path / "short.bag")
+    stamps = [m[3] + m[4] / 1e9 for m in messages]
+    assert took >= 2.0 and 20 <= len(messages) <= 41, (took, len(messages))
+    assert stamps[-1] - stamps[0] <= 2.0
+    idle = run(debian_rosmaster, ros_home, tmp_path, "record", "--duration", "1", "-O", "idle",
+               "/nothing", timeout=30)
+    assert idle.returncode == 0, idle.stdout + idle.stderr
+    assert debian_read(tmp_path / "idle.bag") == []
+
+
 def test_debian_record_read_and_played_by_minros(talker, debian_rosmaster, ros_home, tmp_path):
     rec = debian_rosbag(debian_rosmaster, ros_home, tmp_path, "record", "-l", "12", "-O", "deb",
                         "/chatter")
@@ -393,6 +414,7 @@ def debian_read_images(path: Path) -> List[list]:
     return json.loads(result.stdout)
 
 
+@pytest.mark.smoke
 def test_lz4_bag_api_multi_block_chunks_read_by_debian(tmp_path):
     """The Bag API's lz4 compression, chunks of 4 MB of varied bytes, read back by Debian."""
     require_reference()

@@ -275,6 +275,7 @@ print('spin returned', flush=True)
 """
 
 
+@pytest.mark.smoke
 def test_rospy_param_cache_follows_param_updates(ros_core):
     key = "/" + unique("cached")
     master = ros_core.master()

@@ -68,6 +68,7 @@ def test_synchronous_publisher(scripts, debian_rosmaster, ros_home, pub_impl, su
     assert got == [f"got msg {i} from /talker" for i in range(10)]
 
 
+@pytest.mark.smoke
 @pytest.mark.parametrize("pub_impl, sub_impl", PAIRS)
 def test_latched_message_reaches_late_subscriber(scripts, debian_rosmaster, ros_home, pub_impl, sub_impl):
     got = _exchange(scripts, debian_rosmaster, ros_home, pub_impl, sub_impl, "string", 1, latch=True)

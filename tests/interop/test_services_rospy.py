@@ -155,6 +155,7 @@ def test_debian_rosservice_against_minros_tutorial_server(env_for, monkeypatch):
     assert "Returning [7 + 8 = 15]" in out
 
 
+@pytest.mark.smoke
 def test_tutorial_client_on_minros_against_rospy_server(env_for, scripts):
     server, _ = scripts
     python, env = env_for("rospy")

@@ -86,6 +86,7 @@ def _publisher_uri(port: int, topic: str) -> str:
     return wait_until(find, 20, what=f"a publisher of {topic}")
 
 
+@pytest.mark.smoke
 @pytest.mark.parametrize("impl", ["rospy", "roscpp"])
 def test_reference_publishers_answer_the_offer_with_tcpros(scripts, roscpp_node, debian_rosmaster,
                                                            ros_home, impl):

@@ -48,6 +48,7 @@ def test_known_md5_sums_of_the_bundled_actions() -> None:
     assert m.TwoIntsActionGoal._md5sum == "684a2db55d6ffb8046fb9d6764ce0860"
 
 
+@pytest.mark.slow
 def test_package_with_only_actions_imports_as_msg(tmp_path: Path) -> None:
     _action_package(tmp_path / "src", "actionlib_tutorials", {"Fibonacci": FIBONACCI})
     out = run_python("import rospy\nfrom actionlib_tutorials.msg import FibonacciAction, FibonacciGoal\n"
@@ -59,6 +60,7 @@ def test_package_with_only_actions_imports_as_msg(tmp_path: Path) -> None:
     assert out.stdout == "f59df5767bf7634684781c92598b2406 3 7\n"
 
 
+@pytest.mark.slow
 def test_catkin_make_add_action_files(tmp_path: Path) -> None:
     from minros.workspace import catkin
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import os
 import struct
+import threading
 import time
 from pathlib import Path
 
@@ -189,7 +190,10 @@ def test_bag_filenames():
 
 def test_parse_duration():
     assert parse_duration("30") == 30 and parse_duration("1.5m") == 90 and parse_duration("2h") == 7200
-    for bad in ("", "x", "5d", "0"):
+    # what ROS's recorder reads too: a unit after a space, "3.", ".5", exponents
+    assert parse_duration("3s") == 3 and parse_duration("2 m") == 120
+    assert parse_duration("3.") == 3 and parse_duration(".5m") == 30 and parse_duration("1e1") == 10
+    for bad in ("", "x", "5d", "0", "-3", "3 ms"):
         with pytest.raises(ValueError):
             parse_duration(bad)
 
@@ -243,16 +247,105 @@ def test_sink_hands_chunks_to_the_kernel_on_a_time_bound(tmp_path, monkeypatch):
         assert (conn.callerid, conn.latching) == ("/talker", "0")
 
 
+def _messages(path: str) -> list:
+    with Bag(path) as b:
+        return [m.message.data for m in b.read_messages()]
+
+
 def test_sink_splits_by_duration_and_keeps_max_splits(tmp_path, monkeypatch):
+    """ROS's recorder: a split begins at every DURATION from the start of the recording, with
+    the first message received *more* than DURATION after the period's start."""
     monkeypatch.chdir(tmp_path)
     sink = BagSink(RecordOptions(name="part", split=True, duration="1", max_splits=2),
                    lambda level, text: None)
+    sink.start(100_000_000_000)
     for i in range(8):
-        sink.write(_item(i, 100 + i * 0.5))
+        sink.write(_item(i, 100 + i * 0.5))  # 100.0, 100.5, ... 103.5
     sink.close_current()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["part_2.bag", "part_3.bag"]
-    with Bag("part_3.bag") as b:
-        assert [m.message.data for m in b.read_messages()] == ["m6", "m7"]
+    assert _messages("part_2.bag") == ["m5", "m6"] and _messages("part_3.bag") == ["m7"]
+
+
+def test_sink_duration_without_split_ends_the_recording(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    sink = BagSink(RecordOptions(name="short", duration="2"), lambda level, text: None)
+    sink.start(100_000_000_000)
+    times = [100.5, 101.5, 102.0, 102.1, 103.0]
+    for i, t in enumerate(times):
+        sink.write(_item(i, t))
+        if sink.finished:
+            break
+    assert sink.finished and i == 3  # 102.0 is not more than 2 s after 100.0; 102.1 is
+    sink.close_current()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["short.bag"]
+    assert _messages("short.bag") == ["m0", "m1", "m2"]
+
+
+def test_sink_size_without_split_ends_the_recording(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    sink = BagSink(RecordOptions(name="small", size_mb=1, chunksize_kb=64),
+                   lambda level, text: None)
+    big = String("x" * 300_000)
+    buff = io.BytesIO()
+    big.serialize(buff)
+    written = 0
+    while not sink.finished and written < 10:
+        sink.write(("/big", 100_000_000_000 + written, buff.getvalue(), HEADER))
+        written += 1
+    assert sink.finished and written == 5  # 4 messages pass 1 MB; the 5th is not written
+    sink.close_current()
+    with Bag("small.bag") as b:
+        assert b.get_message_count() == 4
+
+
+def _run_sink(sink: BagSink, queue: RecordQueue, clock: list, ticks: list) -> threading.Thread:
+    """The writer thread on a clock the test moves: each tick once the sink is idle."""
+    writer = threading.Thread(target=sink.run, args=(queue,), daemon=True)
+    writer.start()
+    for t in ticks:
+        time.sleep(FLUSH_INTERVAL)  # two idle looks of the writer per tick
+        clock[0] = int(t * 1e9)
+    return writer
+
+
+def test_sink_duration_ends_an_idle_recording(tmp_path, monkeypatch):
+    """No message at all: the recording still ends DURATION after it began (ROS's recorder
+    looks at the clock every quarter second), leaving the empty bag it opened at the start."""
+    monkeypatch.chdir(tmp_path)
+    clock = [100_000_000_000]
+    sink = BagSink(RecordOptions(name="idle", duration="1"), lambda level, text: None,
+                   clock=lambda: clock[0])
+    sink.start(clock[0])
+    queue = RecordQueue(0)
+    writer = _run_sink(sink, queue, clock, [100.5, 101.0])
+    assert writer.is_alive()  # 1.0 s after the start is not more than the duration
+    clock[0] = 101_000_000_001
+    writer.join(5)
+    assert not writer.is_alive() and sink.finished and not queue.closed
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["idle.bag"]
+    assert _messages("idle.bag") == []
+
+
+def test_sink_idle_split_by_duration_and_a_clock_leap(tmp_path, monkeypatch):
+    """With --split an idle recording rotates files all the same (empty ones, as ROS's); a
+    clock leaping a million periods ahead makes one new file, not a million."""
+    monkeypatch.chdir(tmp_path)
+    clock = [100_000_000_000]
+    sink = BagSink(RecordOptions(name="part", split=True, duration="1"),
+                   lambda level, text: None, clock=lambda: clock[0])
+    sink.start(clock[0])
+    queue = RecordQueue(0)
+    writer = _run_sink(sink, queue, clock, [101.5, 1_000_100.5])
+    wait = time.monotonic() + 5
+    while sink.split_index != 2 and time.monotonic() < wait:
+        time.sleep(0.05)
+    queue.push(_item(0, 1_000_100.6))
+    queue.close()
+    writer.join(5)
+    assert not writer.is_alive()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["part_0.bag", "part_1.bag", "part_2.bag"]
+    assert _messages("part_1.bag") == [] and _messages("part_2.bag") == ["m0"]
+    assert sink.start_ns == 1_000_100_000_000_000  # the period that holds the leap's time
 
 
 def test_raw_class_publishes_stored_bytes():

@@ -256,6 +256,7 @@ def test_corpus_is_reproducible(tmp_path, corpus):
     assert all(a.path.read_bytes() == d.path.read_bytes() for a, d in zip(again, corpus))
 
 
+@pytest.mark.slow  # over half a CPU-second of its own
 def test_info_and_check_print_one_line(corpus):
     for d in corpus:
         for cmd in ("info", "check"):

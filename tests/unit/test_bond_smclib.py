@@ -79,6 +79,7 @@ print(json.dumps(out))
 '''
 
 
+@pytest.mark.slow
 def test_bond_sm_module_is_rosss_machine() -> None:
     """bondpy.BondSM_sm drives an owner exactly as ROS's SMC-generated module does, undefined
     transitions included (SMC's TransitionUndefinedException and text)."""

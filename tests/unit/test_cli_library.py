@@ -201,7 +201,7 @@ def test_layout_svg_png() -> None:
 # hz / bw / rosparam helpers
 
 def test_hz_statistics() -> None:
-    from minros.cli.topic import HzStats, _format_bw
+    from minros.cli.topic_rates import HzStats, format_bw
 
     stats = HzStats()
     for i in range(11):
@@ -214,9 +214,9 @@ def test_hz_statistics() -> None:
     for i in range(10):
         small.tick(float(i))
     assert small.get()[4] == 3
-    assert _format_bw([100, 100], [0.0, 1.0], 2.0) == \
+    assert format_bw([100, 100], [0.0, 1.0], 2.0) == \
         "average: 100.00B/s\n\tmean: 100.00B min: 100.00B max: 100.00B window: 2"
-    assert _format_bw([6_220_800] * 3, [0.0, 0.1, 0.2], 0.3).startswith("average: 62.21MB/s")
+    assert format_bw([6_220_800] * 3, [0.0, 0.1, 0.2], 0.3).startswith("average: 62.21MB/s")
 
 
 def test_rosparam_helpers() -> None:
@@ -241,10 +241,10 @@ def test_rosparam_helpers() -> None:
 # the tools' internals as a library (rostopic.ROSTopicDelay, rosparam's YAML hooks, ...)
 
 def test_topic_delay_and_bandwidth_meters(monkeypatch) -> None:
-    from minros.cli import topic
+    from minros.cli import topic_api as topic
 
     now = [Time(100, 0)]
-    monkeypatch.setattr(topic, "_now", lambda: now[0])
+    monkeypatch.setattr(topic, "ros_now", lambda: now[0])
     delay = topic.ROSTopicDelay(window_size=-1)
     assert delay.get_delay() is None
     for i, lag in enumerate((0.5, 0.25, 0.75)):
@@ -275,7 +275,7 @@ def test_topic_delay_and_bandwidth_meters(monkeypatch) -> None:
 
 
 def test_callback_echo_offsets_filters_and_transforms(capsys) -> None:
-    from minros.cli import topic
+    from minros.cli import topic_api as topic
 
     String = get_message_class("std_msgs/String")
     echo = topic.CallbackEcho("/a/", None, filter_fn=lambda m: m.data != "skip",

@@ -71,6 +71,7 @@ def test_compressed_roundtrip():
     assert np.array_equal(bridge.compressed_imgmsg_to_cv2(msg), image)
 
 
+@pytest.mark.slow
 def test_matches_debians_cv_bridge():
     """getCvType and cv2_to_imgmsg fields agree with Debian's python3-cv-bridge."""
     require_reference()
@@ -81,7 +82,10 @@ def test_matches_debians_cv_bridge():
         f"encs = {ENCODINGS!r}\n"
         "im = (np.arange(5*7*3) % 251).astype(np.uint8).reshape(5, 7, 3)\n"
         "m = CvBridge().cv2_to_imgmsg(im, 'bgr8')\n"
-        "print(json.dumps({'types': [getCvType(e) for e in encs], 'msg': [m.height, m.width, "
+        "import cv2\n"
+        "shift = cv2.CV_8UC2.bit_length() - 1\n"
+        "print(json.dumps({'types': [getCvType(e) for e in encs], 'shift': shift, "
+        "'msg': [m.height, m.width, "
         "m.encoding, m.is_bigendian, m.step, m.data.hex()], "
         "'rgb': CvBridge().imgmsg_to_cv2(m, 'rgb8').tobytes().hex()}))\n"
     )
@@ -89,7 +93,13 @@ def test_matches_debians_cv_bridge():
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     ref = json.loads(out.stdout)
-    assert [getCvType(e) for e in ENCODINGS] == ref["types"]
+    import cv2
+
+    def decoded(types: list, shift: int) -> list:  # (depth, channels): the same in any OpenCV
+        return [(t & ((1 << shift) - 1), (t >> shift) + 1) for t in types]
+
+    ours = cv2.CV_8UC2.bit_length() - 1
+    assert decoded([getCvType(e) for e in ENCODINGS], ours) == decoded(ref["types"], ref["shift"])
     image = (np.arange(5 * 7 * 3) % 251).astype(np.uint8).reshape(5, 7, 3)
     bridge = CvBridge()
     msg = bridge.cv2_to_imgmsg(image, "bgr8")
@@ -139,11 +149,17 @@ for fn, args in calls:
         out.append([str(r.dtype), list(r.shape), r.tobytes().hex()])
     except Exception as exc:
         out.append(["RuntimeError" if isinstance(exc, RuntimeError) else type(exc).__name__, str(exc)])
-out.append([[CV_MAT_CNWrap(t), CV_MAT_DEPTHWrap(t)] for t in (0, 16, 21, 30, 6 + 8 * 3)])
+# type codes of each side's own OpenCV (OpenCV 5 shifts channels by 5 bits, 4 by 3)
+import cv2
+shift = cv2.CV_8UC2.bit_length() - 1
+out.append([[CV_MAT_CNWrap(t), CV_MAT_DEPTHWrap(t)] for t in (
+    depth + ((channels - 1) << shift)
+    for depth, channels in ((0, 1), (0, 3), (5, 3), (3, 4), (6, 4), (0, 5)))])
 print(json.dumps(out))
 '''
 
 
+@pytest.mark.slow
 def test_display_conversion_matches_debians_extension():
     """cv_bridge.boost's cvtColorForDisplay (label colours, scaling, guessing the output) and
     cvtColor2 give Debian's C++ extension's pixels, and its refusals with its texts."""
@@ -161,3 +177,44 @@ def test_display_conversion_matches_debians_extension():
     theirs = json.loads(out.stdout)
     for i, (a, b) in enumerate(zip(mine, theirs)):
         assert a == b, f"case {i}"
+
+
+# cv_bridge's generic encodings (cv_bridge.cpp's getCvType: a depth with any number of
+# channels, or a bare depth for one): ROS's own tests send 5-channel images and ask for "8U"
+
+def test_generic_encodings_beyond_four_channels_and_bare_depths():
+    import cv2
+
+    from cv_bridge import CvBridge, CvBridgeError, getCvType
+
+    assert getCvType("8U") == cv2.CV_8UC1
+    assert getCvType("32F") == cv2.CV_32FC1
+    assert getCvType("8UC5") == cv2.CV_8UC(5)
+    assert getCvType("64FC10") == cv2.CV_64FC(10)
+    for bad in ("8UC0", "8UC513", "8UCX", "9U"):
+        with pytest.raises(CvBridgeError):
+            getCvType(bad)
+    bridge = CvBridge()
+    assert bridge.encoding_to_dtype_with_channels("16SC7") == ("int16", 7)
+    assert bridge.cvtype2_to_dtype_with_channels(cv2.CV_16SC(7)) == ("int16", 7)
+
+
+@pytest.mark.parametrize("dtype", ["uint8", "int8", "uint16", "int16", "int32", "float32",
+                                   "float64"])
+def test_a_five_channel_image_round_trips(dtype):
+    """As ROS's conversions.py test_encode_decode_cv2 does, channels 1 to 5."""
+    from cv_bridge import CvBridge
+
+    bridge = CvBridge()
+    original = np.arange(6 * 4 * 5).astype(dtype).reshape(6, 4, 5)
+    msg = bridge.cv2_to_imgmsg(original)
+    assert msg.encoding == bridge.dtype_with_channels_to_cvtype2(np.dtype(dtype), 5)
+    back = bridge.imgmsg_to_cv2(msg)
+    assert back.dtype == original.dtype and back.shape == original.shape
+    assert (back == original).all()
+    # an explicit encoding of the same type is accepted, another one refused
+    bridge.cv2_to_imgmsg(original, msg.encoding)
+    from cv_bridge import CvBridgeError
+
+    with pytest.raises(CvBridgeError):
+        bridge.cv2_to_imgmsg(original, "rgb8")

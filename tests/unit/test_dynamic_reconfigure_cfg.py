@@ -113,6 +113,7 @@ def test_cfg_that_never_generates_or_exits_nonzero(tmp_path: Path) -> None:
         run_cfg(path)
 
 
+@pytest.mark.slow
 def test_running_a_cfg_by_hand_says_how_it_is_used(tmp_path: Path) -> None:
     path = tmp_path / "Tutorials.cfg"
     path.write_text(TUTORIAL_CFG)
@@ -121,6 +122,7 @@ def test_running_a_cfg_by_hand_says_how_it_is_used(tmp_path: Path) -> None:
     assert out.stderr.startswith("ahhhh! Unexpected command line syntax!")
 
 
+@pytest.mark.slow
 def test_import_hook_serves_cfg_modules(tmp_path: Path) -> None:
     _package(tmp_path / "src", "dynamic_tutorials", {"Tutorials": TUTORIAL_CFG})
     _package(tmp_path / "src", "other_pkg", {"Named": GROUPS_CFG})  # generates GroupsConfig
@@ -144,6 +146,7 @@ def test_import_hook_serves_cfg_modules(tmp_path: Path) -> None:
     assert lines[1].startswith("missing: ") and "cfg/Missing.cfg" in lines[1]
 
 
+@pytest.mark.slow
 def test_import_of_a_broken_cfg_raises_one_line_import_error(tmp_path: Path) -> None:
     broken = TUTORIAL_CFG.replace('"Hello World")', '"Hello World", 1, 2)')
     pkg = _package(tmp_path / "src", "broken_pkg", {"Tutorials": broken})
@@ -155,6 +158,7 @@ def test_import_of_a_broken_cfg_raises_one_line_import_error(tmp_path: Path) -> 
                           "specified for str_param, which is of 'str' type\n")
 
 
+@pytest.mark.slow
 def test_catkin_make_checks_cfg_and_writes_modules(tmp_path: Path) -> None:
     from minros.workspace import catkin
 

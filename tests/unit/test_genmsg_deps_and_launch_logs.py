@@ -50,6 +50,7 @@ def test_msg_dependencies_are_transitive(msg_tree: dict):
         genmsg.deps.find_msg_dependencies("demo", str(root / "demo/msg/Broken.msg"), paths)
 
 
+@pytest.mark.slow
 def test_roslaunch_logs_without_a_master(tmp_path: Path):
     env = {"PATH": "/usr/bin:/bin", "ROS_MASTER_URI": "http://127.0.0.1:9/",
            "ROS_LOG_DIR": str(tmp_path / "logs"), "HOME": str(tmp_path)}

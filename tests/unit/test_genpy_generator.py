@@ -79,6 +79,7 @@ def test_generated_service_module_names_its_classes_and_md5():
     assert SetBool._response_class().deserialize(buff.getvalue()).message == "ok"
 
 
+@pytest.mark.slow
 def test_genmsg_py_command_line_writes_a_package(tmp_path: Path):
     msg_dir = tmp_path / "msg"
     msg_dir.mkdir()

@@ -6,6 +6,11 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
+# each test starts a process (see the slow marker in pyproject.toml)
+pytestmark = pytest.mark.slow
+
 
 def run(code: str, ros_package_path: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,

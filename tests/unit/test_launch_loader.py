@@ -38,6 +38,7 @@ def test_tutorial_launch_files_parse():
     assert [n.resolved_name for n in multi.nodes] == ["/turtlesim1/turtlesim", "/turtlesim2/turtlesim"]
 
 
+@pytest.mark.slow
 def test_param_types_and_sources(tmp_path: Path):
     text_file = write(tmp_path, "t.txt", "some text\n")
     bin_file = tmp_path / "b.bin"
@@ -200,6 +201,7 @@ def test_missing_top_level_arg():
     assert cfg.params["/x"] == 4
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("xml,message", [
     ("<launch><param name='x' value='1'</launch>", "<string>:1: Invalid roslaunch XML syntax: not well-formed"),
     ("<notlaunch/>", "<string>:1: Invalid roslaunch XML syntax: no root <launch> tag"),

@@ -535,6 +535,7 @@ def test_the_command_lists_and_refuses_in_one_line(tmp_path, capsys):
     assert "not an exercise number" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # over half a CPU-second of its own
 def test_an_exercise_whose_traces_grow_too_big_stops(tmp_path):
     import threading
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import logging
 import logging.handlers
 
+import pytest
+
 from minros import logfiles
 from minros.logfiles import RotatingLog
 
@@ -79,6 +81,7 @@ def test_rotate_copy_truncate_keeps_the_writer_appending(tmp_path):
     assert not logfiles.rotate_copy_truncate(tmp_path / "missing.log")
 
 
+@pytest.mark.slow
 def test_roslaunch_rotates_the_console_logs_of_its_processes(tmp_path, monkeypatch):
     import sys
     import time

@@ -16,9 +16,13 @@ import pytest
 from minros.master import MasterHandler
 from support import REFERENCE_PYTHON, reference_env, require_reference
 
+# each test starts a process (see the slow marker in pyproject.toml)
+pytestmark = pytest.mark.slow
+
 _ORACLE = r"""
 import json, sys
 import rosmaster.master_api as api
+
 
 class Recorder:
     def __init__(self):

@@ -7,8 +7,13 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
+
 from minros.msgs import registry
 from minros.msgs.testing import bundled_types
+
+# each test starts a process (see the slow marker in pyproject.toml)
+pytestmark = pytest.mark.slow
 
 
 def test_every_bundled_type_runs_as_its_own_module(tmp_path):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from minros.msgs import write_stub_package
 from support import run_python
 
@@ -19,6 +21,7 @@ def _make_package(root: Path, name: str = "my_pkg") -> Path:
     return pkg
 
 
+@pytest.mark.slow
 def test_import_hook_finds_user_packages(tmp_path: Path) -> None:
     _make_package(tmp_path / "src")
     code = (
@@ -38,6 +41,7 @@ def test_import_hook_finds_user_packages(tmp_path: Path) -> None:
     assert out.stdout.split() == ["my_pkg/Num", "6a2e34150c00229791cc89ff309fff21"]
 
 
+@pytest.mark.slow
 def test_import_hook_leaves_other_imports_alone(tmp_path: Path) -> None:
     _make_package(tmp_path / "src")
     code = (
@@ -59,6 +63,7 @@ def test_import_hook_leaves_other_imports_alone(tmp_path: Path) -> None:
     assert out.stdout.startswith("ok cannot import name 'Missing'")
 
 
+@pytest.mark.slow
 def test_write_stub_package(tmp_path: Path) -> None:
     _make_package(tmp_path / "src")
     devel = tmp_path / "devel" / "lib" / "python3" / "dist-packages"
@@ -79,6 +84,7 @@ def test_write_stub_package(tmp_path: Path) -> None:
     assert out.stdout.split() == ["my_pkg.msg", "my_pkg/AddTwoRequest"]
 
 
+@pytest.mark.slow
 def test_bundled_stub_packages_import_without_ros() -> None:
     code = ("from std_msgs.msg import String\nfrom std_srvs.srv import Empty, EmptyResponse\n"
             "from turtlesim.srv import Spawn, SpawnRequest\nfrom rospy_tutorials.srv import AddTwoInts\n"
@@ -104,6 +110,7 @@ def test_missing_embedded_type_names_the_user(tmp_path: Path, monkeypatch) -> No
                            "unknown type [typo_pkg/Pionts]: no file msg/Pionts.msg")
 
 
+@pytest.mark.slow
 def test_misspelled_field_type_says_which_type_file_and_line(tmp_path: Path) -> None:
     """``from pkg.msg import M`` names the unknown type, the file and line that use it, and
     the likely fix, where Python would say "cannot import name 'M' ... (unknown location)"."""

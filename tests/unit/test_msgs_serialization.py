@@ -331,6 +331,7 @@ def test_numpy_msg_arrays_are_views_of_the_buffer() -> None:
     assert cloud.data.tobytes() == b"\x01" * 16
 
 
+@pytest.mark.slow
 def test_importing_messages_does_not_import_numpy() -> None:
     import subprocess
     import sys

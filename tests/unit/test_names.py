@@ -172,6 +172,7 @@ def _cases():
     return cases
 
 
+@pytest.mark.slow
 def test_matches_rosgraph_names_oracle():
     require_reference()
     cases = _cases()

@@ -10,7 +10,12 @@ import os
 import subprocess
 from pathlib import Path
 
+import pytest
+
 from support import PYTHON, REFERENCE_PYTHON, reference_env, require_reference
+
+# each test starts a process (see the slow marker in pyproject.toml)
+pytestmark = pytest.mark.slow
 
 UI = """<?xml version="1.0" encoding="UTF-8"?>
 <ui version="4.0">
@@ -53,6 +58,7 @@ print(json.dumps(out, sort_keys=True))
 
 NO_BINDING = r'''
 import sys
+
 sys.SELECT_QT_BINDING = "tk"
 try:
     import python_qt_binding

@@ -32,6 +32,7 @@ def rosclean(env_home: Path, *args: str, stdin: str = "") -> subprocess.Complete
                           capture_output=True, text=True, env=env, timeout=60)
 
 
+@pytest.mark.slow
 def test_check_prints_what_du_prints(tmp_path: Path):
     log = make_logs(tmp_path)
     out = rosclean(tmp_path, "check")
@@ -42,6 +43,7 @@ def test_check_prints_what_du_prints(tmp_path: Path):
     assert clean.get_disk_usage(str(log)) >= 2_500_000
 
 
+@pytest.mark.slow
 def test_purge_asks_and_n_keeps_everything(tmp_path: Path):
     log = make_logs(tmp_path)
     out = rosclean(tmp_path, "purge", stdin="maybe\nn\n")
@@ -49,6 +51,7 @@ def test_purge_asks_and_n_keeps_everything(tmp_path: Path):
     assert log.is_dir() and len(list(log.iterdir())) == 3
 
 
+@pytest.mark.slow
 def test_purge_to_size_drops_the_oldest(tmp_path: Path):
     log = make_logs(tmp_path)
     out = rosclean(tmp_path, "purge", "-y", "--size", "2")
@@ -58,6 +61,7 @@ def test_purge_to_size_drops_the_oldest(tmp_path: Path):
     assert "which is already below the requested threshold of 5 MB" in out.stdout
 
 
+@pytest.mark.slow
 def test_purge_y_removes_the_log_folder(tmp_path: Path):
     log = make_logs(tmp_path)
     assert rosclean(tmp_path, "purge", "-y").returncode == 0

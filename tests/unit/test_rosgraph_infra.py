@@ -125,6 +125,7 @@ def test_configure_logging_refuses_a_file_in_the_way(tmp_path: Path, monkeypatch
         rosgraph.roslogging.configure_logging("x", filename="blocker/x.log")
 
 
+@pytest.mark.slow
 def test_rosout_logger_made_before_roslogging_names_methods_too():
     """minros's node names the 'rosout' logger on import, possibly before roslogging's is
     imported: that logger still names a method's caller Class.method."""

@@ -44,6 +44,7 @@ def _run_monitor(pm: roslaunch.pmon.ProcessMonitor, limit: float = 10.0) -> None
         killer.cancel()
 
 
+@pytest.mark.slow
 def test_monitor_respawns_reports_and_ends_when_all_are_gone(capsys):
     pm = roslaunch.pmon.ProcessMonitor()
     quick = _local("quick", "raise SystemExit(3)")
@@ -74,6 +75,7 @@ def test_monitor_respawns_reports_and_ends_when_all_are_gone(capsys):
     assert "log file: " in err.err and quick.log_dir and os.path.isdir(quick.log_dir)
 
 
+@pytest.mark.slow
 def test_required_process_death_shuts_the_monitor_down(capsys):
     pm = roslaunch.pmon.ProcessMonitor()
     keeper = _local("keeper", "import time; time.sleep(30)")
@@ -86,6 +88,7 @@ def test_required_process_death_shuts_the_monitor_down(capsys):
     assert not keeper.is_alive()  # stopped on the monitor's exit
 
 
+@pytest.mark.slow
 def test_stop_escalates_from_sigint_to_sigterm_on_time():
     code = ("import signal, time, sys; signal.signal(signal.SIGINT, signal.SIG_IGN); "
             "print('up', flush=True); time.sleep(30)")

@@ -115,6 +115,7 @@ def test_stacks_on_the_package_path(workspace: Path):
     assert [d.stack for d in m.depends] == ["ros"] and m.version == "1.4.2"
 
 
+@pytest.mark.slow
 @pytest.mark.interop
 def test_same_fields_as_debians_roslib():
     need(reference_imports("roslib.manifestlib"), "Debian's roslib", "scripts/install-ros-reference.sh")

@@ -73,6 +73,7 @@ def test_master_class_serves_and_stops(monkeypatch):
     assert not master.ok()
 
 
+@pytest.mark.slow
 def test_rosmaster_main_runs_until_the_shutdown_call(tmp_path):
     port = free_port()
     code = "import rosmaster, sys; rosmaster.rosmaster_main(sys.argv)"

@@ -151,6 +151,7 @@ def test_deserialize_messages_keeps_the_tail_and_the_newest():
         rospy.msg.serialize_message(io.BytesIO(), 0, String(data=5))
 
 
+@pytest.mark.slow
 def test_shutdown_hooks_run_in_rospys_order_and_the_flag_resets():
     code = r'''
 import rospy.core as core

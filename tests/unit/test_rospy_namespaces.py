@@ -40,6 +40,7 @@ def test_from_rospy_core_import_star_gives_rospys_names():
     assert "threading" not in scope and "Any" not in scope  # only rospy's names
 
 
+@pytest.mark.slow
 def test_log_class_is_built_on_first_use_only():
     code = ("import sys, rospy, rospy.topics, rospy.service; "
             "assert not any(m.endswith('_Log') for m in sys.modules), 'built at import'; "

@@ -184,17 +184,34 @@ def test_sleep_raises_interrupt_on_shutdown(clock, monkeypatch):
         rostime.sleep(10)
 
 
-def test_wall_sleep_raises_interrupt_when_node_shuts_down(wallclock, monkeypatch):
+def test_wall_sleep_returns_when_node_shuts_down_and_raises_after(wallclock, monkeypatch):
+    """rospy's wall sleep raises nothing, so `while not rospy.is_shutdown(): rate.sleep()`
+    ends without a traceback on Ctrl-C; minros's returns early, and the second sleep a thread
+    begins after the shutdown raises, so a loop that never looks at is_shutdown() ends."""
     from minros import node
 
-    shut = threading.Event()
-    monkeypatch.setattr(node, "wait_for_shutdown", lambda timeout: shut.wait(timeout))
+    shut, waiting = threading.Event(), threading.Event()
+
+    def wait_for_shutdown(timeout):
+        waiting.set()
+        return shut.wait(timeout)
+
+    monkeypatch.setattr(node, "wait_for_shutdown", wait_for_shutdown)
     monkeypatch.setattr(rostime, "_node_is_shutdown", shut.is_set)
     t, result = in_thread(lambda: rostime.sleep(60))
+    assert waiting.wait(5)
     shut.set()
     t.join(5)
     assert not t.is_alive()
-    assert isinstance(result.get("error"), ROSInterruptException)
+    assert "error" not in result
+    # after the shutdown: the first sleep of a thread sleeps and returns, as rospy's (the
+    # Ctrl-C landed between a loop's is_shutdown() and its sleep); a second one raises
+    t, result = in_thread(lambda: (rostime.sleep(0.2), rostime.Rate(10).sleep()))
+    t.join(5)
+    assert not t.is_alive() and isinstance(result.get("error"), ROSInterruptException)
+    t, result = in_thread(lambda: (time.monotonic(), rostime.sleep(0.2), time.monotonic()))
+    t.join(5)
+    assert "error" not in result and result["value"][2] - result["value"][0] >= 0.2
 
 
 def test_wall_sleep_duration(wallclock):

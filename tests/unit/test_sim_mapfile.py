@@ -188,3 +188,176 @@ def test_any_yaml_or_image_file_loads_or_is_one_map_error(tmp_path_factory, text
             assert "\n" not in str(exc)
         else:
             assert grid.data.dtype == np.int8 and grid.data.ndim == 2
+
+
+# -- hostile map files: the size is read from the header, every failure is one line ----------
+
+
+def png_bytes(width: int, height: int, rows: int | None = None, colour: int = 0) -> bytes:
+    """A gray 8-bit PNG of ``width`` x ``height`` zeros (``rows`` of them compressed: fewer
+    makes a truncated file whose header still claims the whole size)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return (struct.pack(">I", len(body)) + kind + body
+                + struct.pack(">I", zlib.crc32(kind + body)))
+
+    channels = {0: 1, 2: 3, 6: 4}[colour]
+    compressor = zlib.compressobj(9)
+    row = bytes(1 + width * channels)
+    parts = []
+    left = height if rows is None else rows
+    while left > 0:
+        n = min(left, 100)
+        parts.append(compressor.compress(row * n))
+        left -= n
+    parts.append(compressor.flush())
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, colour, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", b"".join(parts))
+            + chunk(b"IEND", b""))
+
+
+def test_a_small_png_claiming_a_huge_picture_costs_no_memory(tmp_path):
+    """An attacker's 400 kB PNG of 20000 x 20000 zeros: refused from its header (it used to be
+    decoded first, 400 MB, then refused)."""
+    import subprocess
+    import sys
+
+    image = tmp_path / "huge.png"
+    path = write_map(tmp_path, np.zeros((1, 1), np.uint8), name="huge", image="huge.png")
+    image.write_bytes(png_bytes(20000, 20000))  # write_map wrote a 1 x 1 image over it
+    assert image.stat().st_size < 1_000_000
+    probe = ("import resource, sys\n"
+             "from minros.sim import mapfile\n"
+             "import cv2, numpy\n"
+             "before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+             "try:\n"
+             "    mapfile.load_map(sys.argv[1])\n"
+             "except mapfile.MapError as exc:\n"
+             "    print(exc)\n"
+             "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before)\n")
+    out = subprocess.run([sys.executable, "-c", probe, str(path)], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    message, grown_kb = out.stdout.strip().splitlines()
+    assert int(grown_kb) < 20_000, f"loading grew the peak RSS by {int(grown_kb) >> 10} MB"
+    assert "is too large (20000 x 20000 PNG" in message and "scale it down" in message
+    assert out.stderr == ""
+
+
+def test_a_png_beyond_opencvs_own_limit_is_one_line(tmp_path):
+    path = write_map(tmp_path, np.zeros((1, 1), np.uint8), name="vast", image="vast.png")
+    (tmp_path / "vast.png").write_bytes(png_bytes(60000, 60000, rows=10))
+    with pytest.raises(mapfile.MapError) as info:
+        mapfile.load_map(str(path))
+    assert "is too large (60000 x 60000 PNG" in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("image: m.png\nresolution: " + "[" * 10_000 + "]" * 10_000 + "\n", "nests too deeply"),
+    ("image: m.png\nresolution: " + "{a: " * 3000 + "1" + "}" * 3000 + "\n", "nests too deeply"),
+    ("image: m.png\nresolution: " + "9" * 5000 + "\n", "is not valid YAML: Exceeds the limit"),
+    ("image: m.png\nresolution: 1" + "0" * 400 + "\n", "resolution tag or it is invalid"),
+    ("image: m.png\nresolution: !!timestamp 2001-13-45\n", "is not valid YAML: month"),
+    ("origin: [0, 0, 1" + "0" * 400 + "]\n", "origin tag or it is invalid"),
+])
+def test_hostile_yaml_is_one_line(tmp_path, text, expected):
+    base = ("image: m.png\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+            "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    keys = {line.split(":")[0] for line in text.splitlines()}
+    kept = "".join(line + "\n" for line in base.splitlines() if line.split(":")[0] not in keys)
+    (tmp_path / "m.yaml").write_text(kept + text)
+    with pytest.raises(mapfile.MapError) as info:
+        mapfile.load_map(str(tmp_path / "m.yaml"))
+    assert expected in str(info.value) and "\n" not in str(info.value)
+    assert len(str(info.value)) < 400
+
+
+def _small(format_suffix: str, folder: Path) -> Path:
+    shape = (3, 5, 3) if format_suffix in (".ppm", ".webp") else (3, 5)
+    path = folder / f"small{format_suffix}"
+    assert cv2.imwrite(str(path), np.full(shape, 200, np.uint8))
+    return path
+
+
+@pytest.mark.parametrize("suffix, name", [
+    (".png", "PNG"), (".pgm", "PNM"), (".ppm", "PNM"), (".pbm", "PNM"), (".pam", "PAM"),
+    (".jpg", "JPEG"), (".bmp", "BMP"), (".tif", "TIFF"), (".webp", "WebP"),
+    (".ras", "Sun raster")])
+def test_image_headers_give_the_size_opencv_decodes(tmp_path, suffix, name):
+    path = _small(suffix, tmp_path)
+    header = mapfile.image_header(str(path))
+    assert (header.format, header.width, header.height) == (name, 5, 3)
+    assert mapfile.read_image(str(path)).shape[:2] == (3, 5)
+
+
+def _forged(kind: str) -> bytes:
+    """A few bytes whose header claims 40000 x 40000 pixels."""
+    import struct
+
+    n = 40000
+    if kind == "png":
+        return png_bytes(n, n, rows=1)
+    if kind == "pgm":
+        return b"P5\n# a comment\n%d %d\n255\n" % (n, n) + bytes(100)
+    if kind == "pam":
+        return b"P7\nWIDTH %d\nHEIGHT %d\nDEPTH 1\nMAXVAL 255\nENDHDR\n" % (n, n) + bytes(100)
+    if kind == "jpeg":
+        app0 = b"\xff\xe0" + struct.pack(">H", 16) + b"JFIF\x00\x01\x01\x00\x00\x01\x00\x01\x00\x00"
+        sof = b"\xff\xc0" + struct.pack(">HBHHB", 11, 8, n, n, 1) + b"\x01\x11\x00"
+        return b"\xff\xd8" + app0 + sof + bytes(100)
+    if kind == "bmp":
+        return b"BM" + struct.pack("<IHHI", 54, 0, 0, 54) + struct.pack("<IiiHH", 40, n, -n, 1, 8) + bytes(100)
+    if kind == "tiff":
+        entries = struct.pack("<HHII", 256, 4, 1, n) + struct.pack("<HHII", 257, 4, 1, n)
+        return b"II*\x00" + struct.pack("<I", 8) + struct.pack("<H", 2) + entries + bytes(100)
+    if kind == "webp":
+        body = b"VP8X" + struct.pack("<I", 10) + bytes(4) + (n - 1).to_bytes(3, "little") * 2
+        return b"RIFF" + struct.pack("<I", 4 + len(body)) + b"WEBP" + body
+    if kind == "gif":
+        return b"GIF89a" + struct.pack("<HH", n, n) + bytes(100)
+    assert kind == "ras"
+    return b"\x59\xa6\x6a\x95" + struct.pack(">IIII", n, n, 8, 0) + bytes(100)
+
+
+@pytest.mark.parametrize("kind", ["png", "pgm", "pam", "jpeg", "bmp", "tiff", "webp", "gif", "ras"])
+def test_forged_headers_are_refused_before_decoding(tmp_path, monkeypatch, kind):
+    (tmp_path / "forged.img").write_bytes(_forged(kind))
+
+    def no_decoding(*_args):
+        raise AssertionError("the image was handed to the decoder")
+
+    monkeypatch.setattr(mapfile, "_quiet_imread", no_decoding)
+    with pytest.raises(mapfile.MapError) as info:
+        mapfile.read_image(str(tmp_path / "forged.img"))
+    assert "is too large (40000 x 40000" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_formats_without_a_header_reader_are_refused(tmp_path):
+    path = tmp_path / "x.hdr"
+    assert cv2.imwrite(str(path), np.zeros((3, 5, 3), np.float32))
+    with pytest.raises(mapfile.MapError, match="not an image format map_server reads here"):
+        mapfile.read_image(str(path))
+
+
+def test_banded_conversion_matches_the_whole_image(monkeypatch):
+    rng = np.random.default_rng(5)
+    pixels = rng.integers(0, 256, (37, 11, 4), dtype=np.uint8)
+    whole = {m: mapfile.occupancy_from_pixels(pixels, False, 0.65, 0.196, m) for m in mapfile.MODES}
+    monkeypatch.setattr(mapfile, "_BAND_CELLS", 30)  # bands of 2 rows, the last one of 1
+    for mode in mapfile.MODES:
+        assert np.array_equal(mapfile.occupancy_from_pixels(pixels, False, 0.65, 0.196, mode),
+                              whole[mode])
+    assert np.array_equal(whole["trinary"][0], mapfile.occupancy_from_pixels(
+        pixels[-1:], False, 0.65, 0.196)[0])  # row 0 of the grid is the picture's last
+
+
+def test_map_server_says_a_huge_map_in_one_line(tmp_path, capsys):
+    from minros.nodes.map_server import map_server
+
+    path = write_map(tmp_path, np.zeros((1, 1), np.uint8), name="vast", image="vast.png")
+    (tmp_path / "vast.png").write_bytes(png_bytes(60000, 60000, rows=10))
+    assert map_server.main(["map_server", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("map_server: image file ")

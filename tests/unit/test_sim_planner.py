@@ -122,6 +122,7 @@ def drive(world: World, name: str, follower: planner.Follower, seconds: float, d
     return status
 
 
+@pytest.mark.slow  # over half a CPU-second of its own
 @pytest.mark.parametrize("goal", [(4.0, 0.0, math.pi / 2), (-3.0, -3.0, math.pi), (-2.5, 3.0, 0.0)])
 def test_the_follower_drives_a_simulated_robot_to_the_goal(rooms, goal):
     world = World(rooms)
@@ -175,5 +176,71 @@ def test_goal_quaternions_are_checked_as_move_base_does(q, problem):
     assert (found is None) if problem is None else (problem in found)
 
 
+@pytest.mark.parametrize("goal", [(math.nan, 0.0), (0.0, math.inf), (-math.inf, math.nan)])
+def test_non_finite_points_are_no_path_not_a_traceback(rooms, goal):
+    cost = planner.inflate(rooms, planner.CostmapParams())
+    with pytest.raises(planner.NoPath, match="not a finite position") as info:
+        planner.plan(rooms, cost, (0.0, 0.0), goal)
+    assert info.value.about_goal
+    with pytest.raises(planner.NoPath, match="not a finite position") as info:
+        planner.plan(rooms, cost, goal, (0.0, 0.0))
+    assert not info.value.about_goal
+    assert "nans or infs" in planner.position_problem(goal[0], goal[1], 0.0)
+    assert planner.position_problem(1.0, 2.0, 0.0) is None
+
+
 def test_yaw_of():
     assert planner.yaw_of(0.0, 0.0, math.sin(0.4), math.cos(0.4)) == pytest.approx(0.8)
+
+
+def test_recovery_behaviors_are_move_bases_default_list():
+    params = planner.ProgressParams()
+    assert [(b.name, b.kind, b.reset_distance) for b in planner.recovery_behaviors(params, 0.105)] == [
+        ("conservative_reset", "clear", 3.0), ("rotate_recovery", "rotate", 0.0),
+        ("aggressive_reset", "clear", pytest.approx(0.42)), ("rotate_recovery", "rotate", 0.0)]
+    no_turns = planner.ProgressParams(clearing_rotation_allowed=False)
+    assert [b.name for b in planner.recovery_behaviors(no_turns, 0.105)] == [
+        "conservative_reset", "aggressive_reset"]
+    marks = [(0.1, 0.1), (1.4, -1.4), (1.6, 0.0), (-0.2, 0.25)]
+    assert planner.clear_marks(marks, 0.0, 0.0, 3.0) == [(0.1, 0.1), (1.4, -1.4), (-0.2, 0.25)]
+    assert planner.clear_marks(marks, 0.0, 0.0, 0.42) == [(0.1, 0.1)]
+
+
+def test_progress_patience_recovery_list_and_abort():
+    progress = planner.Progress(planner.ProgressParams(controller_patience=15.0), 0.105, now=100.0)
+    progress.moved(100.0, 0.0, 0.0)
+    assert not progress.control_failed(115.0) and progress.control_failed(115.1)
+    # every behaviour once, in order; then None: abort with move_base's text
+    names = []
+    while (behavior := progress.next_recovery("controlling")) is not None:
+        names.append(behavior.name)
+        progress.recovered(116.0)
+    assert len(names) == 4
+    assert planner.EXHAUSTED["controlling"].startswith("Failed to find a valid control")
+    # a valid command starts the list again from the top (for the trigger that used it)
+    progress.controlled(120.0)
+    assert progress.next_recovery("controlling").name == "conservative_reset"
+    assert not progress.control_failed(130.0)
+    off = planner.Progress(planner.ProgressParams(recovery_behavior_enabled=False), 0.105, 0.0)
+    assert off.next_recovery("planning") is None
+
+
+def test_progress_oscillation_clock():
+    params = planner.ProgressParams(oscillation_timeout=10.0, oscillation_distance=0.2)
+    progress = planner.Progress(params, 0.105, now=0.0)
+    for t in range(0, 11):  # turning on the spot, 5 cm of drift
+        progress.moved(float(t), 0.005 * t, 0.0)
+    assert not progress.oscillating(10.0) and progress.oscillating(10.5)
+    assert progress.next_recovery("oscillation").name == "conservative_reset"
+    progress.recovered(11.0)  # the robot gets time again after each behaviour
+    assert not progress.oscillating(20.0)
+    progress.moved(21.0, 0.3, 0.0)  # 0.25 m from where the clock started: progress
+    assert progress.index == 0 and not progress.oscillating(30.0)
+    assert not planner.Progress(planner.ProgressParams(oscillation_timeout=0.0), 0.1,
+                                0.0).oscillating(1e9)
+
+
+def test_the_follower_says_what_blocks_it():
+    follower = planner.Follower([(0.0, 0.0), (1.0, 0.0)], 0.0)
+    v, w, status = follower.step(0.0, 0.0, 0.0, 0.05, np.array([[0.5, 0.0], [0.12, 0.14]]))
+    assert status == "blocked" and follower.blocking == pytest.approx((0.12, 0.14))

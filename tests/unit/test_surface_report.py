@@ -40,6 +40,7 @@ def test_exclusions_cover_subpackages_only_when_asked() -> None:
     assert surface.exclusion("rviz.srv") is None
 
 
+@pytest.mark.slow
 def test_worker_survives_hangs_crashes_and_noise(tmp_path: Path) -> None:
     lib = tmp_path / "lib"
     lib.mkdir()

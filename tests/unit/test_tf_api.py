@@ -11,6 +11,9 @@ import pytest
 
 from support import REFERENCE_PYTHON, reference_env, require_tf_reference
 
+# each test starts a process (see the slow marker in pyproject.toml)
+pytestmark = pytest.mark.slow
+
 SCRIPT = r'''
 import json, math
 import rospy
@@ -18,6 +21,7 @@ import tf
 import tf2_ros
 import tf2_geometry_msgs
 from geometry_msgs.msg import (PointStamped, PoseStamped, QuaternionStamped, TransformStamped,
+
                                Vector3Stamped, WrenchStamped)
 
 def stamped(parent, child, secs, xyz, rpy):

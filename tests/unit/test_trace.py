@@ -496,6 +496,7 @@ def test_pcap_subcommand_writes_a_file_and_says_how_to_open_it(tmp_path, capsys)
 # --------------------------------------------------------------------------- bad files
 
 
+@pytest.mark.slow
 def test_an_unwritable_trace_file_costs_one_line_and_nothing_else(tmp_path):
     target = tmp_path / "no" / "such" / "dir" / "t.jsonl"
     env = dict(os.environ, MINROS_TRACE=str(target))
@@ -510,6 +511,7 @@ def test_an_unwritable_trace_file_costs_one_line_and_nothing_else(tmp_path):
     assert "running without a trace" in done.stderr
 
 
+@pytest.mark.slow
 def test_minros_trace_runs_the_command_untraced_when_it_cannot_write(tmp_path):
     target = tmp_path / "missing" / "t.jsonl"
     done = subprocess.run([sys.executable, "-m", "minros", "trace", "-o", str(target), "--",
@@ -521,6 +523,7 @@ def test_minros_trace_runs_the_command_untraced_when_it_cannot_write(tmp_path):
     assert done.stderr.count("\n") == 1 and "cannot write the trace" in done.stderr
 
 
+@pytest.mark.slow
 def test_minros_trace_passes_the_exit_status_and_the_settings(tmp_path):
     target = tmp_path / "t.jsonl"
     code = ("import os, sys; e = os.environ; print(e['MINROS_TRACE'], e['MINROS_TRACE_MESSAGES'],"

@@ -46,3 +46,22 @@ def test_joints_and_transforms() -> None:
 def test_broken_descriptions(text: str, message: str) -> None:
     with pytest.raises(URDFError, match=message):
         parse_joints(text)
+
+
+def test_joint_state_publisher_takes_the_first_robot_of_a_urdf_root() -> None:
+    """A description whose root is <urdf> holding a <robot>: joint_state_publisher reads the
+    first <robot> of the document (Debian's: ``robot.getElementsByTagName('robot')[0]``), so
+    its joints are the robot's; robot_state_publisher's rule (urdfdom's: the root is the
+    <robot>) still refuses it."""
+    from minros.joint_state_publisher.joints import JointTable
+
+    robot = ROBOT.replace('<mimic joint="x" multiplier="2"/>', "")
+    wrapped = f'<urdf version="1">\n<!-- a comment -->\n{robot}\n</urdf>'
+    bare, inside = JointTable(robot), JointTable(wrapped)
+    assert inside.order == bare.order == ["j1", "j2"]
+    assert inside.free == bare.free and list(inside.free) == ["j1"]
+    assert [j.name for j in parse_joints(wrapped, robot_anywhere=True)] == ["j1", "j2"]
+    with pytest.raises(URDFError, match="root element is <urdf>, not <robot>"):
+        parse_joints(wrapped)
+    with pytest.raises(URDFError, match="root element is <urdf>, not <robot>"):
+        JointTable("<urdf><link name='a'/></urdf>")

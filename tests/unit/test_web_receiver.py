@@ -124,6 +124,7 @@ def receiver():
     r.close()
 
 
+@pytest.mark.slow  # over half a CPU-second of its own
 def test_many_subscriptions_share_one_receive_thread(receiver):
     pub = Publisher()
     before = threading.active_count()

@@ -249,3 +249,61 @@ def test_meta_round_trip_and_refusals():
                         (meta.encode(none) + b"x", "without a latched message")]:
         with pytest.raises(meta.MetaError, match=reason):
             meta.decode(bad)
+
+
+# -- what remote beacons may create -------------------------------------------------------------
+
+def test_the_first_heard_keep_their_bridges_under_the_cap():
+    from minros.zenoh.plan import limit_remote, remote_only
+
+    local = {R("sub", "/wanted"), R("pub", "/mine")}
+    remote = {R("pub", "/wanted"), R("pub", "/early"), R("sub", "/asked"), R("srv", "/svc"),
+              *(R("pub", f"/flood{i}") for i in range(10))}
+    first = {r.topic: float(i) for i, r in enumerate(sorted(remote, key=lambda r: r.name))}
+    first[("/early", "std_msgs/String", STRING_MD5)] = -1.0  # heard before the flood
+    first[("/svc", "std_msgs/String", STRING_MD5)] = -0.5
+    wanted = plan(local, remote)
+    only = remote_only(wanted, local)
+    assert ("/wanted", "std_msgs/String", STRING_MD5) not in only["inlets"]  # a local subscriber
+    limited, dropped = limit_remote(wanted, local, first, cap=3)
+    assert dropped == len(only["inlets"]) + len(only["outlets"]) + len(only["proxies"]) - 3
+    names = {t[0] for t in limited.inlets | limited.outlets | limited.proxies}
+    # what the local graph asks for is never dropped; of the rest, the first heard stay
+    assert {"/wanted", "/mine", "/early", "/svc"} <= names
+    assert len(names - {"/wanted", "/mine"}) == 3
+    assert limit_remote(wanted, local, first, cap=100) == (wanted, 0)
+
+
+def test_the_table_says_when_each_topic_was_first_heard_and_refuses_when_full():
+    from minros.zenoh.discovery import TableFull
+
+    table = RemoteTable(max_entries=2)
+    table.heard(_beacon("pub", "/a"), 1.0)
+    table.heard(_beacon("sub", "/a"), 2.0)
+    table.heard(_beacon("pub", "/a"), 5.0)  # a repeat keeps the first time
+    assert table.first_heard() == {("/a", "std_msgs/String", STRING_MD5): 1.0}
+    with pytest.raises(TableFull):
+        table.heard(_beacon("pub", "/b"), 5.0)
+    assert len(table) == 2
+
+
+def test_token_bucket_bound_log_and_chatter():
+    from minros.zenoh.discovery import BoundLog, Chatter, TokenBucket
+
+    bucket = TokenBucket(rate=10.0, burst=5.0, now=0.0)
+    assert sum(bucket.take(0.0) for _ in range(20)) == 5  # the burst, then nothing
+    assert sum(bucket.take(0.5) for _ in range(20)) == 5  # 0.5 s at 10/s, capped by the burst
+    lines = []
+    bound = BoundLog(lines.append, interval=60.0)
+    assert bound("count", "at the bound", 0.0)
+    assert not any(bound("count", "at the bound", t) for t in range(1, 60))
+    assert bound("count", "at the bound", 61.0)
+    assert lines == ["at the bound", "at the bound (59 more times since the last report)"]
+    said = []
+    chatter = Chatter(said.append, budget=3, interval=10.0)
+    for i in range(10):
+        chatter(f"bridging /t{i}", float(i) / 10)
+    chatter("bridging /late", 11.0)
+    assert said == ["bridging /t0", "bridging /t1", "bridging /t2",
+                    "7 more lines about bridges for remote beacons were not written (at most 3 "
+                    "every 10 s)", "bridging /late"]

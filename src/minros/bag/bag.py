@@ -181,6 +181,8 @@ class Bag:
         self._check_open()
         if self._writer is not None:
             return self._writer.tell()
+        if hasattr(self._reader, "size"):  # a rosbag2 directory: its files
+            return int(self._reader.size)
         if self._stream is not None:
             pos = self._stream.tell()
             size = self._stream.seek(0, os.SEEK_END)
@@ -574,9 +576,17 @@ def _check_stream(f: Any, mode: str) -> None:
 
 
 def open_reader(source: Union[str, BinaryIO], allow_unindexed: bool, keep_open: bool = False) -> Any:
-    """The reader of a bag v2.0 or MCAP file (by its first bytes)."""
+    """The reader of a bag v2.0 or MCAP file (by its first bytes), or of a ROS 2 recording (a
+    rosbag2 directory, a ROS 2 MCAP or SQLite file), whose messages it converts to ROS 1."""
     if isinstance(source, str) and not os.path.exists(source):
         raise ROSBagException(f"[Errno 2] No such file or directory: '{source}'")
+    if isinstance(source, str):
+        from minros.bag.ros2.storage import kind  # a few bytes read: which reader
+
+        if kind(source):
+            from minros.bag.ros2.reader import Rosbag2Reader
+
+            return Rosbag2Reader(source, allow_unindexed)
     if is_mcap(source):
         if not isinstance(source, str):
             raise ROSBagException("minros reads MCAP files by name: pass the file's name, not a file object")

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from typing import Any, Dict, List, Optional, Tuple
@@ -46,6 +47,8 @@ def _version_str(bag: Any) -> str:
     version = bag.version
     if version == "mcap":
         return "mcap (ros1 profile)"
+    if isinstance(version, str):  # a ROS 2 recording: what its reader says it is
+        return version
     return "%d.%d" % (int(version / 100), version % 100)
 
 
@@ -119,11 +122,18 @@ def info_text(bag: Any, with_freq: bool = False) -> str:
                 if t.connections > 1:
                     s += " (%d connections)" % t.connections
                 rows.append(("topics" if i == 0 else "", s))
+    rows += _extra_rows(bag)
     width = max(len(f) for f, _ in rows) + 1
     out = ""
     for name, value in rows:
         out += "%-*s %s\n" % (width, name + ":" if name else "", value)
     return out.rstrip()
+
+
+def _extra_rows(bag: Any) -> List[Tuple[str, str]]:
+    """What a reader adds of its own (a rosbag2 recording's ROS 2 types and skipped topics)."""
+    rows = getattr(getattr(bag, "_reader", None), "info_rows", None)
+    return list(rows()) if rows is not None else []
 
 
 def info_yaml(bag: Any, key: Optional[str] = None, with_freq: bool = False) -> Optional[str]:
@@ -154,9 +164,29 @@ def info_yaml(bag: Any, key: Optional[str] = None, with_freq: bool = False) -> O
                 s += "      connections: %d\n" % t.connections
             if t.frequency is not None:
                 s += "      frequency: %.4f\n" % t.frequency
+        s += _extra_yaml(bag)
     if not key:
         return s
     return _yaml_key(s, key)
+
+
+def _extra_yaml(bag: Any) -> str:
+    reader = getattr(bag, "_reader", None)
+    topics = getattr(reader, "topics", None)
+    if reader is None or not hasattr(reader, "info_rows") or topics is None:
+        return ""
+    s = "ros2_types:\n"
+    seen: Dict[str, str] = {}
+    for t in topics.values():
+        seen.setdefault(t.ros2_type, t.type_hash)
+    for name, digest in sorted(seen.items()):
+        s += "    - type: %s\n      type_hash: %s\n" % (name, digest or "''")
+    if reader.skipped:
+        s += "skipped:\n"
+        for topic, (ros2_type, reason) in sorted(reader.skipped.items()):
+            s += "    - topic: %s\n      type: %s\n      reason: %s\n" % (
+                topic, ros2_type, json.dumps(reason))
+    return s
 
 
 class _Obj:

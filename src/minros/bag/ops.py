@@ -10,7 +10,12 @@ from typing import Any, Callable, List, Optional
 
 from minros.bag import bag1
 from minros.bag.bag import Bag, is_mcap
-from minros.bag.errors import Compression, ROSBagException, ROSBagUnindexedException
+from minros.bag.errors import (
+    ROSBagEncryptException,
+    ROSBagEncryptNotSupportedException,
+    ROSBagException,
+    ROSBagUnindexedException,
+)
 from minros.bag.progress import ProgressMeter
 
 
@@ -106,47 +111,23 @@ def filter_bag(inbag_path: str, outbag_path: str, expr: str,
     return 0
 
 
-def _copy_messages(inbag: Bag, outbag: Bag, quiet: bool) -> None:
-    meter = None if quiet else ProgressMeter(outbag.filename, inbag._uncompressed_size)
-    total = 0
-    for topic, raw, t, header in inbag.read_messages(raw=True, return_connection_header=True):
-        outbag.write(topic, raw, t, raw=True, connection_header=header)
-        if meter is not None:
-            total += len(raw[1])
-            meter.step(total)
-    if meter is not None:
-        meter.finish()
+# -- the in-place operations (compress, decompress, reindex): one walk over the bags
 
-
-def _reindex_into(path: str, quiet: bool) -> None:
-    meter = None if quiet else ProgressMeter(path, os.path.getsize(path))
-    scan = bag1.reindex_in_place(path, None if meter is None else meter.step)
-    if meter is not None:
-        meter.finish()
-    if scan.skipped:  # damage in the middle (a file that is only cut short is the usual case)
-        more = f" and {len(scan.skipped) - 1} more place(s)" if len(scan.skipped) > 1 else ""
-        kept = sum(sum(c.counts.values()) for c in scan.chunks)
-        _err(f"WARNING {path}: skipped damaged data ({scan.skipped[0]}){more}; kept {kept} messages")
-
-
-def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
-           output_dir: Optional[str] = None, force: bool = False, quiet: bool = False) -> int:
-    """compress / decompress / reindex each bag, keeping the original as ``NAME.orig.EXT``
-    when writing in place (rosbag's bag_op)."""
+def _each_bag(paths: List[str], prepare: Callable[[str], bool],
+              run: Callable[[str, str, bool], None], output_dir: Optional[str],
+              force: bool, quiet: bool) -> None:
+    """For each bag: ``prepare(path)`` checks that it can be read and says whether to start
+    from a copy of it (a ROSBagException or OSError is reported and the bag skipped); the
+    output is the bag itself (the input kept as ``NAME.orig.EXT``, moved or copied) or its
+    name in ``output_dir``; then ``run(source, out, copy)``. Ctrl-C puts the original back."""
     for path in paths:
-        reindex = op == "reindex"
-        if reindex and is_mcap(path):
-            _err(f"ERROR reading {path}: reindexing MCAP files is not supported by minros")
-            continue
         try:
-            if reindex:  # the scan reads the whole file: here only what makes it a bag
-                bag1.check_version(path)
-            else:
-                Bag(path, "r").close()
+            copy = prepare(path)
         except (ROSBagException, OSError) as exc:
             _read_error(path, exc)
             continue
         out = path if output_dir is None else os.path.join(output_dir, os.path.basename(path))
+        backup = None
         source = path
         if out == path:
             root, ext = os.path.splitext(path)
@@ -156,42 +137,125 @@ def bag_op(paths: List[str], op: str, compression: str = Compression.NONE,
                     _err(f"Skipping {path}. Backup path {backup} already exists.")
                 continue
             try:
-                if reindex:
-                    shutil.copy(path, backup)
-                else:
-                    os.rename(path, backup)
+                (shutil.copy if copy else os.rename)(path, backup)
             except OSError as exc:
-                _err(f"ERROR {'copying' if reindex else 'moving'} {path} to {backup}: {exc}")
+                _err(f"ERROR {'copying' if copy else 'moving'} {path} to {backup}: {exc}")
                 continue
             source = backup
-        elif reindex:
+        elif copy:
             shutil.copy(path, out)
+            source = out
         try:
-            if reindex:
-                _reindex_into(out, quiet)
-                continue
-            inbag = Bag(source)
-            try:
-                outbag = Bag(out, "w", compression=compression)
-            except (ROSBagException, OSError) as exc:
-                _err(f"ERROR writing to {out}: {exc}")
-                inbag.close()
-                continue
-            try:
-                _copy_messages(inbag, outbag, quiet)
-            finally:
-                outbag.close()
-                inbag.close()
+            run(source, out, copy)
         except KeyboardInterrupt:
-            if source != path:
+            if backup is not None:
                 try:
-                    if reindex:
-                        os.remove(source)
+                    if copy:
+                        os.remove(backup)
                     else:
-                        os.rename(source, path)
+                        os.rename(backup, path)
                 except OSError:
                     pass
             raise
         except (ROSBagException, OSError) as exc:
             _err(f"ERROR operating on {path}: {exc}")
+
+
+def bag_op(inbag_filenames: List[str], allow_unindexed: bool, open_inbag: bool,
+           copy_fn: Callable[[Any], bool], op: Callable[..., None],
+           output_dir: Optional[str] = None, force: bool = False, quiet: bool = False) -> None:
+    """rosbag_main's bag_op: run ``op(inbag, outbag, quiet=quiet)`` on each bag, writing in
+    place (the input kept as ``NAME.orig.EXT``) or into ``output_dir``. ``copy_fn(bag)`` says
+    whether to start from a copy of the input (opened for appending) rather than an empty
+    bag; without ``open_inbag``, ``op`` gets the input's file name."""
+    def prepare(path: str) -> bool:
+        if not open_inbag:
+            return False
+        with Bag(path, "r", allow_unindexed=allow_unindexed) as inbag:
+            return bool(copy_fn(inbag))
+
+    def run(source: str, out: str, copy: bool) -> None:
+        inbag: Any = Bag(source, "r", allow_unindexed=allow_unindexed) if open_inbag else source
+        try:
+            try:
+                outbag = Bag(out, "a" if copy else "w", allow_unindexed=allow_unindexed)
+            except (ROSBagException, OSError) as exc:
+                _err(f"ERROR writing to {out}: {exc}")
+                return
+            try:
+                op(inbag, outbag, quiet=quiet)
+            except ROSBagException as exc:
+                _err(f"\nERROR operating on {source}: {exc}")
+            finally:
+                outbag.close()
+        finally:
+            if open_inbag:
+                inbag.close()
+
+    _each_bag(inbag_filenames, prepare, run, output_dir, force, quiet)
+
+
+def change_compression_op(inbag: Bag, outbag: Bag, compression: str, quiet: bool) -> None:
+    """Copy every message of ``inbag`` into ``outbag`` with ``compression`` (as recorded:
+    raw bytes, connection headers kept), with rosbag's progress bar unless ``quiet``."""
+    outbag.compression = compression
+    meter = None if quiet else ProgressMeter(outbag.filename, inbag._uncompressed_size)
+    total = 0
+    for topic, msg, t, header in inbag.read_messages(raw=True, return_connection_header=True):
+        outbag.write(topic, msg, t, raw=True, connection_header=header)
+        if meter is not None:
+            total += len(msg[1])
+            meter.step(total)
+    if meter is not None:
+        meter.finish()
+
+
+def reindex_op(inbag: Bag, outbag: Bag, quiet: bool) -> None:
+    """rosbag_main's reindex_op: rebuild ``outbag``'s index (a copy of ``inbag`` opened for
+    appending) from its chunks; damage past the last good chunk ends the scan, as in rosbag."""
+    meter = None if quiet else ProgressMeter(outbag.filename, outbag.size)
+    try:
+        for offset in outbag.reindex():
+            if meter is not None:
+                meter.step(offset)
+    except (ROSBagEncryptNotSupportedException, ROSBagEncryptException):
+        raise
+    except Exception:  # noqa: BLE001 - damage past the last good chunk ends the scan, as in rosbag
+        pass
+    if meter is not None:
+        meter.finish()
+
+
+def compress(paths: List[str], compression: str, output_dir: Optional[str] = None,
+             force: bool = False, quiet: bool = False) -> int:
+    """``rosbag compress`` (``compression`` bz2 or lz4) and ``decompress`` (``none``)."""
+    def op(inbag: Bag, outbag: Bag, quiet: bool) -> None:
+        change_compression_op(inbag, outbag, compression, quiet)
+
+    bag_op(paths, False, True, lambda bag: False, op, output_dir, force, quiet)
+    return 0
+
+
+def reindex(paths: List[str], output_dir: Optional[str] = None, force: bool = False,
+            quiet: bool = False) -> int:
+    """``rosbag reindex``: the index rebuilt in a copy of each bag. Unlike rosbag's, the scan
+    goes past damage in the middle (to the next chunk it can read) and says what it skipped;
+    only the first line is read before copying (rosbag opens the whole bag to look at it)."""
+    def prepare(path: str) -> bool:
+        if is_mcap(path):
+            raise ROSBagException("reindexing MCAP files is not supported by minros")
+        bag1.check_version(path)
+        return True
+
+    def run(_source: str, out: str, _copy: bool) -> None:
+        meter = None if quiet else ProgressMeter(out, os.path.getsize(out))
+        scan = bag1.reindex_in_place(out, None if meter is None else meter.step)
+        if meter is not None:
+            meter.finish()
+        if scan.skipped:  # damage in the middle (a file only cut short is the usual case)
+            more = f" and {len(scan.skipped) - 1} more place(s)" if len(scan.skipped) > 1 else ""
+            kept = sum(sum(c.counts.values()) for c in scan.chunks)
+            _err(f"WARNING {out}: skipped damaged data ({scan.skipped[0]}){more}; kept {kept} messages")
+
+    _each_bag(paths, prepare, run, output_dir, force, quiet)
     return 0

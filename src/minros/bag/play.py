@@ -1,5 +1,9 @@
 """``rosbag play``: publish the stored bytes of one or more bags at their recorded pace.
 
+ROS 2 recordings (rosbag2 directories, ROS 2 MCAP) play too: their reader
+(:mod:`minros.bag.ros2.reader`) hands over each message converted to ROS 1 bytes, under the
+ROS 1 type ros1_bridge's rules give it, so ROS 1 nodes can be fed from ROS 2 recordings.
+
 Each topic is advertised with the type, md5sum, definition and latching of the connection it
 was recorded from, and a message is sent as the bytes in the bag, so types nobody installed
 play all the same. Send times follow the bag's receive times, scaled by ``-r``: the player
@@ -143,16 +147,23 @@ class Player:
         for path in self.opts.bags:
             minros.loginfo(f"Opening {path}")
             try:
-                self.readers.append(open_reader(path, allow_unindexed=False))
+                reader = open_reader(path, allow_unindexed=False)
             except ROSBagException as exc:
                 raise ROSBagException(f"Error opening file: {path}: {exc}") from None
+            self.readers.append(reader)
+            # a ROS 2 recording plays converted to ROS 1: what does not convert is named
+            for topic, (ros2_type, reason) in sorted(getattr(reader, "skipped", {}).items()):
+                if self._selected_topic(topic):
+                    minros.logwarn(f"{topic} [{ros2_type}] is not played: {reason}")
 
     def _selected(self, conn: ConnInfo) -> bool:
+        return self._selected_topic(conn.topic)
+
+    def _selected_topic(self, topic: str) -> bool:
         if not self.opts.topics:
             return True
         wanted = {t if t.startswith("/") else "/" + t for t in self.opts.topics}
-        topic = conn.topic if conn.topic.startswith("/") else "/" + conn.topic
-        return topic in wanted
+        return (topic if topic.startswith("/") else "/" + topic) in wanted
 
     def advertise(self) -> None:
         import minros

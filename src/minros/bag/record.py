@@ -6,6 +6,11 @@ megabytes, the oldest message dropped and counted per topic when full) and a wri
 puts it in the bag. The writer closes a chunk at least every :data:`FLUSH_INTERVAL` seconds and
 hands it to the kernel, so a recorder killed with SIGKILL loses at most that much: the
 ``.bag.active`` file it leaves is recovered by ``rosbag reindex``.
+
+``--duration`` and ``--size`` are rosbag's: the recording ends at the first message received
+more than DURATION after it began (ROS time, checked also every quarter second while nothing
+arrives), or bigger than SIZE MB; with ``--split`` a new file begins instead, at every
+DURATION from the start (empty files too, as ROS's recorder makes them).
 """
 
 from __future__ import annotations
@@ -56,14 +61,19 @@ class RecordOptions:
     publish: bool = False
 
 
+#: a number as ROS's recorder reads one (C++ stream extraction of a double), then a unit
+_DURATION = re.compile(r"\s*(\+?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*([smh]?)\s*")
+
+
 def parse_duration(text: str) -> float:
     """``--duration``: seconds, or minutes/hours with an ``m``/``h`` suffix."""
-    m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+)\s*([smh]?)\s*", text)
+    m = _DURATION.fullmatch(text)
     if not m:
-        raise ValueError(f"Duration '{text}' is not a number of seconds, optionally followed by 'm' or 'h'")
+        raise ValueError(f"Duration '{text}' is not a number of seconds, optionally followed by "
+                         "'s', 'm' or 'h' (e.g. --duration 30, --duration 1.5m)")
     value = float(m.group(1)) * {"": 1, "s": 1, "m": 60, "h": 3600}[m.group(2)]
     if value <= 0:
-        raise ValueError("Split duration must be greater than 0")
+        raise ValueError(f"Duration '{text}' must be greater than 0")
     return value
 
 
@@ -148,10 +158,13 @@ class BagSink:
     """The writer thread's state: the open bag, its connections, splitting and flushing."""
 
     def __init__(self, opts: RecordOptions, log: Callable[[str, str], None],
-                 on_open: Optional[Callable[[str], None]] = None) -> None:
+                 on_open: Optional[Callable[[str], None]] = None,
+                 clock: Optional[Callable[[], int]] = None) -> None:
         self.opts = opts
         self.log = log
         self.on_open = on_open
+        #: the node's ROS time in ns, read while no message arrives (--duration)
+        self.clock = clock
         self.writer: Any = None
         self.target = ""
         self.active = ""
@@ -159,11 +172,14 @@ class BagSink:
         self.conn_ids: Dict[tuple, int] = {}
         self.opened_at = 0.0
         self.chunk_started = 0.0
-        self.first_time: Optional[int] = None
         self.split_files: Deque[str] = collections.deque()
         self.latched: Dict[Tuple[str, str], Item] = {}
-        self.max_size = opts.size_mb * 1048576 if opts.split or opts.size_mb else 0
-        self.max_duration = parse_duration(opts.duration) if opts.duration else 0.0
+        self.max_size = opts.size_mb * 1048576
+        self.max_duration = round(parse_duration(opts.duration) * 1e9) if opts.duration else 0
+        #: ROS time (ns) the recording began, then of the current split's period
+        self.start_ns: Optional[int] = None
+        #: --duration or --size reached without --split: the recording is over
+        self.finished = False
         self.error: Optional[str] = None
 
     # the file --------------------------------------------------------------------------
@@ -175,7 +191,6 @@ class BagSink:
             os.unlink(self.active)
         self.writer = open_writer(self.active, self.opts.compression, self.opts.chunksize_kb * 1024)
         self.conn_ids = {}
-        self.first_time = None
         self.opened_at = self.chunk_started = time.monotonic()
         self.log("info", f"Recording to '{self.target}'.")
         if self.on_open is not None:
@@ -212,27 +227,53 @@ class BagSink:
                                          header.get("callerid"), header.get("latching"))
             self.conn_ids[key] = cid
         self.writer.write(cid, t_ns, data)
-        if self.first_time is None:
-            self.first_time = t_ns
+
+    def start(self, start_ns: int) -> None:
+        """The recording begins at ROS time ``start_ns`` (--duration counts from here)."""
+        self.start_ns = start_ns
 
     def write(self, item: Item) -> None:
+        """Write one message, unless the bag's size or the message's time ends the recording
+        (as ROS's recorder: the size is looked at first, then the time)."""
         if self.writer is None:
             self.open_next()
-        elif self._should_split(item[1]):
-            self.close_current()
-            self.split_index = (self.split_index or 0) + 1
-            self.open_next()
+        if self.start_ns is None:
+            self.start_ns = item[1]
+        if self.finished or self.check_size() or self.check_duration(item[1]):
+            return
         if self.opts.repeat_latched and item[3].get("latching") == "1":
             self.latched[(item[0], item[3].get("callerid", ""))] = item
         self._write(item)
 
-    def _should_split(self, t_ns: int) -> bool:
-        if not self.opts.split:
+    def _next_split(self) -> None:
+        self.close_current()
+        self.split_index = (self.split_index or 0) + 1
+        self.open_next()
+
+    def check_size(self) -> bool:
+        """--size: past it, the next split begins, or without --split the recording ends
+        (True)."""
+        if not self.max_size or self.writer is None or self.writer.tell() <= self.max_size:
             return False
-        if self.max_size and self.writer.tell() > self.max_size:
+        if self.opts.split:
+            self._next_split()
+            return False
+        self.finished = True
+        return True
+
+    def check_duration(self, t_ns: int) -> bool:
+        """--duration at ROS time ``t_ns``: more than DURATION after the start, the next split
+        begins, or without --split the recording ends (True)."""
+        if not self.max_duration or self.start_ns is None or \
+                t_ns - self.start_ns <= self.max_duration:
+            return False
+        if not self.opts.split:
+            self.finished = True
             return True
-        if self.max_duration and self.first_time is not None:
-            return (t_ns - self.first_time) / 1e9 >= self.max_duration
+        # the period that holds t_ns; ROS's recorder writes one empty file for each period
+        # skipped, which a clock leaping ahead would turn into millions: one file here
+        self.start_ns += (t_ns - self.start_ns - 1) // self.max_duration * self.max_duration
+        self._next_split()
         return False
 
     def maybe_flush(self, now: float) -> None:
@@ -241,14 +282,19 @@ class BagSink:
             self.chunk_started = now
 
     def run(self, queue: RecordQueue) -> None:
-        """The writer thread: until the queue is closed and empty, or writing fails."""
+        """The writer thread: until the queue is closed and empty, the recording is over
+        (--duration, --size) or writing fails. The bag is there from the start, as ROS's."""
         try:
-            while True:
+            if self.writer is None:
+                self.open_next()
+            while not self.finished:
                 item = queue.pop(FLUSH_INTERVAL / 2)
                 if item is not None:
                     self.write(item)
                 elif queue.closed:
                     break
+                elif self.clock is not None:
+                    self.check_duration(self.clock())
                 self.maybe_flush(time.monotonic())
             self.close_current()
         except OSError as exc:
@@ -292,7 +338,7 @@ class Recorder:
         self.stop = threading.Event()
         self.last_warn = 0.0
         self.begin_write_pub: Any = None
-        self.sink = BagSink(opts, self._log, self._on_open)
+        self.sink = BagSink(opts, self._log, self._on_open, self._ros_time_ns)
         self.patterns = [re.compile(t) for t in opts.topics] if opts.regex else []
         self.exclude = re.compile(opts.exclude) if opts.exclude else None
 
@@ -300,6 +346,29 @@ class Recorder:
         import minros
 
         {"info": minros.loginfo, "warn": minros.logwarn, "error": minros.logerr}[level](text)
+
+    @staticmethod
+    def _ros_time_ns() -> int:
+        import minros
+
+        t = minros.get_rostime()
+        return t.secs * 1_000_000_000 + t.nsecs
+
+    def _wait_for_valid_time(self) -> Optional[int]:
+        """ROS time once it is valid (on simulated time, the first /clock), as ROS's recorder
+        waits for it before it begins; None if the node shuts down first."""
+        began = time.monotonic()
+        warned = False
+        while not self.stop.is_set():
+            now = self._ros_time_ns()
+            if now:
+                return now
+            if not warned and time.monotonic() - began >= 2.0:
+                self._log("warn", "/use_sim_time set to true and no clock published.  Still "
+                                  "waiting for valid time...")
+                warned = True
+            self.stop.wait(0.05)
+        return None
 
     def _on_open(self, target: str) -> None:
         if self.begin_write_pub is not None:
@@ -403,13 +472,17 @@ class Recorder:
             self.begin_write_pub = minros.Publisher("begin_write", String, queue_size=1, latch=True)
         if self.opts.udp:
             self._log("warn", "--udp: minros speaks TCPROS only; recording over TCP")
-        writer = threading.Thread(target=self.sink.run, args=(self.queue,), name="bag-writer",
-                                  daemon=True)
-        writer.start()
         discover = self.opts.record_all or self.opts.regex or bool(self.opts.node)
         if not discover:
             for topic in self.opts.topics:
                 self.subscribe(topic)
+        start = self._wait_for_valid_time()
+        if start is None:
+            return 0
+        self.sink.start(start)
+        writer = threading.Thread(target=self.sink.run, args=(self.queue,), name="bag-writer",
+                                  daemon=True)
+        writer.start()
         next_poll = 0.0
         explicit = set(self.opts.topics)
         while not self.stop.is_set() and writer.is_alive():

@@ -1,4 +1,5 @@
-"""``rosbag`` / ``minros bag``: record, play, info, filter, compress, decompress, reindex, check.
+"""``rosbag`` / ``minros bag``: record, play, info, filter, compress, decompress, reindex, check,
+and convert (minros's: ROS 1 bags to ROS 2 recordings and back).
 
 The options, help texts, messages and exit statuses are rosbag's (ros_comm noetic); the work
 is done by :mod:`minros.bag`.
@@ -17,6 +18,7 @@ from minros.tools.common import strip_ros_args
 DESCRIPTIONS = {
     "check": "Determine whether a bag is playable in the current system, or if it can be migrated.",
     "compress": "Compress one or more bag files.",
+    "convert": "Convert a bag to a ROS 2 recording (rosbag2), or a ROS 2 recording to a bag.",
     "decompress": "Decompress one or more bag files.",
     "decrypt": "Decrypt one or more bag files.",
     "encrypt": "Encrypt one or more bag files.",
@@ -206,6 +208,44 @@ def info_cmd(argv: List[str], prog: str = "rosbag") -> int:
     return info(args, options.yaml, options.key, options.freq)
 
 
+def _append(option: Any, opt_str: Any, value: Any, parser: Any) -> None:
+    getattr(parser.values, option.dest).append(value)
+
+
+def convert_parser(prog: str) -> optparse.OptionParser:
+    p = _parser(prog, """rosbag convert [options] INBAG OUTBAG
+
+Convert the ROS 1 bag INBAG (.bag, or ROS 1 .mcap) into the ROS 2 recording OUTBAG (a rosbag2
+directory: metadata.yaml and an .mcap or .db3 file), or the ROS 2 recording INBAG (a rosbag2
+directory, a ROS 2 .mcap or .db3 file) into the ROS 1 bag OUTBAG (.bag, or .mcap). Types map
+by ros1_bridge's rules (Header loses seq, time becomes builtin_interfaces/Time, field names
+lower case); a type ROS 2 has no counterpart of is made from the bag's own definition. A topic
+that cannot be converted is named with the reason, and the rest is converted.""",
+                DESCRIPTIONS["convert"])
+    p.add_option("--to", dest="to", default=None, choices=["ros2", "ros1"], metavar="ros2|ros1", help="what to convert to (default: ros2 for a ROS 1 bag, ros1 for a ROS 2 recording)")
+    p.add_option("--storage", dest="storage", default="mcap", choices=["mcap", "sqlite3"], metavar="mcap|sqlite3", help="the ROS 2 recording's storage (default: %default)")
+    p.add_option("--distro", dest="distro", default=None, choices=["jazzy", "kilted", "humble"], metavar="jazzy|kilted|humble", help="the ROS 2 distro whose types and metadata to write (default: jazzy); reading, the one the recording names")
+    p.add_option("--topic", dest="topics", default=[], type="string", action="callback", callback=_append, metavar="TOPIC", help="convert only TOPIC: a topic name or a message type, wildcards allowed (repeat for more)")
+    p.add_option("--exclude", dest="exclude", default=[], type="string", action="callback", callback=_append, metavar="TOPIC", help="leave out TOPIC: a topic name or a message type, wildcards allowed (repeat for more)")
+    p.add_option("-f", "--force", dest="force", default=False, action="store_true", help="replace OUTBAG if it exists")
+    p.add_option("-q", "--quiet", dest="quiet", default=False, action="store_true", help="print no plan, progress or summary (warnings still)")
+    return p
+
+
+def convert_cmd(argv: List[str], prog: str = "rosbag") -> int:
+    p = convert_parser(prog)
+    options, args = p.parse_args(argv)
+    if len(args) < 2:
+        p.error("You must specify an input bag and an output bag." if not args
+                else "You must specify an output bag.")
+    if len(args) > 2:
+        p.error("Too many arguments.")
+    from minros.bag.convert import convert
+
+    return convert(args[0], args[1], options.to, options.storage, options.distro,
+                   options.topics, options.exclude, options.quiet, options.force)
+
+
 def filter_cmd(argv: List[str], prog: str = "rosbag") -> int:
     p = _parser(prog, """rosbag filter [options] INBAG OUTBAG EXPRESSION
 
@@ -245,10 +285,10 @@ def compress_cmd(argv: List[str], prog: str = "rosbag") -> int:
     options, args = p.parse_args(argv)
     if not args:
         p.error("You must specify at least one bag file.")
-    from minros.bag.ops import bag_op
+    from minros.bag import ops
 
-    return bag_op(args, "compress", options.compression, options.output_dir, bool(options.force),
-                  bool(options.quiet))
+    return ops.compress(args, options.compression, options.output_dir, bool(options.force),
+                        bool(options.quiet))
 
 
 def decompress_cmd(argv: List[str], prog: str = "rosbag") -> int:
@@ -256,9 +296,9 @@ def decompress_cmd(argv: List[str], prog: str = "rosbag") -> int:
     options, args = p.parse_args(argv)
     if not args:
         p.error("You must specify at least one bag file.")
-    from minros.bag.ops import bag_op
+    from minros.bag import ops
 
-    return bag_op(args, "decompress", "none", options.output_dir, bool(options.force), bool(options.quiet))
+    return ops.compress(args, "none", options.output_dir, bool(options.force), bool(options.quiet))
 
 
 def reindex_cmd(argv: List[str], prog: str = "rosbag") -> int:
@@ -267,9 +307,9 @@ def reindex_cmd(argv: List[str], prog: str = "rosbag") -> int:
     options, args = p.parse_args(argv)
     if not args:
         p.error("You must specify at least one bag file.")
-    from minros.bag.ops import bag_op
+    from minros.bag import ops
 
-    return bag_op(args, "reindex", "none", options.output_dir, bool(options.force), bool(options.quiet))
+    return ops.reindex(args, options.output_dir, bool(options.force), bool(options.quiet))
 
 
 def print_trans(old: Any, new: Any, indent: int) -> None:
@@ -438,28 +478,33 @@ def fix_cmd(argv: List[str], prog: str = "rosbag") -> int:
     return 1
 
 
-def _unavailable(name: str, why: str) -> Callable[[List[str], str], int]:
+def _unavailable(name: str, fix: str) -> Callable[[List[str], str], int]:
+    """A rosbag command minros does not have: one line, with ``-h`` too (no usage of a command
+    that does nothing)."""
     def cmd(argv: List[str], prog: str) -> int:
-        p = _parser(prog, f"rosbag {name} [options] ...", DESCRIPTIONS[name])
-        p.parse_args(argv)  # -h still prints a usage
-        return _fail(f"ERROR: rosbag {name} is not available in minros: {why}")
+        return _fail(f"ERROR: rosbag {name} is not available in minros (it reads and writes "
+                     f"unencrypted bags only): {fix}")
 
     return cmd
 
 
 COMMANDS: Dict[str, Callable[[List[str], str], int]] = {
-    "check": check_cmd, "compress": compress_cmd, "decompress": decompress_cmd,
-    "decrypt": _unavailable("decrypt", "encrypted bags are not supported"),
-    "encrypt": _unavailable("encrypt", "encrypted bags are not supported"),
+    "check": check_cmd, "compress": compress_cmd, "convert": convert_cmd,
+    "decompress": decompress_cmd,
+    "decrypt": _unavailable("decrypt", "decrypt the bag with ROS's rosbag decrypt first"),
+    "encrypt": _unavailable("encrypt", "use ROS's rosbag encrypt, or encrypt the whole file "
+                                       "(gpg -c BAG)"),
     "filter": filter_cmd,
     "fix": fix_cmd,
     "info": info_cmd, "play": play_cmd, "record": record_cmd, "reindex": reindex_cmd,
 }
+#: in COMMANDS for scripts written for ROS's rosbag, not offered by --help
+UNAVAILABLE = ("decrypt", "encrypt")
 
 
 def _valid_cmds() -> str:
     out = "Available subcommands:\n"
-    for name in sorted([*COMMANDS, "help"]):
+    for name in sorted([*(c for c in COMMANDS if c not in UNAVAILABLE), "help"]):
         out += f"   {name}  "
         if name in DESCRIPTIONS:
             out += f"\t{DESCRIPTIONS[name]}"
@@ -527,119 +572,13 @@ def play_node_main() -> int:
 # ---------------------------------------------------------------------------------------------
 # rosbag.rosbag_main's Python API (the stand-in re-exports it): the commands above take
 # argv without the command name, as rosbag's do, and return the exit status; these are the
-# pieces they are built from
+# pieces they are built from (bag_op and its ops are minros.bag.ops')
 
 handle_split = _handle_split
 handle_topics = _collect("topics")
 handle_pause_topics = _collect("pause_topics")
 encrypt_cmd = COMMANDS["encrypt"]
 decrypt_cmd = COMMANDS["decrypt"]
-
-
-def bag_op(inbag_filenames: List[str], allow_unindexed: bool, open_inbag: bool,
-           copy_fn: Callable[[Any], bool], op: Callable[..., None],
-           output_dir: Optional[str] = None, force: bool = False, quiet: bool = False) -> None:
-    """Run ``op(inbag, outbag, quiet=quiet)`` on each bag, writing in place (the input kept
-    as ``NAME.orig.EXT``) or into ``output_dir``. ``copy_fn(bag)`` says whether to start
-    from a copy of the input (opened for appending) rather than an empty bag; without
-    ``open_inbag``, ``op`` gets the input's file name."""
-    import shutil
-
-    from minros.bag import Bag, ROSBagException, ROSBagUnindexedException
-
-    for name in inbag_filenames:
-        copy = False
-        if open_inbag:
-            try:
-                with Bag(name, "r", allow_unindexed=allow_unindexed) as inbag:
-                    copy = bool(copy_fn(inbag))
-            except ROSBagUnindexedException:
-                _fail(f"ERROR bag unindexed: {name}.  Run rosbag reindex.")
-                continue
-            except (ROSBagException, OSError) as exc:
-                _fail(f"ERROR reading {name}: {exc}")
-                continue
-        out_name = name if output_dir is None else os.path.join(output_dir, os.path.basename(name))
-        backup = None
-        source = name
-        if out_name == name:
-            root, ext = os.path.splitext(name)
-            backup = f"{root}.orig{ext}"
-            if not force and os.path.exists(backup):
-                if not quiet:
-                    _fail(f"Skipping {name}. Backup path {backup} already exists.")
-                continue
-            try:
-                (shutil.copy if copy else os.rename)(name, backup)
-            except OSError as exc:
-                _fail(f"ERROR {'copying' if copy else 'moving'} {name} to {backup}: {exc}")
-                continue
-            source = backup
-        elif copy:
-            shutil.copy(name, out_name)
-            source = out_name
-        try:
-            try:
-                outbag = Bag(out_name, "a" if copy else "w", allow_unindexed=allow_unindexed)
-            except (ROSBagException, OSError) as exc:
-                _fail(f"ERROR writing to {out_name}: {exc}")
-                continue
-            inbag = Bag(source, "r", allow_unindexed=allow_unindexed) if open_inbag else source
-            try:
-                op(inbag, outbag, quiet=quiet)
-            except ROSBagException as exc:
-                _fail(f"\nERROR operating on {source}: {exc}")
-            finally:
-                outbag.close()
-                if open_inbag:
-                    inbag.close()
-        except KeyboardInterrupt:
-            if backup is not None:
-                try:
-                    if copy:
-                        os.remove(backup)
-                    else:
-                        os.rename(backup, name)
-                except OSError:
-                    pass
-            raise
-        except (ROSBagException, OSError) as exc:
-            _fail(f"ERROR operating on {name}: {exc}")
-
-
-def change_compression_op(inbag: Any, outbag: Any, compression: str, quiet: bool) -> None:
-    """Copy every message of ``inbag`` into ``outbag`` with ``compression`` (as recorded:
-    raw bytes, connection headers kept), with rosbag's progress bar unless ``quiet``."""
-    from minros.bag.progress import ProgressMeter
-
-    outbag.compression = compression
-    meter = None if quiet else ProgressMeter(outbag.filename, inbag._uncompressed_size)
-    total = 0
-    for topic, msg, t, header in inbag.read_messages(raw=True, return_connection_header=True):
-        outbag.write(topic, msg, t, raw=True, connection_header=header)
-        if meter is not None:
-            total += len(msg[1])
-            meter.step(total)
-    if meter is not None:
-        meter.finish()
-
-
-def reindex_op(inbag: Any, outbag: Any, quiet: bool) -> None:
-    """Rebuild ``outbag``'s index (a copy of ``inbag`` opened for appending) from its chunks."""
-    from minros.bag import ROSBagEncryptException, ROSBagEncryptNotSupportedException
-    from minros.bag.progress import ProgressMeter
-
-    meter = None if quiet else ProgressMeter(outbag.filename, outbag.size)
-    try:
-        for offset in outbag.reindex():
-            if meter is not None:
-                meter.step(offset)
-    except (ROSBagEncryptNotSupportedException, ROSBagEncryptException):
-        raise
-    except Exception:  # noqa: BLE001 - damage past the last good chunk ends the scan, as in rosbag
-        pass
-    if meter is not None:
-        meter.finish()
 
 
 class RosbagCmds(collections.UserDict):

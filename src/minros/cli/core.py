@@ -41,13 +41,12 @@ def _version() -> str:
 
 
 def _port_from_env(env: Any) -> int | None:
-    uri = env.get("ROS_MASTER_URI")
-    if not uri:
+    if not env.get("ROS_MASTER_URI"):
         return None
-    try:
-        return urlparse(uri).port
-    except ValueError:
-        return None
+    from minros import rosenv
+
+    # one that is not a URI is named with its fix (MasterURIError), not silently ignored
+    return urlparse(rosenv.get_master_uri(env)).port
 
 
 def _master_running(port: int) -> bool:

@@ -40,6 +40,7 @@ COMMANDS: Dict[str, Tuple[str, str]] = {
     "master": ("minros.master", "run a ROS master alone, without rosout (rosmaster)"),
     "learn": ("minros.cli.learn", "exercises on the ROS wire that check themselves"),
     "zenoh": ("minros.cli.zenoh", "bridge topics and services with Zenoh (zenoh-bridge-ros1's wire)"),
+    "ros2": ("minros.cli.ros2", "bridge topics and services with a ROS 2 domain (ros1_bridge)"),
 }
 
 #: ROS command name -> (sub-command, arguments put before the user's)
@@ -77,7 +78,8 @@ def _usage() -> str:
         lines.append(f"  {name.ljust(width)}  {summary}")
     lines.append("")
     lines.append("ROS names work too: " + ", ".join(sorted(ALIASES)))
-    lines.append("Run 'minros COMMAND --help' for the options of a command.")
+    lines.append("Run 'minros COMMAND --help' for the options of a command, "
+                 "'minros --version' for the version.")
     return "\n".join(lines)
 
 
@@ -91,8 +93,14 @@ def run(command: str, argv: List[str], prog: Optional[str] = None) -> int:
             raise
         print(f"minros: '{command}' is not available in this version of minros", file=sys.stderr)
         return 1
+    from minros.rosenv import MasterURIError
+
     try:
         return int(module.main(argv, prog=prog or f"minros {command}") or 0)
+    except MasterURIError as exc:  # ROS_MASTER_URI=localhost:11311: the value and its fix
+        sys.stdout.flush()
+        print(f"ERROR: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:
@@ -104,10 +112,26 @@ def run(command: str, argv: List[str], prog: Optional[str] = None) -> int:
         return 0
 
 
+def _version() -> str:
+    """What ``minros --version`` prints: the version, where it runs from (an editable install
+    shows its clone), the Python and the ROS distribution minros speaks."""
+    import os
+    import platform
+
+    import minros
+    from minros.cli.rosversion import ROSDISTRO
+
+    return (f"minros {minros.__version__} from {os.path.dirname(os.path.abspath(minros.__file__))} "
+            f"(Python {platform.python_version()}, ROS 1 {ROSDISTRO})")
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     if not args or args[0] in ("-h", "--help", "help"):
         print(_usage())
+        return 0
+    if args[0] in ("--version", "-V"):
+        print(_version())
         return 0
     command, prefix = ALIASES.get(args[0], (args[0], []))
     args[1:1] = prefix

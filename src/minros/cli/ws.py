@@ -65,19 +65,47 @@ def _make(argv: List[str], prog: str) -> int:
 _TOOLS = {"init": ("catkin_init_workspace", _init), "create_pkg": ("catkin_create_pkg", _create_pkg),
           "make": ("catkin_make", _make)}
 
+_USAGE = "usage: {prog} {{init,create_pkg,make}} ..."
+
+_HELP = """\
+{usage}
+
+Catkin workspaces as the ROS tutorials build them. Nothing is compiled: the messages and
+services of your packages (msg/*.msg, srv/*.srv) are generated when a script imports them.
+
+commands:
+  init [SRC]                 make SRC (default .) a workspace's source space: its top-level
+                             CMakeLists.txt (catkin_init_workspace)
+  create_pkg NAME [DEPS...]  create package NAME: package.xml, CMakeLists.txt, src/
+                             (catkin_create_pkg)
+  make [-C WS]               build workspace WS (default .): devel/setup.bash, which puts its
+                             packages on ROS_PACKAGE_PATH, PATH and PYTHONPATH (catkin_make)
+
+'{prog} COMMAND --help' gives the options of a command. A workspace, from the start:
+
+  mkdir -p ~/catkin_ws/src && cd ~/catkin_ws/src
+  {prog} init
+  {prog} create_pkg my_package rospy std_msgs
+  cd ~/catkin_ws && {prog} make && source devel/setup.bash
+  rosrun my_package my_script.py"""
+
 
 def main(argv: List[str], prog: str | None = None) -> int:
     from minros.workspace.catkin import WorkspaceError
 
+    prog = prog or "minros ws"
     if not argv or argv[0] not in _TOOLS:
-        if argv and argv[0] in ("-h", "--help"):
-            print("usage: minros ws {init,create_pkg,make} ...")
+        usage = _USAGE.format(prog=prog)
+        if argv and argv[0] in ("-h", "--help", "help"):
+            print(_HELP.format(usage=usage, prog=prog))
             return 0
-        print("usage: minros ws {init,create_pkg,make} ...", file=sys.stderr)
+        what = f"unknown command '{argv[0]}'" if argv else "a command is needed"
+        print(f"{usage}\n{prog}: error: {what} (init, create_pkg or make; "
+              f"'{prog} --help' explains them)", file=sys.stderr)
         return 2
     ros_name, tool = _TOOLS[argv[0]]
     # called as `catkin_make`, prog is the ROS name; as `minros ws make`, the sub-command
-    name = prog if prog and prog.startswith("catkin") else f"{prog or 'minros ws'} {argv[0]}"
+    name = prog if prog.startswith("catkin") else f"{prog} {argv[0]}"
     try:
         return tool(argv[1:], name)
     except WorkspaceError as exc:

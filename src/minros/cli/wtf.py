@@ -16,7 +16,6 @@ of a source installation are not run.
 
 from __future__ import annotations
 
-import argparse
 import os
 import socket
 import sys
@@ -116,7 +115,7 @@ def _load_env(ctx: WtfContext, env: Any) -> None:
     ctx.ros_root = env.get("ROS_ROOT")
     ctx.ros_package_path = env.get("ROS_PACKAGE_PATH")
     ctx.pythonpath = env.get("PYTHONPATH")
-    ctx.ros_master_uri = rosenv.get_master_uri(env)
+    ctx.ros_master_uri = rosenv.get_master_uri(env, check=False)  # its own rule reports it
 
 
 Rule = Tuple[Callable[[WtfContext], Any], str]
@@ -533,18 +532,28 @@ def print_results(ctx: WtfContext, out: Any = None) -> None:
             print("\033[31m\033[1mERROR\033[0m", error.msg, file=out)
 
 
-def main(argv: Sequence[str], prog: str = "minros wtf") -> int:
-    parser = argparse.ArgumentParser(
-        prog=prog, usage=f"{prog} [launch file]",
+def parse_options(argv: Sequence[str], prog: str = "roswtf") -> Any:
+    """roswtf's options, parsed as roswtf parses them: optparse, so ``-h`` prints roswtf's
+    text (``Usage:``, ``Options:``) and an unknown option exits 2 with its error."""
+    import optparse
+
+    parser = optparse.OptionParser(
+        prog=prog, usage="usage: %prog [launch file]",
         description="roswtf is a tool for verifying a ROS installation and running system. "
                     "Checks provided launchfile if provided, else current stack or package.")
-    parser.add_argument("--all", dest="all_packages", action="store_true",
-                        help="run roswtf against all packages")
-    parser.add_argument("--no-plugins", dest="disable_plugins", action="store_true",
-                        help="disable roswtf plugins")
-    parser.add_argument("--offline", action="store_true", help="only run offline tests")
-    parser.add_argument("launch_files", nargs="*", metavar="FILE")
-    options = parser.parse_args(list(argv))
+    parser.add_option("--all", dest="all_packages", default=False, action="store_true",
+                      help="run roswtf against all packages")
+    parser.add_option("--no-plugins", dest="disable_plugins", default=False,
+                      action="store_true", help="disable roswtf plugins")
+    parser.add_option("--offline", dest="offline", default=False, action="store_true",
+                      help="only run offline tests")
+    options, args = parser.parse_args(list(argv))
+    options.launch_files = args
+    return options
+
+
+def main(argv: Sequence[str], prog: str = "minros wtf") -> int:
+    options = parse_options(argv, prog)
     try:
         if options.launch_files:
             ctx = WtfContext.from_roslaunch(options.launch_files)

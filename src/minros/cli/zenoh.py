@@ -47,6 +47,11 @@ def _bridge_parser(prog: str) -> argparse.ArgumentParser:
                              "the router or peer named by --connect)")
     parser.add_argument("--service-timeout", type=float, default=10.0, metavar="SECONDS",
                         help="how long a call of a remote service may take (default 10)")
+    parser.add_argument("--max-remote", type=int, default=1000, metavar="N",
+                        help="bridge at most N topics and services that only remote beacons "
+                             "declare (no local node publishes, subscribes or serves them; the "
+                             "first heard are kept; default 1000): a peer cannot make this "
+                             "master and process grow without bound")
     parser.add_argument("--name", default="minros_zenoh", help="node name (default minros_zenoh)")
     return parser
 
@@ -82,6 +87,9 @@ def main(argv: List[str], prog: Optional[str] = None) -> int:
     if args.service_timeout <= 0:
         print(f"{prog}: error: --service-timeout must be positive", file=sys.stderr)
         return 2
+    if args.max_remote < 0:
+        print(f"{prog}: error: --max-remote must be 0 or more", file=sys.stderr)
+        return 2
     from minros.zenoh.bridge import Options, run
     from minros.zenoh.keys import KeyMappingError, check_namespace
 
@@ -92,7 +100,8 @@ def main(argv: List[str], prog: Optional[str] = None) -> int:
         return 2
     options = Options(mode=args.mode, listen=args.listen, connect=args.connect,
                       multicast_scouting=not args.no_multicast_scouting,
-                      namespace=args.namespace, service_timeout=args.service_timeout)
+                      namespace=args.namespace, service_timeout=args.service_timeout,
+                      max_remote=args.max_remote)
     return run(options, name=args.name, announce=lambda text: print(text, flush=True))
 
 

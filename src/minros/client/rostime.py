@@ -227,12 +227,29 @@ def _wait_sim(duration: Duration, stop: Callable[[], bool] | None) -> None:
         raise ROSTimeMovedBackwardsException((start - now).to_sec())
 
 
+#: per thread: whether it slept once already after the node shut down (wall clock)
+_after_shutdown = threading.local()
+
+
 def _sleep(duration: Union[float, int, _MsgDuration], stop: Callable[[], bool] | None = None) -> None:
     d = _to_duration(duration)
     if is_wallclock():
+        # rospy's wall sleep raises nothing (a time.sleep), so the tutorial's `while not
+        # rospy.is_shutdown(): ... rate.sleep()` ends quietly on Ctrl-C, wherever in the loop
+        # the signal lands: a sleep the shutdown cuts short returns, and so does the first one
+        # a thread begins after it, which sleeps its time as rospy's (code that publishes a
+        # last message at shutdown sleeps so it goes out). A second one raises, so a loop that
+        # never looks at is_shutdown() ends (rospy's runs on, deaf to Ctrl-C).
+        if _node_is_shutdown():
+            if getattr(_after_shutdown, "slept", False):
+                raise ROSInterruptException("ROS shutdown request")
+            _after_shutdown.slept = True
+            if stop is None:
+                time.sleep(max(d.to_sec(), 0.0))
+            return
         _wait_wall(d.to_sec(), stop)
-    else:
-        _wait_sim(d, stop)
+        return
+    _wait_sim(d, stop)
     if _node_is_shutdown():
         raise ROSInterruptException("ROS shutdown request")
 
@@ -240,7 +257,9 @@ def _sleep(duration: Union[float, int, _MsgDuration], stop: Callable[[], bool] |
 def sleep(duration: Union[float, int, _MsgDuration]) -> None:
     """Sleep for ``duration`` (seconds or Duration) of ROS time; negative returns at once.
 
-    Raises ROSInterruptException when the node shuts down meanwhile, and
+    Raises ROSInterruptException when the node shuts down meanwhile on simulated time (on the
+    wall clock, as rospy, the sleep returns; the second a thread begins after shutdown raises),
+    and
     ROSTimeMovedBackwardsException when simulated time jumps backwards.
     """
     _sleep(duration)

@@ -24,7 +24,7 @@ class JointTable:
         self.free: Dict[str, Dict[str, Any]] = {}
         self.order: List[str] = []
         self.warnings: List[str] = []
-        for joint in parse_joints(description):
+        for joint in parse_joints(description, robot_anywhere=True):
             if not joint.moving:
                 continue
             self.order.append(joint.name)

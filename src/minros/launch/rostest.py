@@ -144,8 +144,10 @@ def run_rostest(test_file: str, package: str, pkg_dir: Path | None, argv: Sequen
         master_uri = f"http://localhost:{port}/"
     child_env: Dict[str, str] = dict(env)
     child_env["ROS_MASTER_URI"] = master_uri
+    # as ROS's rostest: the test's own master comes without rosout (its runner finds a master
+    # running and starts no core node), so a <test> named rosout is the only /rosout
     runner = LaunchRunner(config, master_uri=master_uri, env=child_env, port=port, screen=text,
-                          out=out, err=err)
+                          core_nodes=False, out=out, err=err)
     outcome = RostestOutcome()
     started = time.monotonic()
     cases: List[testing.CaseResult] = []

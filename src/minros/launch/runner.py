@@ -236,7 +236,7 @@ class LaunchRunner:
 
     def __init__(self, config: LaunchConfig, *, master_uri: str, env: Dict[str, str] | None = None,
                  port: int | None = None, screen: bool = False, wait_for_master: bool = False,
-                 run_id: str | None = None, core_only: bool = False,
+                 run_id: str | None = None, core_only: bool = False, core_nodes: bool = True,
                  sigint_timeout: float = SIGINT_TIMEOUT, sigterm_timeout: float = SIGTERM_TIMEOUT,
                  out: Print | None = None, err: Print | None = None) -> None:
         self.config = config
@@ -247,6 +247,9 @@ class LaunchRunner:
         self.wait_for_master = wait_for_master
         self.run_id = run_id
         self.core_only = core_only
+        #: whether a master started here comes with roscore's nodes (rosout), as roslaunch's
+        #: does; rostest's master has none
+        self.core_nodes = core_nodes
         self.sigint_timeout = sigint_timeout
         self.sigterm_timeout = sigterm_timeout
         self.out: Print = out or _safe_printer(sys.stdout)
@@ -283,6 +286,8 @@ class LaunchRunner:
                               "(it is not on this machine, so roslaunch cannot start it)")
         self.out("auto-starting new master")
         argv = [sys.executable, "-m", "minros", "core", "-p", str(port)]
+        if not self.core_nodes:
+            argv.append("--no-rosout")
         env = dict(self.env, ROS_MASTER_URI=self.master_uri)
         # the master's own console output goes to a log file, as roslaunch does with rosmaster's
         self.master = LaunchProcess("master", argv, env, str(ros_home(self.env)), screen=False,

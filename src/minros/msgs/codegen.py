@@ -314,9 +314,10 @@ class _DeserializerGen(_Writer):
         self.need(ind, length, fpath)
         if self.views:
             # the data may be a memoryview (large messages are not copied): str() decodes both
-            self.emit(ind, f"{target} = str(view[end:end + {length}], 'utf-8', 'replace')")
+            # not UTF-8: U+FFFD, and one ERROR per message type, as genpy's 'rosmsg' handler
+            self.emit(ind, f"{target} = str(view[end:end + {length}], 'utf-8', _TEXT_ERRORS)")
         else:
-            self.emit(ind, f"{target} = view[end:end + {length}].decode('utf-8', 'replace')")
+            self.emit(ind, f"{target} = view[end:end + {length}].decode('utf-8', _TEXT_ERRORS)")
         self.emit(ind, f"end += {length}")
 
     def fields(self, spec: MsgSpec, obj: str, path: str, ind: int, reuse: bool = False) -> None:
@@ -539,6 +540,10 @@ def generate_source(spec: MsgSpec, get_spec: GetSpec, md5sum: str, full_text: st
         out.append("# fixed-size runs of fields, packed/unpacked in one call")
         for fmt, sname in sorted(structs.items(), key=lambda kv: kv[1]):
             out.append(f"{sname} = _Struct({'<' + fmt!r})")
+    if any("_TEXT_ERRORS" in line for gen in (de, fresh) for line in gen.lines):
+        out.append("")
+        out.append("# how its strings decode: bytes that are not UTF-8 become U+FFFD, logged once")
+        out.append(f"_TEXT_ERRORS = _decoding_errors({spec.full_name!r})")
     out.append("")
     out.append("")
     if in_place:

@@ -40,20 +40,23 @@ __getattr__, __dir__ = namespace_hooks("{pkg}", "{kind}", globals())
 '''
 
 
-def _package_dir(package: str, refresh: bool = True) -> Path | None:
+def _package_dirs(package: str, refresh: bool = True) -> List[Path]:
+    """The folders of ``package``, the first one and the underlays it hides."""
     if refresh:
-        return packages.find_package(package)
-    return packages.list_packages().get(package)
+        return packages.package_folders(package)
+    return packages.known_package_folders(package)
 
 
 def type_names(package: str, kind: str) -> List[str]:
-    """Names importable from ``<package>.<kind>``: message types, or services and their parts."""
-    package_dir = _package_dir(package)
-    if package_dir is None:
-        return []
+    """Names importable from ``<package>.<kind>`` (``from pkg.msg import *``): message types,
+    or services and their parts, of the first folder of the package that has such a folder
+    (an overlay's; its underlay's when the overlay has none). A type only an underlay has
+    still imports by name."""
     from .registry import type_names_in
 
-    stems = type_names_in(package_dir, kind)
+    folders = ("msg", "action") if kind == "msg" else (kind,)
+    first = next((d for d in _package_dirs(package) if any((d / f).is_dir() for f in folders)), None)
+    stems = type_names_in(first, kind) if first is not None else []
     if kind == "srv":
         return [name for stem in stems for name in (stem, stem + "Request", stem + "Response")]
     return stems
@@ -185,8 +188,13 @@ class MsgImportFinder:
     """Finds ``<pkg>``, ``<pkg>.msg`` and ``<pkg>.srv`` of ROS packages with definitions.
 
     A plain ``sys.meta_path`` finder (importlib's protocol without its ABCs, whose import
-    would pull in importlib.resources and slow every ``import rospy``).
+    would pull in importlib.resources and slow every ``import rospy``). With
+    ``environment_only`` it answers only for packages found on ROS_PACKAGE_PATH, not for the
+    ones minros ships (the start-up hook's finder, :data:`ENVIRONMENT_FINDER`).
     """
+
+    def __init__(self, environment_only: bool = False) -> None:
+        self.environment_only = environment_only
 
     def find_spec(self, fullname: str, path: Sequence[str] | None = None,
                   target: ModuleType | None = None) -> ModuleSpec | None:
@@ -206,29 +214,39 @@ class MsgImportFinder:
     def _find(self, fullname: str, parts: List[str]) -> ModuleSpec | None:
         if len(parts) == 1:
             # only packages already discovered (no rescan per failed import of some module)
-            package_dir = _package_dir(parts[0], refresh=False)
-            if package_dir is None or not any((package_dir / k).is_dir() for k in _SERVED):
-                return None
+            package_dir = _serving(_package_dirs(parts[0], refresh=False), _SERVED,
+                                   self.environment_only)
             kind = None
         elif len(parts) == 2 and parts[1] in ("msg", "srv"):
-            package_dir = _package_dir(parts[0])
             # a package with only .action files still has a .msg module (their seven types)
             folders = ("msg", "action") if parts[1] == "msg" else ("srv",)
-            if package_dir is None or not any((package_dir / f).is_dir() for f in folders):
-                return None
+            package_dir = _serving(_package_dirs(parts[0]), folders, self.environment_only)
             kind = parts[1]
         elif len(parts) in (2, 3) and parts[1] == "cfg":
-            package_dir = _package_dir(parts[0])
-            if package_dir is None or not (package_dir / "cfg").is_dir():
+            package_dir = _serving(_package_dirs(parts[0]), ("cfg",), self.environment_only)
+            if package_dir is None:
                 return None
             return _plugin("cfg").find_spec(fullname, parts, package_dir)
         else:
+            return None
+        if package_dir is None:
             return None
         loader: Any = _NamespaceLoader(parts[0], kind)  # importlib's protocol, not its ABC
         spec = ModuleSpec(fullname, loader,
                                               is_package=True)
         spec.submodule_search_locations = []
         return spec
+
+
+def _serving(package_dirs: List[Path], kinds: Sequence[str], environment_only: bool) -> Path | None:
+    """The first of a package's folders holding one of ``kinds``; with ``environment_only``,
+    None when that is a package minros ships (its stand-in serves it)."""
+    for package_dir in package_dirs:
+        if any((package_dir / k).is_dir() for k in kinds):
+            if environment_only and packages.is_builtin(package_dir):
+                return None
+            return package_dir
+    return None
 
 
 #: package folders that make a ROS package importable: definitions, actions, .cfg scripts
@@ -246,6 +264,9 @@ def _plugin(folder: str) -> Any:
 _NOT_ROS = frozenset(getattr(sys, "stdlib_module_names", ())) | frozenset(sys.builtin_module_names)
 _busy = threading.local()
 _FINDER = MsgImportFinder()
+#: what ``_minros_import_hook`` (the .pth installed with minros) asks: packages on
+#: ROS_PACKAGE_PATH import before anything imported rospy
+ENVIRONMENT_FINDER = MsgImportFinder(environment_only=True)
 _hook_lock = threading.Lock()
 
 

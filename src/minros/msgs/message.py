@@ -39,17 +39,33 @@ class RosMsgUnicodeErrors:
         self._warned: set = set()
 
     def __call__(self, err: UnicodeError) -> tuple:
-        if self.msg_type not in self._warned:
-            self._warned.add(self.msg_type)
+        return self.report(self.msg_type, err)
+
+    def report(self, msg_type: str | None, err: UnicodeError) -> tuple:
+        """Log the first decoding error of ``msg_type`` (genpy's text), replace the bytes."""
+        if msg_type not in self._warned:
+            self._warned.add(msg_type)
             import logging
 
-            what = f"message {self.msg_type}" if self.msg_type else "unknown message"
+            what = f"message {msg_type}" if msg_type else "unknown message"
             logging.getLogger("rosout").error(
                 "Characters replaced when decoding %s (will print only once): %s", what, err)
         return codecs.replace_errors(err)
 
 
-codecs.register_error("rosmsg", RosMsgUnicodeErrors())
+_ROSMSG_ERRORS = RosMsgUnicodeErrors()
+codecs.register_error("rosmsg", _ROSMSG_ERRORS)
+_decoders: set = set()
+
+
+def decoding_errors(type_name: str) -> str:
+    """The codec error handler the strings of ``type_name`` decode with (minros's generated
+    classes): ``'rosmsg'``'s rule with the type fixed, so no decode sets shared state first."""
+    name = f"rosmsg:{type_name}"
+    if name not in _decoders:
+        codecs.register_error(name, lambda err: _ROSMSG_ERRORS.report(type_name, err))
+        _decoders.add(name)
+    return name
 
 #: Largest element count accepted for arrays whose elements occupy no bytes on the wire
 #: (e.g. ``std_msgs/Empty[]``): the count cannot be checked against the data, so bound it.

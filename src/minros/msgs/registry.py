@@ -96,26 +96,29 @@ class MsgContext:
             self._specs[spec.full_name] = spec
 
     def _find_file(self, type_name: str, kind: str) -> Path:
-        from minros.packages import BUILTIN_SHARE_DIRS, find_package, ros_package_path
+        from minros.packages import BUILTIN_SHARE_DIRS, package_folders, ros_package_path
 
         package, short = _split_type(type_name, "service" if kind == "srv" else "message")
         if not self._search:
             raise UnknownTypeError(type_name, f"Cannot locate message [{type_name}]: "
                                               f"it is not part of the message definition")
-        package_dir = find_package(package)
-        if package_dir is None:
+        folders = package_folders(package)
+        if not folders:
             where = [str(p) for p in ros_package_path()] + [str(p) for p in BUILTIN_SHARE_DIRS]
             raise UnknownTypeError(
                 type_name, f"Cannot locate {'service' if kind == 'srv' else 'message'} "
                            f"[{type_name}]: package [{package}] not found (searched ROS_PACKAGE_PATH "
                            f"and minros's bundled packages: {', '.join(where) or 'nothing'})")
-        path = package_dir / kind / f"{short}.{kind}"
-        if not path.is_file():
-            raise UnknownTypeError(
-                type_name, f"Cannot locate {'service' if kind == 'srv' else 'message'} "
-                           f"[{type_name}]: no file {kind}/{short}.{kind} in package "
-                           f"[{package}] ({package_dir})")
-        return path
+        # the first package of the name that has the file: an overlay that lacks a type (or a
+        # whole msg/ or srv/ folder) falls back to its underlay, as in ROS
+        for package_dir in folders:
+            path = package_dir / kind / f"{short}.{kind}"
+            if path.is_file():
+                return path
+        raise UnknownTypeError(
+            type_name, f"Cannot locate {'service' if kind == 'srv' else 'message'} "
+                       f"[{type_name}]: no file {kind}/{short}.{kind} in package "
+                       f"[{package}] ({', '.join(map(str, folders))})")
 
     def get_spec(self, type_name: str) -> MsgSpec:
         """The spec of message type ``type_name`` (loads it on first use)."""
@@ -161,19 +164,17 @@ class MsgContext:
         """(text, origin) of a message generated from an ``.action`` file, as catkin does."""
         if not self._search:
             return None
-        from minros.packages import find_package
+        from minros.packages import package_folders
 
         package, _, short = type_name.partition("/")
-        package_dir = find_package(package) if package else None
-        if package_dir is None:
-            return None
-        for suffix in ACTION_SUFFIXES:
-            if short.endswith(suffix) and len(short) > len(suffix):
-                base = short[:-len(suffix)]
-                path = package_dir / "action" / f"{base}.action"
-                if path.is_file():
-                    texts = action_message_texts(_read_text(path), base)
-                    return texts[short], f"{path} ({short} generated from it)"
+        for package_dir in package_folders(package) if package else []:
+            for suffix in ACTION_SUFFIXES:
+                if short.endswith(suffix) and len(short) > len(suffix):
+                    base = short[:-len(suffix)]
+                    path = package_dir / "action" / f"{base}.action"
+                    if path.is_file():
+                        texts = action_message_texts(_read_text(path), base)
+                        return texts[short], f"{path} ({short} generated from it)"
         return None
 
     def get_srv_spec(self, type_name: str) -> SrvSpec:

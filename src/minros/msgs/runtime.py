@@ -14,7 +14,7 @@ from typing import Any, Callable
 
 from minros.exceptions import DeserializationError, SerializationError
 
-from .message import MAX_EMPTY_ELEMENTS, Message, _init_fields, struct_I
+from .message import MAX_EMPTY_ELEMENTS, Message, _init_fields, decoding_errors, struct_I
 from .tval import Duration, Time
 
 #: genpy's constructor rules (all fields positionally, or any by keyword)
@@ -148,8 +148,8 @@ EXPORTS = {
     "_bad_length": "bad_length", "_put_array": "put_array", "_unpack_array": "unpack_array",
     "_numpy_view": "numpy_view", "_as_bytes": "as_bytes", "_as_list": "as_list",
     "_string_bytes": "string_bytes", "_init_fields": "init_fields",
-    "_MAX_EMPTY_ELEMENTS": "MAX_EMPTY_ELEMENTS",
+    "_MAX_EMPTY_ELEMENTS": "MAX_EMPTY_ELEMENTS", "_decoding_errors": "decoding_errors",
 }
 __all__ = ["Duration", "MAX_EMPTY_ELEMENTS", "Message", "S_I", "Struct", "Time", "as_bytes", "as_list",
-           "bad_length", "init_fields", "new", "numpy_view", "overrun", "put_array", "string_bytes",
+           "bad_length", "decoding_errors", "init_fields", "new", "numpy_view", "overrun", "put_array", "string_bytes",
            "too_many", "unpack_array"]

@@ -18,8 +18,17 @@ first when that point lies far off the robot's heading; within ``xy_tolerance`` 
 turns to the goal's heading and is done within ``yaw_tolerance``. It stops when a laser point
 lies in the corridor the robot is about to drive through.
 
+**Progress** (move_base's executive, its clocks and recovery list): a goal makes no progress
+when the follower finds no valid command for ``controller_patience`` seconds, or when the
+robot moves less than ``oscillation_distance`` in ``oscillation_timeout`` seconds; then the
+recovery behaviours run one at a time (move_base's default list: clear the marked obstacles
+farther than ``conservative_reset_dist``, rotate in place, clear all but those within four
+robot radii, rotate), each followed by a new plan; when they are used up the goal is aborted
+with the reason. A valid command (or enough motion, for the oscillation clock) starts the
+list again from the top, as in move_base.
+
 This is a teaching stack: no dynamic window, no rolling local costmap, no clearing by
-raytracing, no oscillation detection. It is not the ROS navigation stack.
+raytracing. It is not the ROS navigation stack.
 """
 
 from __future__ import annotations
@@ -207,6 +216,10 @@ def astar(cost: np.ndarray, start: Tuple[int, int], goal: Tuple[int, int],
 def plan(grid: GridMap, cost: np.ndarray, start: Point, goal: Point,
          params: PlannerParams = PlannerParams(), robot_radius: float = 0.105) -> List[Point]:
     """A* between two world points; the path in world coordinates, from start to goal exactly."""
+    for what, point in (("robot", start), ("goal", goal)):
+        if not all(math.isfinite(v) for v in point):
+            raise NoPath(f"the {what} ({point[0]}, {point[1]}) is not a finite position",
+                         about_goal=what == "goal")
     s = grid.cell_of(*start)
     if s is None:
         raise NoPath(f"the robot ({start[0]:.2f}, {start[1]:.2f}) is outside the map")
@@ -255,6 +268,8 @@ class Follower:
     index: int = 0
     xy_reached: bool = False
     last_v: float = 0.0
+    #: the nearest laser point (robot frame) that blocked the last step, for the reason
+    blocking: Point | None = None
 
     def remaining(self, x: float, y: float) -> float:
         gx, gy = self.path[-1]
@@ -336,7 +351,133 @@ class Follower:
         reach = p.robot_radius + p.safety_margin + max(v, 0.05) * p.stop_time
         reach = min(reach, goal_distance + p.robot_radius + 0.01)
         ahead = (points[:, 0] > 0.0) & (points[:, 0] < reach) & (np.abs(points[:, 1]) < half)
-        return bool(ahead.any())
+        if not ahead.any():
+            return False
+        inside = points[ahead]
+        nearest = int(np.argmin(np.hypot(inside[:, 0], inside[:, 1])))
+        self.blocking = (float(inside[nearest, 0]), float(inside[nearest, 1]))
+        return True
+
+
+# -- progress and recovery ---------------------------------------------------------------------
+
+
+@dataclass
+class ProgressParams:
+    """move_base's names. The defaults are move_base's, except the oscillation clock, which
+    move_base leaves off (``oscillation_timeout`` 0) and TurtleBot3's navigation configuration
+    (move_base_params.yaml) sets to 10 s and 0.2 m: a teaching stack should end every goal."""
+
+    controller_patience: float = 15.0
+    oscillation_timeout: float = 10.0
+    oscillation_distance: float = 0.2
+    recovery_behavior_enabled: bool = True
+    clearing_rotation_allowed: bool = True
+    conservative_reset_dist: float = 3.0
+
+
+@dataclass(frozen=True)
+class Recovery:
+    """One recovery behaviour: ``clear`` (forget marked obstacles outside the square of side
+    ``reset_distance`` around the robot, as clear_costmap_recovery) or ``rotate`` (turn once
+    in place, as rotate_recovery)."""
+
+    name: str
+    kind: str
+    reset_distance: float = 0.0
+
+
+def recovery_behaviors(params: ProgressParams, robot_radius: float) -> List[Recovery]:
+    """move_base's default list (its loadDefaultRecoveryBehaviors), in its order; the
+    aggressive reset keeps what lies within four robot radii, as move_base sizes it."""
+    out = [Recovery("conservative_reset", "clear", params.conservative_reset_dist)]
+    if params.clearing_rotation_allowed:
+        out.append(Recovery("rotate_recovery", "rotate"))
+    out.append(Recovery("aggressive_reset", "clear", 4.0 * robot_radius))
+    if params.clearing_rotation_allowed:
+        out.append(Recovery("rotate_recovery", "rotate"))
+    return out
+
+
+def clear_marks(marks: Sequence[Point], x: float, y: float,
+                reset_distance: float) -> List[Point]:
+    """The marks clear_costmap_recovery keeps: those inside the axis-aligned square of side
+    ``reset_distance`` centred on the robot at (x, y)."""
+    half = reset_distance / 2.0
+    return [(mx, my) for mx, my in marks if abs(mx - x) <= half and abs(my - y) <= half]
+
+
+#: what the goal is aborted with when the recoveries are used up, by what triggered them
+EXHAUSTED = {
+    "planning": "Failed to find a valid plan. Even after executing recovery behaviors.",
+    "controlling": "Failed to find a valid control. Even after executing recovery behaviors.",
+    "oscillation": "Robot is oscillating. Even after executing recovery behaviors.",
+}
+
+
+class Progress:
+    """move_base's clocks of no progress and its place in the recovery list, for one goal.
+
+    Pure: the caller passes the time (seconds, any clock) and the robot's position. The
+    executive calls :meth:`controlled` after each valid command, :meth:`moved` every cycle,
+    asks :meth:`control_failed` after an invalid one and :meth:`oscillating` while
+    controlling, then :meth:`next_recovery` with the trigger (None means abort with
+    ``EXHAUSTED[trigger]``) and :meth:`recovered` once the behaviour has run."""
+
+    def __init__(self, params: ProgressParams, robot_radius: float, now: float) -> None:
+        self.params = params
+        self.behaviors = recovery_behaviors(params, robot_radius)
+        self.reset(now)
+
+    def reset(self, now: float) -> None:
+        """A new goal: every clock starts now and the recovery list from its top."""
+        self.last_valid_control = now
+        self.last_oscillation_reset = now
+        self.oscillation_pose: Point | None = None
+        self.index = 0
+        self.trigger: str | None = None
+
+    def moved(self, now: float, x: float, y: float) -> None:
+        if self.oscillation_pose is None:
+            self.oscillation_pose = (x, y)
+            return
+        ox, oy = self.oscillation_pose
+        if math.hypot(x - ox, y - oy) >= self.params.oscillation_distance:
+            self.oscillation_pose = (x, y)
+            self.last_oscillation_reset = now
+            if self.trigger == "oscillation":
+                self.index = 0
+
+    def controlled(self, now: float) -> None:
+        self.last_valid_control = now
+        if self.trigger == "controlling":
+            self.index = 0
+
+    def planned(self) -> None:
+        if self.trigger == "planning":
+            self.index = 0
+
+    def control_failed(self, now: float) -> bool:
+        """Whether the controller has been without a valid command beyond its patience."""
+        return now - self.last_valid_control > self.params.controller_patience
+
+    def oscillating(self, now: float) -> bool:
+        timeout = self.params.oscillation_timeout
+        return timeout > 0 and now - self.last_oscillation_reset > timeout
+
+    def next_recovery(self, trigger: str) -> Recovery | None:
+        """The behaviour to run for ``trigger`` ("planning", "controlling", "oscillation"),
+        or None when recovery is off or every behaviour has been tried."""
+        self.trigger = trigger
+        if not self.params.recovery_behavior_enabled or self.index >= len(self.behaviors):
+            return None
+        behavior = self.behaviors[self.index]
+        self.index += 1
+        return behavior
+
+    def recovered(self, now: float) -> None:
+        """A behaviour has run: the robot gets time to stop oscillating, as in move_base."""
+        self.last_oscillation_reset = now
 
 
 # -- goals -------------------------------------------------------------------------------------
@@ -355,6 +496,14 @@ def quaternion_problem(x: float, y: float, z: float, w: float) -> str | None:
     if abs((1.0 - 2.0 * (x * x + y * y)) - 1.0) > 1e-3:
         return ("Quaternion is invalid... for navigation the z-axis of the quaternion must be "
                 "close to vertical.")
+    return None
+
+
+def position_problem(x: float, y: float, z: float) -> str | None:
+    """Why a goal position cannot be used (None when it can): the companion of
+    :func:`quaternion_problem`, which move_base lacks (its planner turns a NaN into a cell)."""
+    if not all(math.isfinite(v) for v in (x, y, z)):
+        return f"(x={x}, y={y}, z={z}): the position has nans or infs"
     return None
 
 

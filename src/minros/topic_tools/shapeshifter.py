@@ -73,9 +73,12 @@ class RawOutput:
         self._on_advertise = on_advertise
         self._listener = subscriber_listener
 
-    def forward(self, msg: Any) -> bool:
-        """Publish ``msg`` (an AnyMsg received by a subscriber); False if its type differs
-        from the one the output was advertised with."""
+    @property
+    def advertised(self) -> bool:
+        return self.publisher is not None
+
+    def advertise(self, msg: Any) -> None:
+        """Advertise the output under ``msg``'s type (its first message), if not yet."""
         header = header_of(msg)
         with self._lock:
             if self.publisher is None:
@@ -87,7 +90,14 @@ class RawOutput:
                     subscriber_listener=self._listener)
                 if self._on_advertise is not None:
                     self._on_advertise(self.publisher)
-            elif header.get("md5sum") not in (self.cls._md5sum, None):  # type: ignore[union-attr]
+
+    def forward(self, msg: Any) -> bool:
+        """Publish ``msg`` (an AnyMsg received by a subscriber); False if its type differs
+        from the one the output was advertised with."""
+        header = header_of(msg)
+        self.advertise(msg)
+        with self._lock:
+            if header.get("md5sum") not in (self.cls._md5sum, None):  # type: ignore[union-attr]
                 if not self._warned:
                     self._warned = True
                     minros.logerr(f"{self.topic} carries {self.cls._type} "  # type: ignore[union-attr]

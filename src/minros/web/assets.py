@@ -13,17 +13,39 @@ Two clients read them: the page's 3D view (``GET /pkg/<package>/<path>``, the UR
 * the file must lie inside the folder of a package minros's package lookup finds
   (``ROS_PACKAGE_PATH``, then the bundled packages), after percent-decoding and after
   symbolic links are followed: ``%2e%2e`` and a link out of the package are refused too;
-* at most :data:`MAX_ASSET_BYTES` are read.
+* at most :data:`MAX_ASSET_BYTES` are served.
+
+Files are sent as they are read, :data:`CHUNK_BYTES` at a time (:func:`chunks`), never held
+whole: each connection holds one chunk, and a :class:`Budget` bounds the chunks in memory
+across all connections (:data:`BUDGET_BYTES`, of which one peer address may hold
+``peer_share``, as :mod:`minros.wire.admission` shares a server's memory): a reader waits for
+room, and one that finds none within the server's send timeout is refused. So thirty
+unread downloads of a 46 MB mesh hold thirty chunks, not thirty meshes, and nothing after
+they close.
 
 Errors are :class:`AssetError` with the reason and, where there is one, the fix.
 """
 
 from __future__ import annotations
 
+import os
 import re
+import threading
+import time
 import urllib.parse
 from pathlib import Path
-from typing import Callable, Iterable, List, Optional, Pattern, Sequence, Tuple
+from typing import (
+    BinaryIO,
+    Callable,
+    Dict,
+    Iterable,
+    Iterator,
+    List,
+    Optional,
+    Pattern,
+    Sequence,
+    Tuple,
+)
 
 from minros import packages
 
@@ -36,6 +58,14 @@ DEFAULT_ALLOWLIST = (
 #: the largest file served (a detailed mesh is tens of MB; a Foxglove client's replies wait
 #: in a queue of 64 MB)
 MAX_ASSET_BYTES = 48 << 20
+
+#: bytes read from a file at a time (and held, per connection, until the kernel has them)
+CHUNK_BYTES = 64 << 10
+#: chunks of asset files in memory at once, all connections together (512 connections, the
+#: web server's cap, at one chunk each)
+BUDGET_BYTES = 32 << 20
+#: the fraction of the budget one peer address may hold (admission's default share)
+PEER_SHARE = 0.75
 
 PACKAGE_PREFIX = "package://"
 FILE_PREFIX = "file://"
@@ -110,6 +140,124 @@ def resolve(uri: str, patterns: Sequence[Pattern[str]] = DEFAULT_PATTERNS,
     if not is_file:
         raise AssetError(f"{uri}: no such file ({target})", 404)
     return real
+
+
+class Budget:
+    """Bytes of asset files in memory (read, not yet handed to the kernel), all connections
+    together and per peer address. Thread-safe; ``report`` gets one line when readers first
+    have to wait, then at most one a minute."""
+
+    def __init__(self, total: int = BUDGET_BYTES, peer_share: float = PEER_SHARE,
+                 report: Optional[Callable[[str], None]] = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self.total = max(CHUNK_BYTES, total)
+        self.peer_limit = max(CHUNK_BYTES, int(self.total * peer_share))
+        self.used = 0
+        self.by_peer: Dict[str, int] = {}
+        self.waiting = 0
+        self._cond = threading.Condition(threading.Lock())
+        self._report = report
+        self._reported = -float("inf")
+        self._clock = clock
+
+    def _fits(self, peer: str, n: int) -> bool:
+        return (self.used + n <= self.total
+                and self.by_peer.get(peer, 0) + n <= self.peer_limit)
+
+    def acquire(self, peer: str, n: int, timeout: float) -> bool:
+        """Take ``n`` bytes for ``peer``, waiting up to ``timeout`` seconds for room; False
+        when there was none."""
+        deadline = self._clock() + timeout
+        with self._cond:
+            if not self._fits(peer, n):
+                self.waiting += 1
+                try:
+                    self._note_full(peer)
+                    while not self._fits(peer, n):
+                        left = deadline - self._clock()
+                        if left <= 0:
+                            return False
+                        self._cond.wait(left)
+                finally:
+                    self.waiting -= 1
+            self.used += n
+            self.by_peer[peer] = self.by_peer.get(peer, 0) + n
+            return True
+
+    def release(self, peer: str, n: int) -> None:
+        with self._cond:
+            self.used -= n
+            left = self.by_peer.get(peer, 0) - n
+            if left > 0:
+                self.by_peer[peer] = left
+            else:
+                self.by_peer.pop(peer, None)
+            self._cond.notify_all()
+
+    def _note_full(self, peer: str) -> None:
+        now = self._clock()
+        if self._report is None or now - self._reported < 60.0:
+            return
+        self._reported = now
+        whose = (f"{peer} holds its share, {self.peer_limit >> 20} MB"
+                 if self.by_peer.get(peer, 0) >= self.peer_limit - CHUNK_BYTES
+                 else f"all {self.total >> 20} MB are taken")
+        self._report(f"package files in memory are at their bound ({whose}): downloads wait "
+                     "for room (clients that do not read theirs are closed after the send "
+                     "timeout)")
+
+
+def open_file(path: Path, uri: str, max_bytes: int = MAX_ASSET_BYTES) -> Tuple[BinaryIO, int]:
+    """The open file and its size, checked against ``max_bytes``; AssetError otherwise."""
+    try:
+        stream = open(path, "rb")
+    except OSError as exc:
+        raise AssetError(f"{uri}: cannot read {path}: {exc.strerror or exc}", 404) from None
+    try:
+        size = os.fstat(stream.fileno()).st_size
+    except OSError as exc:
+        stream.close()
+        raise AssetError(f"{uri}: cannot read {path}: {exc.strerror or exc}", 404) from None
+    if size > max_bytes:
+        stream.close()
+        raise AssetError(f"{uri} is {size} bytes, more than the {max_bytes} served", 413)
+    return stream, size
+
+
+def chunks(stream: BinaryIO, size: int, budget: Budget, peer: str, timeout: float,
+           chunk: int = CHUNK_BYTES) -> Iterator[memoryview]:
+    """The file's first ``size`` bytes, ``chunk`` at a time, each taken from ``budget`` for
+    ``peer`` and given back when the next is asked for (the caller has sent it by then: the
+    view is of one buffer, reused). AssetError (503) when no room is found in ``timeout``
+    seconds; a file that shrank ends early."""
+    buffer = bytearray(min(chunk, max(1, size)))
+    view = memoryview(buffer)
+    left = size
+    while left > 0:
+        n = min(len(buffer), left)
+        if not budget.acquire(peer, n, timeout):
+            raise AssetError(f"no room for package files in memory for {timeout:.0f} s "
+                             f"({budget.total >> 20} MB, shared by every download): "
+                             "try again", 503)
+        try:
+            got = stream.readinto(view[:n])
+            if not got:
+                return
+            yield view[:got]
+        finally:
+            budget.release(peer, n)
+        left -= got
+
+
+class Fragments:
+    """One WebSocket message made of fragments produced while it is sent (the writer sends
+    each before it asks for the next, so the message is never whole in memory)."""
+
+    def __init__(self, make: Callable[[], Iterator[bytes]]) -> None:
+        self.make = make
+
+    def __iter__(self) -> Iterator[bytes]:
+        return self.make()
 
 
 def read(uri: str, patterns: Sequence[Pattern[str]] = DEFAULT_PATTERNS,

@@ -14,7 +14,7 @@ from inside a ROS package, :mod:`minros.web.assets`); with ``use_sim_time`` the 
 from __future__ import annotations
 
 import threading
-from typing import Any, Callable, Dict, List, Optional, Set, Tuple
+from typing import Any, Callable, Dict, Iterator, List, Optional, Set, Tuple
 
 import minros
 from minros.msgs import reader_for
@@ -30,7 +30,7 @@ CAPABILITIES = ["clientPublish", "parameters", "parametersSubscribe", "services"
 QUEUE_LENGTH = 10
 QUEUE_BYTES = 32 << 20
 MAX_CALLS_IN_FLIGHT = 16
-#: asset fetches one client may have in flight (each reads a file in a thread)
+#: asset fetches one client may have in flight (resolved, queued or being sent)
 MAX_FETCHES_IN_FLIGHT = 8
 #: subscriptions and advertised channels one client may hold (each costs memory; a channel
 #: a publisher and a master registration)
@@ -47,7 +47,9 @@ class FoxgloveSession:
     def __init__(self, client_id: str, state: WebState, outbox: Outbox,
                  close_client: Callable[[str], None], server_name: str = "minros web",
                  run_async: Optional[Callable[[Callable[[], None]], None]] = None,
-                 asset_patterns: Any = assets.DEFAULT_PATTERNS) -> None:
+                 asset_patterns: Any = assets.DEFAULT_PATTERNS,
+                 asset_budget: Optional[assets.Budget] = None, peer: str = "",
+                 asset_timeout: float = 10.0) -> None:
         self.client_id = client_id
         self.state = state
         self.outbox = outbox
@@ -65,6 +67,11 @@ class FoxgloveSession:
         self._calls = threading.BoundedSemaphore(MAX_CALLS_IN_FLIGHT)
         self._fetches = threading.BoundedSemaphore(MAX_FETCHES_IN_FLIGHT)
         self.asset_patterns = asset_patterns
+        #: the server's budget of file bytes in memory, this client's address, and how long
+        #: a chunk may wait for room
+        self.asset_budget = asset_budget or assets.Budget()
+        self.peer = peer or client_id.rpartition(":")[0]
+        self.asset_timeout = asset_timeout
         self._closed = False
 
     @staticmethod
@@ -400,7 +407,7 @@ class FoxgloveSession:
 
     def fetch_asset(self, msg: Dict[str, Any]) -> None:
         """foxglove_bridge's fetchAsset: the file's bytes, or an error naming the URI (and,
-        unlike foxglove_bridge, why), read in a worker thread."""
+        unlike foxglove_bridge, why); resolved in a worker thread, read as it is sent."""
         uri, request_id = msg.get("uri"), msg.get("requestId")
         if not isinstance(uri, str) or type(request_id) is not int or not 0 <= request_id < 1 << 32:
             self.error("fetchAsset needs a string 'uri' and an integer 'requestId' (0 to 2^32-1)")
@@ -413,17 +420,40 @@ class FoxgloveSession:
 
         def run() -> None:
             try:
-                reply = fp.fetch_asset_response(request_id, assets.read(uri, self.asset_patterns))
+                path = assets.resolve(uri, self.asset_patterns)
+                stream, size = assets.open_file(path, uri)
             except assets.AssetError as exc:
-                minros.logwarn(f"[web] Foxglove client {self.client_id}: Failed to retrieve "
-                               f"asset '{uri[:300]}': {exc}")
-                reply = fp.fetch_asset_response(request_id,
-                                                error=f"Failed to retrieve asset {uri}: {exc}")
-            finally:
                 self._fetches.release()
-            if not self._closed:
-                self.send_binary(reply)
+                self._asset_failed(request_id, uri, exc)
+                return
+            if self._closed:
+                stream.close()
+                self._fetches.release()
+                return
+            # one message, sent as fragments while the file is read (assets.chunks): the
+            # reply holds one chunk of the budget at a time, never the whole file
+            reply = assets.Fragments(lambda: self._asset_fragments(request_id, stream, size))
+            if not self.outbox.put_control(reply, assets.CHUNK_BYTES):
+                stream.close()
+                self._fetches.release()
+                self.close_client("the client does not read its messages")
         self.run_async(run)
+
+    def _asset_fragments(self, request_id: int, stream: Any, size: int) -> Iterator[bytes]:
+        try:
+            with stream:
+                yield fp.fetch_asset_response(request_id, b"")
+                yield from assets.chunks(stream, size, self.asset_budget, self.peer,
+                                         self.asset_timeout)
+        finally:
+            self._fetches.release()
+
+    def _asset_failed(self, request_id: int, uri: str, exc: assets.AssetError) -> None:
+        minros.logwarn(f"[web] Foxglove client {self.client_id}: Failed to retrieve "
+                       f"asset '{uri[:300]}': {exc}")
+        if not self._closed:
+            self.send_binary(fp.fetch_asset_response(
+                request_id, error=f"Failed to retrieve asset {uri}: {exc}"))
 
     # -- parameters ------------------------------------------------------------------------
 

@@ -11,6 +11,14 @@ names: ``~port``, ``~address``, ``~topics_glob``, ``~services_glob``, ``~params_
 page's 3D view and Foxglove's ``fetchAsset`` may read; see :mod:`minros.web.assets`; also read
 by ``minros web``, as ``_asset_uri_allowlist:=...``). Once listening, the node sets
 ``~actual_port`` to the port it got, as rosbridge_websocket does (``~port`` 0 picks a free one).
+
+``minros web`` refuses to start, in one line, when a live node already holds its name
+(``/minros_web`` unless ``--name`` or ``__name:=`` says otherwise): by ROS's rule the new node
+would shut the old one down, a server whose pages and clients would then lose it without a
+word. A unique (anonymous) name would not do either: both servers would serve the same
+``/rosapi/*`` services, the newer taking them over and, on exit, leaving the older without.
+So a second server is a deliberate choice, ``--name``. The launch-file executables keep
+ROS's rule: roslaunch users relaunch a node by its name.
 """
 
 from __future__ import annotations
@@ -93,6 +101,34 @@ def master_error() -> Optional[str]:
         master.close()
 
 
+def name_taken(name: str, argv: Optional[List[str]] = None) -> Optional[str]:
+    """Why ``minros web`` must not take the node name ``name`` (``__name:=`` in ``argv``
+    wins): a live node already holds it. None when it is free, or held by a node that no
+    longer answers (a stale registration, which init_node replaces as rospy does)."""
+    from minros import names
+    from minros.tools.master import Master, MasterError, MasterIOError, call_node
+
+    argv = list(sys.argv if argv is None else argv)
+    given = names.load_mappings(argv).get("__name", name)
+    resolved = names.resolve_name(given, names.get_ros_namespace(argv=argv) + "unnamed")
+    master = Master(resolved)
+    try:
+        uri = master.lookup_node(resolved)
+    except (MasterError, MasterIOError):
+        return None
+    finally:
+        master.close()
+    try:
+        code, _msg, pid = call_node(uri, "getPid", resolved, timeout=2.0)
+    except OSError:
+        return None
+    if code != 1:
+        return None
+    return (f"a node named {resolved} is already running (pid {pid}, {uri}); another with its "
+            "name would shut it down, as ROS does. Stop that one, or start this one under a "
+            "name of its own: minros web --name minros_web2")
+
+
 def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = None) -> int:
     """Start the node and the server; serve until Ctrl-C or a ROS shutdown. Exit status."""
     from minros.web.rosapi import Rosapi
@@ -102,6 +138,15 @@ def run(settings: Settings, announce: Any = print, argv: Optional[List[str]] = N
     if error:
         print(f"minros web: error: {error}", file=sys.stderr)
         return 1
+    # `minros web` (the node not yet started): refuse a name a live node holds. The
+    # launch-file executables (run_node, already a node) keep ROS's rule instead.
+    from minros.node import is_initialized
+
+    if not is_initialized():
+        taken = name_taken(settings.name, argv)
+        if taken:
+            print(f"minros web: error: {taken}", file=sys.stderr)
+            return 1
     minros.init_node(settings.name, argv=argv, disable_signals=True)
     stop = threading.Event()
     SignalWatch(lambda _signum: stop.set(), "web-signals").install((signal.SIGINT, signal.SIGTERM))

@@ -45,7 +45,7 @@ import time
 import traceback
 import urllib.parse
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple
 
 import minros
 from minros import rosenv
@@ -170,13 +170,29 @@ class _Client:
                               f"{slot.key if slot else 'reply'}: {exc}")
                 continue
             try:
-                for frame in frames:
-                    self.send_started = time.monotonic()
-                    send(frame)
+                if isinstance(frames, assets.Fragments):
+                    send(self._paced(frames))
                     self.send_started = None
+                else:
+                    for frame in frames:
+                        self.send_started = time.monotonic()
+                        send(frame)
+                        self.send_started = None
             except (ConnectionClosed, OSError):
                 self.send_started = None
                 return
+            except assets.AssetError as exc:  # websockets has failed the connection (1011)
+                self.send_started = None
+                self.close(f"a file could not be sent: {exc}")
+                return
+            self.touch()
+
+    def _paced(self, fragments: Iterable[Any]) -> Iterator[Any]:
+        """The fragments of one message, the watchdog's clock restarted at each (a long
+        message to a client that keeps reading is not a stalled send)."""
+        for fragment in fragments:
+            self.send_started = time.monotonic()
+            yield fragment
             self.touch()
 
 
@@ -320,6 +336,8 @@ class WebServer:
         self._threads: List[threading.Thread] = []
         self._evicted = 0
         self._evicted_logged = -10.0
+        self._slow_closed = 0
+        self._slow_logged = -60.0
         self.allowed = rosenv.allowed_hosts()  # ValueError naming a malformed entry
         #: the Host and Origin checks (OriginError naming a malformed --allow-origin)
         self.origins = OriginPolicy(allow_origins, _local_names(host))
@@ -327,6 +345,8 @@ class WebServer:
         #: which package files /pkg/ and Foxglove's fetchAsset serve (ValueError naming a
         #: pattern that does not parse)
         self.asset_patterns = assets.compile_allowlist(asset_allowlist)
+        #: the bytes of package files in memory at once, for /pkg/ and fetchAsset together
+        self.asset_budget = assets.Budget(report=lambda text: minros.logwarn(f"[web] {text}"))
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -515,7 +535,7 @@ class WebServer:
             return self._response(200, video.viewer_page(params, query).encode(),
                                   "text/html; charset=utf-8")
         if path.startswith("/pkg/"):
-            return self._package_file(path)
+            return self._package_file(connection, path, cors)
         if path == "/streams":
             graph = self.state.refresh_graph()
             topics = [t for t, ty in graph.topic_types.items() if video.is_image_type(ty)]
@@ -538,18 +558,64 @@ class WebServer:
             content_type += "; charset=utf-8"
         return self._response(200, target.read_bytes(), content_type)
 
-    def _package_file(self, path: str) -> Any:
+    def _package_file(self, connection: Any, path: str, cors: Optional[str]) -> Any:
         """``/pkg/<package>/<path>``: the file ``package://<package>/<path>`` names, if the
-        asset rules allow it (the path stays percent-encoded: the rules decode it)."""
+        asset rules allow it (the path stays percent-encoded: the rules decode it), written
+        on the socket as it is read (:func:`assets.chunks`), within admission's time for
+        its length; this runs in the connection's own thread."""
         uri = assets.PACKAGE_PREFIX + path[len("/pkg/"):]
         try:
-            data = assets.read(uri, self.asset_patterns)
+            stream, size = assets.open_file(assets.resolve(uri, self.asset_patterns), uri)
         except assets.AssetError as exc:
             return self._text(exc.status, f"minros web: {exc}")
         suffix = uri.rsplit(".", 1)[-1].lower()
-        content_type = _MESH_TYPES.get(suffix) or mimetypes.guess_type("x." + suffix)[0]
-        return self._response(200, data, content_type or "application/octet-stream",
-                              [("Cache-Control", "no-cache")])
+        content_type = (_MESH_TYPES.get(suffix) or mimetypes.guess_type("x." + suffix)[0]
+                        or "application/octet-stream")
+        head = [f"HTTP/1.1 200 OK\r\nServer: minros web\r\nContent-Type: {content_type}\r\n",
+                f"Content-Length: {size}\r\nCache-Control: no-cache\r\nConnection: close\r\n"]
+        if cors is not None:
+            head.append(f"Access-Control-Allow-Origin: {cors}\r\nVary: Origin\r\n")
+        sock = connection.socket
+        peer = connection.remote_address[0] if connection.remote_address else ""
+        deadline = time.monotonic() + WEB_LIMITS.transfer_time(size)
+        started = False
+        try:
+            with stream:
+                pending = ["".join(head).encode("latin-1") + b"\r\n"]
+                for chunk in assets.chunks(stream, size, self.asset_budget, peer,
+                                           self.send_timeout):
+                    left = deadline - time.monotonic()
+                    if left <= 0:
+                        raise TimeoutError(f"{size} bytes take longer than "
+                                           f"{WEB_LIMITS.transfer_time(size):.0f} s")
+                    started = True
+                    send_with_timeout(sock, [*pending, chunk], min(self.send_timeout, left))
+                    pending = []
+                if pending:  # an empty file
+                    send_with_timeout(sock, pending, self.send_timeout)
+        except assets.AssetError as exc:  # no room in the budget
+            if not started:
+                return self._text(exc.status, f"minros web: {exc}")
+        except TimeoutError as exc:
+            self._note_slow_download(peer, uri, str(exc))
+        except OSError:
+            pass  # the client went away
+        try:
+            sock.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+        return self._text(200, "")  # not delivered: the socket is shut down
+
+    def _note_slow_download(self, peer: str, uri: str, why: str) -> None:
+        """One line for a download closed for not being read, then at most one a minute."""
+        now = time.monotonic()
+        with self._lock:
+            if now - self._slow_logged < 60.0:
+                self._slow_closed += 1
+                return
+            count, self._slow_closed, self._slow_logged = self._slow_closed, 0, now
+        more = f" ({count} more since the last report)" if count else ""
+        minros.logwarn(f"[web] closed the download of {uri[:200]} to {peer}: {why}{more}")
 
     # -- video -----------------------------------------------------------------------------
 
@@ -655,7 +721,10 @@ class WebServer:
         if foxglove:
             client.session = FoxgloveSession(client_id, self.state, client.outbox, client.close,
                                              server_name=self.name,
-                                             asset_patterns=self.asset_patterns)
+                                             asset_patterns=self.asset_patterns,
+                                             asset_budget=self.asset_budget,
+                                             peer=peer[0] if peer else "",
+                                             asset_timeout=self.send_timeout)
         elif page:
             client.session = PageSession(client_id, self.state, client.outbox, client.close,
                                          self.page_hub, rosapi=self.rosapi,

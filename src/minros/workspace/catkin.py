@@ -358,20 +358,26 @@ exec "$@"
 """
 
 
+#: what an earlier catkin_make's relay to a package's sources began with (rewritten now)
 _RELAY_MARK = "# minros catkin_make: relay to the package's Python sources"
 
 
-def _python_relay(src_module: Path) -> str:
-    """An __init__.py that makes the devel-space package also serve the source-space modules."""
-    return f"""{_RELAY_MARK}
-import os as _os
-__path__.append({str(src_module)!r})
-_init = _os.path.join({str(src_module)!r}, "__init__.py")
-if _os.path.isfile(_init):
-    with open(_init) as _f:
-        exec(compile(_f.read(), _init, "exec"))
-del _os, _init
-"""
+def _write_overlay_init(folder: Path, module_src: Path | None) -> None:
+    """The devel-space ``__init__.py`` of a package (minros.workspace.devel): the package's
+    sources and its underlay behind the stand-ins written here. One a user wrote (no minros
+    mark) is left alone."""
+    from minros.workspace.devel import MARK, init_text
+
+    init = folder / "__init__.py"
+    folder.mkdir(parents=True, exist_ok=True)
+    if init.exists():
+        try:
+            current = init.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            return
+        if current.strip() and not any(mark in current for mark in (*_WRITTEN_BY_MINROS, MARK)):
+            return
+    init.write_text(init_text(str(folder), str(module_src) if module_src else None))
 
 
 def _interface_counts(pkg: Path) -> Dict[str, int]:
@@ -443,7 +449,9 @@ def _write_message_stubs(manifest: Manifest, dist_packages: Path, src: Path,
             for suffix in _ACTION_TYPES:
                 _check_definition(path, msgs.get_message_class, f"{name}/{path.stem}{suffix}")
         if stubs:
-            msgs.write_stub_package(name, dist_packages)
+            kinds = [kind for kind, folders in (("msg", ("msg", "action")), ("srv", ("srv",)))
+                     if any((manifest.path / f).is_dir() for f in folders)]
+            msgs.write_stub_package(name, dist_packages, kinds)
     finally:
         if previous is None:
             os.environ.pop("ROS_PACKAGE_PATH", None)
@@ -468,29 +476,12 @@ def shipped_python_packages() -> frozenset:
         if stubs.is_dir():
             names = {p.name for p in stubs.iterdir() if (p / "__init__.py").is_file()}
     names.discard("minros")
-    return frozenset(names)
+    # _minros_import_hook: minros's start-up hook, no ROS package
+    return frozenset(n for n in names if not n.startswith("_"))
 
 
 #: texts that mark a devel-space package as written by minros's catkin_make (safe to remove)
 _WRITTEN_BY_MINROS = ("provided by minros", "written by minros catkin_make", _RELAY_MARK)
-
-
-def _remove_shadowing_package(folder: Path) -> bool:
-    """Remove a devel-space package an earlier catkin_make wrote under a name minros ships;
-    one the user wrote (without minros's marks) is left alone. Returns whether it is gone."""
-    import shutil
-
-    init = folder / "__init__.py"
-    if not folder.is_dir():
-        return True
-    try:
-        text = init.read_text(encoding="utf-8") if init.exists() else ""
-    except (OSError, UnicodeDecodeError):
-        return False
-    if not any(mark in text for mark in _WRITTEN_BY_MINROS):
-        return False
-    shutil.rmtree(folder, ignore_errors=True)
-    return not folder.exists()
 
 
 def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _print) -> List[Manifest]:
@@ -534,33 +525,21 @@ def make_workspace(workspace: Path, *, jobs: int | None = None, out: Print = _pr
         out(f"-- +++ processing catkin package: '{m.name}'")
         out(f"-- ==> add_subdirectory({m.path.relative_to(src)})")
         counts = _interface_counts(m.path)
-        # a package under the name of a library minros ships gets no Python package in the
-        # devel space (it would hide the library); its .msg/.srv/.cfg still import through
-        # minros's package of that name and the import hook, from the workspace's files
-        hides = m.name in shipped
-        if hides:
-            if not _remove_shadowing_package(dist / m.name):
-                raise WorkspaceError(
-                    f"{dist / m.name} hides minros's Python package '{m.name}': remove it")
-            out(f"-- {m.name}: minros ships the Python package '{m.name}'; the devel space "
-                "leaves it in place (the package's messages import from the workspace)")
+        module_src = m.path / "src" / m.name
+        has_python = (module_src / "__init__.py").is_file()
+        if m.name in shipped:
+            # a devel space puts the workspace's package first: its modules and messages win,
+            # and what it lacks comes from minros's package of that name (as an underlay)
+            out(f"-- {m.name}: the workspace's package comes before minros's '{m.name}'; "
+                "what it lacks comes from minros's")
         if counts["msg"] or counts["srv"] or counts["action"]:
             messages = counts["msg"] + len(_ACTION_TYPES) * counts["action"]
             out(f"-- {m.name}: {messages} messages, {counts['srv']} services")
-            _write_message_stubs(m, dist, src, out, stubs=not hides)
+            _write_message_stubs(m, dist, src, out)
         if counts["cfg"]:
-            if hides:
-                _check_cfg_scripts(m, out)
-            else:
-                _write_cfg_modules(m, dist, out)
-        module_src = m.path / "src" / m.name
-        if (module_src / "__init__.py").is_file() and not hides:
-            init = dist / m.name / "__init__.py"
-            init.parent.mkdir(parents=True, exist_ok=True)
-            text = init.read_text() if init.exists() else ""
-            if _RELAY_MARK not in text:
-                init.write_text(text + ("\n" if text and not text.endswith("\n") else "")
-                                + _python_relay(module_src))
+            _write_cfg_modules(m, dist, out)
+        if has_python or (dist / m.name).is_dir():
+            _write_overlay_init(dist / m.name, module_src if has_python else None)
         share = devel / "share" / m.name
         share.mkdir(parents=True, exist_ok=True)
         out(f"[{100 * index // total:3d}%] Built target {m.name}")

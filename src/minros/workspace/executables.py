@@ -87,7 +87,9 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     "rosservice": {"rosservice": "minros.cli.service"},
     "rosmsg": {"rosmsg": "minros.cli.msg", "rossrv": "minros.cli.srv"},
     "rosconsole": {"rosconsole": "minros.cli.console"},
-    "rostest": {"rostest": "minros.cli.rostest"},
+    # rostest's own test nodes (<test pkg="rostest" type="hztest">)
+    "rostest": {"rostest": "minros.cli.rostest", **{name: f"minros.nodes.rostest.{name}" for name in (
+        "hztest", "paramtest", "publishtest", "advertisetest")}},
     "nodelet": {"nodelet": "minros.nodes.nodelet.nodelet"},
     "image_transport": {"republish": "minros.nodes.image_transport.republish"},
     "robot_state_publisher": {
@@ -108,7 +110,7 @@ BUILTIN_NODES: Dict[str, Dict[str, str]] = {
     # topic_tools' programs (minros.topic_tools; ROS ships C++ relay/throttle/drop/mux)
     "topic_tools": {name: f"minros.nodes.topic_tools.{name}" for name in (
         "relay", "throttle", "drop", "mux", "transform", "mux_select", "mux_add",
-        "mux_delete", "mux_list")},
+        "mux_delete", "mux_list", "switch_mux")},
 }
 
 # `#!/usr/bin/env python`, `#!/usr/bin/python3`, `#!/usr/bin/env -S python3 -u`...

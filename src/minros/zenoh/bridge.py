@@ -8,7 +8,18 @@
   and sends the beacons of the local resources (once when declared, then every second).
 - Zenoh's own threads deliver beacons (into the remote table, waking the control thread),
   samples (``Inlet``: checked, then published in ROS in that thread, no hand-off) and queries
-  (``Queryable``: handed to a pool, as a service call may take long).
+  (``Queryable``: handed to a pool of 8, as a service call may take long; past 64 waiting,
+  refused). Callbacks are declared ``indirect=False`` (zenoh-python would otherwise start a
+  thread per subscriber and queryable, a thread per remote topic), but for the samples of the
+  topics local nodes subscribe to (``Inlet``'s ``threaded``: the local graph bounds those).
+
+What remote beacons can make is bounded (a peer on a ``--listen`` port can send any): the
+remote table holds at most ``MAX_REMOTE`` resources; at most ``max_remote`` bridges exist for
+remote beacons alone (``plan.limit_remote``: the first heard are kept, so earlier peers keep
+theirs); they are made at ``create_rate`` a second at most, after what the local graph asks
+for, and one round spends at most ``CREATE_BUDGET`` seconds making bridges; each bound, when
+hit, is one log line, then one a minute. The threads are a constant: graph, control, the
+probe and call pools, Zenoh's own.
 
 ROS side, only the public API: a ``Subscriber`` with a raw class per topic carried out (the
 receive thread puts each message on Zenoh: no hand-off either), a ``Publisher`` with the
@@ -33,10 +44,18 @@ import minros
 from minros.exceptions import ServiceException
 from minros.tools.master import get_master_uri
 from minros.zenoh import keys, layout, meta
-from minros.zenoh.discovery import Declarations, OnceLog, RemoteTable
+from minros.zenoh.discovery import (
+    BoundLog,
+    Chatter,
+    Declarations,
+    OnceLog,
+    RemoteTable,
+    TableFull,
+    TokenBucket,
+)
 from minros.zenoh.graph import LocalGraph, PublisherInfo, Snapshot
 from minros.zenoh.keys import KeyMappingError
-from minros.zenoh.plan import Plan, Topic, plan
+from minros.zenoh.plan import Plan, Topic, limit_remote, plan, remote_only
 from minros.zenoh.raw import raw_class, raw_service_class
 
 __all__ = ["Bridge", "BridgeError", "Options", "zenoh_config"]
@@ -52,6 +71,20 @@ RETRY = 2.0
 META_TIMEOUT = 1.0
 #: idle persistent service connections kept per answered service
 IDLE_PROXIES = 4
+#: service calls from Zenoh waiting for the pool before new ones are refused
+MAX_PENDING_CALLS = 64
+#: seconds one control round may spend making bridges (the rest wait for the next round)
+CREATE_BUDGET = 0.25
+#: bridges that exist for remote beacons alone, and how fast they are made
+MAX_REMOTE_BRIDGES = 1000
+CREATE_RATE = 50.0
+CREATE_BURST = 100.0
+
+
+def _direct(fn: Callable[[Any], None]) -> Any:
+    """A Zenoh callback run in Zenoh's own thread (zenoh-python's default runs each
+    subscriber's and queryable's callback in a thread of its own: one per remote topic)."""
+    return zenoh.handlers.Callback(fn, indirect=False)
 
 
 class BridgeError(Exception):
@@ -69,6 +102,9 @@ class Options:
     poll_interval: float = 0.1
     #: data samples skip Zenoh's batching (latency over throughput of tiny messages)
     express: bool = True
+    #: bridges that exist for remote beacons alone (see the module doc), and their rate
+    max_remote: int = MAX_REMOTE_BRIDGES
+    create_rate: float = CREATE_RATE
 
 
 def zenoh_config(options: Options) -> Any:
@@ -110,7 +146,7 @@ class Outlet:
             self.key, congestion_control=zenoh.CongestionControl.BLOCK,
             reliability=zenoh.Reliability.RELIABLE, express=bridge.options.express,
             allowed_destination=zenoh.Locality.REMOTE)
-        self.queryable = session.declare_queryable(self.meta_key, self._on_meta,
+        self.queryable = session.declare_queryable(self.meta_key, _direct(self._on_meta),
                                                    allowed_origin=zenoh.Locality.REMOTE)
         self.subscriber = minros.Subscriber(name, raw_class(type_name, md5, self.definition),
                                             self._on_message, tcp_nodelay=True)
@@ -147,9 +183,15 @@ class Inlet:
 
     The Zenoh subscriber comes first and keeps the last sample that arrives before the
     publisher exists, then the publishing bridge is asked for its record: a latched message
-    sent while this inlet was being made is not lost either way."""
+    sent while this inlet was being made is not lost either way.
 
-    def __init__(self, bridge: Bridge, topic: Topic) -> None:
+    ``threaded``: the samples are taken by a thread of the subscriber's own (zenoh-python's
+    default), which costs a thread but about 60 us less CPU per sample than a callback in
+    Zenoh's thread, which has to take the GIL each time; an inlet a local node subscribes to
+    is threaded (the local graph bounds those), one made for remote beacons alone is not
+    until a local node subscribes (:meth:`thread`)."""
+
+    def __init__(self, bridge: Bridge, topic: Topic, threaded: bool = False) -> None:
         name, type_name, md5 = topic
         self.bridge = bridge
         self.topic = topic
@@ -157,8 +199,8 @@ class Inlet:
         self.publisher: Any = None
         self._early: Optional[Tuple[bytes, str]] = None
         self._lock = threading.Lock()
-        self.subscriber = bridge.session.declare_subscriber(
-            self.key, self._on_sample, allowed_origin=zenoh.Locality.REMOTE)
+        self.threaded = threaded
+        self.subscriber = self._declare(threaded)
         try:
             self.record = record = bridge.ask_meta(topic)
             definition = (record.definition if record and record.definition
@@ -179,6 +221,21 @@ class Inlet:
             early, self._early = self._early, None
         if early is not None:
             self._publish(*early)
+
+    def _declare(self, threaded: bool) -> Any:
+        handler = self._on_sample if threaded else _direct(self._on_sample)
+        return self.bridge.session.declare_subscriber(self.key, handler,
+                                                      allowed_origin=zenoh.Locality.REMOTE)
+
+    def thread(self) -> None:
+        """Take the samples in a thread from now on (a local node subscribes now). The
+        direct subscriber goes first: a sample in between is lost, none is delivered twice."""
+        if self.threaded:
+            return
+        self.threaded = True
+        old = self.subscriber
+        old.undeclare()
+        self.subscriber = self._declare(True)
 
     def _on_sample(self, sample: Any) -> None:
         data = sample.payload.to_bytes()
@@ -225,10 +282,12 @@ class Queryable:
         self._idle: List[Any] = []
         self._lock = threading.Lock()
         self.queryable = bridge.session.declare_queryable(
-            self.key, self._on_query, allowed_origin=zenoh.Locality.REMOTE)
+            self.key, _direct(self._on_query), allowed_origin=zenoh.Locality.REMOTE)
 
     def _on_query(self, query: Any) -> None:
-        self.bridge.pool.submit(self._answer, query)
+        if not self.bridge.submit_call(self._answer, query):
+            query.reply_err(f"the bridge has {MAX_PENDING_CALLS} calls waiting: {self.name} "
+                            "is not called, try again")
 
     def _answer(self, query: Any) -> None:
         payload = query.payload
@@ -341,6 +400,16 @@ def _text(data: bytes) -> Optional[str]:
 # -- the bridge ---------------------------------------------------------------------------------
 
 
+@dataclass
+class _Round:
+    """One control round's creation budget: its deadline, the first-heard times, and how
+    many bridges it left for later."""
+
+    deadline: float
+    first_heard: Dict[Topic, float]
+    deferred: int = 0
+
+
 class Bridge:
     """Bridges the master the node is attached to with a Zenoh network."""
 
@@ -360,6 +429,12 @@ class Bridge:
         self.graph = LocalGraph(minros.get_name(), get_master_uri(),
                                 lambda text: self.once(text))
         self.pool = ThreadPoolExecutor(max_workers=8, thread_name_prefix="minros-zenoh-call")
+        self._pending_calls = 0
+        self._calls_lock = threading.Lock()
+        self.bounds = BoundLog(log)
+        self.chatter = Chatter(info)
+        self.rate = TokenBucket(options.create_rate, max(CREATE_BURST, options.create_rate),
+                                time.monotonic())
         self.snapshot: Optional[Snapshot] = None
         self.outlets: Dict[Topic, Outlet] = {}
         self.inlets: Dict[Topic, Inlet] = {}
@@ -367,13 +442,14 @@ class Bridge:
         self.proxies: Dict[Topic, Proxy] = {}
         self._beacons: Dict[str, Any] = {}
         self._retry: Dict[Tuple[str, Topic], float] = {}
+        self._round = _Round(0.0, {})
         self._checkers: Dict[Tuple[str, str, str], Optional[Callable[[Any], None]]] = {}
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._master_down = False
         self._threads: List[threading.Thread] = []
         self._discovery = self.session.declare_subscriber(
-            keys.discovery_subscription(options.namespace), self._on_beacon)
+            keys.discovery_subscription(options.namespace), _direct(self._on_beacon))
 
     @property
     def zid(self) -> str:
@@ -410,11 +486,43 @@ class Bridge:
 
     def _on_beacon(self, sample: Any) -> None:
         key = str(sample.key_expr)
+        now = time.monotonic()
         try:
-            if self.remote.heard(key, time.monotonic()) is not None:
+            if self.remote.heard(key, now) is not None:
                 self._wake.set()
+        except TableFull:
+            self.bounds("table", f"more than {self.remote.max_entries} remote resources are "
+                        f"declared to this bridge: ignoring the new ones (such as [{key[:200]}]) "
+                        "until some are lost", now)
         except KeyMappingError as exc:
             self.once(f"beacon {key}", f"ignoring beacons on {key}: {exc}")
+
+    def submit_call(self, fn: Callable[[Any], None], query: Any) -> bool:
+        """Run a service call from Zenoh in the pool; False when too many wait already."""
+        with self._calls_lock:
+            if self._pending_calls >= MAX_PENDING_CALLS:
+                full = True
+            else:
+                full = False
+                self._pending_calls += 1
+        if full:
+            self.bounds("calls", f"{MAX_PENDING_CALLS} service calls from Zenoh are waiting: "
+                        "new ones are refused until they are answered", time.monotonic())
+            return False
+
+        def run() -> None:
+            try:
+                fn(query)
+            finally:
+                with self._calls_lock:
+                    self._pending_calls -= 1
+        try:
+            self.pool.submit(run)
+        except RuntimeError:  # shutting down
+            with self._calls_lock:
+                self._pending_calls -= 1
+            return False
+        return True
 
     # -- the graph thread ---------------------------------------------------------------------
 
@@ -454,38 +562,78 @@ class Bridge:
     def step(self, now: float) -> Plan:
         """One round: forget silent remote resources, bridge what the plan says, beacon."""
         for lost in self.remote.expire(now):
-            self.info(f"lost remote {lost.kind} {lost.name} ({lost.type})")
+            self.chatter(f"lost remote {lost.kind} {lost.name} ({lost.type})", now)
         snapshot = self.snapshot
         local = snapshot.resources if snapshot is not None else frozenset()
         remote = self.remote.resources()
-        wanted = plan(local, remote)
+        first_heard = self.remote.first_heard()
+        wanted, left_out = limit_remote(plan(local, remote), local, first_heard,
+                                        self.options.max_remote)
         for text in wanted.conflicts:
             self.once(text)
+        if left_out:
+            self.bounds("count", f"remote bridges are at their bound of "
+                        f"{self.options.max_remote}: {left_out} more topics and services "
+                        "declared by remote beacons alone are not bridged (the first heard "
+                        "are kept; --max-remote raises the bound)", now)
+        only = remote_only(wanted, local)
         publishers = snapshot.publishers if snapshot is not None else {}
-        self._sync("outlet", self.outlets, wanted.outlets, now,
-                   lambda t: Outlet(self, t, publishers.get(t)), "ROS -> Zenoh")
+        self._round = _Round(now + CREATE_BUDGET, first_heard)
         self._sync("inlet", self.inlets, wanted.inlets, now,
-                   lambda t: Inlet(self, t), "Zenoh -> ROS")
+                   lambda t: Inlet(self, t, threaded=t not in only["inlets"]), "Zenoh -> ROS",
+                   only["inlets"])
+        for topic, inlet in self.inlets.items():
+            if not inlet.threaded and topic not in only["inlets"]:
+                inlet.thread()
+        self._sync("outlet", self.outlets, wanted.outlets, now,
+                   lambda t: Outlet(self, t, publishers.get(t)), "ROS -> Zenoh", only["outlets"])
         self._upgrade_inlets(remote)
         self._sync("queryable", self.queryables, wanted.queryables, now,
-                   lambda t: Queryable(self, t), "service ROS -> Zenoh")
+                   lambda t: Queryable(self, t), "service ROS -> Zenoh", frozenset())
         self._sync("proxy", self.proxies, wanted.proxies, now,
-                   lambda t: Proxy(self, t), "service Zenoh -> ROS")
+                   lambda t: Proxy(self, t), "service Zenoh -> ROS", only["proxies"])
+        if self._round.deferred:
+            self.bounds("rate", f"bridges for remote beacons are made at most "
+                        f"{self.options.create_rate:g} a second and {CREATE_BUDGET} s a round: "
+                        f"{self._round.deferred} wait for the next rounds", now)
+        kept = {(k, t) for k, table in (("inlet", wanted.inlets), ("outlet", wanted.outlets),
+                                        ("queryable", wanted.queryables),
+                                        ("proxy", wanted.proxies)) for t in table}
+        for stale in [k for k in self._retry if k not in kept]:
+            del self._retry[stale]
         self.declarations.update(wanted.declare, now)
         self._send_beacons(now)
         return wanted
 
     def _sync(self, kind: str, current: Dict[Topic, Any], wanted: Any, now: float,
-              make: Callable[[Topic], Any], direction: str) -> None:
+              make: Callable[[Topic], Any], direction: str, beacon_only: Any) -> None:
+        """Close what is no longer wanted; make what is newly wanted: what the local graph
+        asks for first, then what remote beacons alone ask for, the first heard first, one
+        token of the creation rate each; none once the round's time budget is spent."""
+        def said(text: str, topic: Topic) -> None:
+            if topic in beacon_only or topic not in wanted:
+                self.chatter(text, now)  # a peer's flood must not flood the log
+            else:
+                self.info(text)
+
         for topic in [t for t in current if t not in wanted]:
             obj = current.pop(topic)
             try:
                 obj.close()
             except Exception as exc:  # noqa: BLE001
                 self.once(f"close {kind} {topic} {exc}", f"closing the bridge of {topic[0]}: {exc}")
-            self.info(f"stopped bridging {topic[0]} ({topic[1]}) {direction}")
-        for topic in sorted(t for t in wanted if t not in current):
+            said(f"stopped bridging {topic[0]} ({topic[1]}) {direction}", topic)
+        first = self._round.first_heard
+        new = sorted((t for t in wanted if t not in current),
+                     key=lambda t: (t in beacon_only, first.get(t, 0.0), t))
+        for topic in new:
             if self._retry.get((kind, topic), 0.0) > now:
+                continue
+            if time.monotonic() > self._round.deadline:
+                self._round.deferred += 1
+                continue
+            if topic in beacon_only and not self.rate.take(time.monotonic()):
+                self._round.deferred += 1
                 continue
             try:
                 current[topic] = make(topic)
@@ -495,7 +643,7 @@ class Bridge:
                           f"cannot bridge {topic[0]} ({topic[1]}) {direction}: {exc}")
                 continue
             self._retry.pop((kind, topic), None)
-            self.info(f"bridging {topic[0]} ({topic[1]}) {direction}")
+            said(f"bridging {topic[0]} ({topic[1]}) {direction}", topic)
 
     def ask_meta(self, topic: Topic) -> Optional[meta.TopicMeta]:
         """The record a minros bridge publishing ``topic`` answers with, or None (no minros
@@ -535,7 +683,7 @@ class Bridge:
                 del self.inlets[topic]
                 inlet.close()
                 try:
-                    self.inlets[topic] = Inlet(self, topic)
+                    self.inlets[topic] = Inlet(self, topic, threaded=inlet.threaded)
                 except Exception as exc:  # noqa: BLE001 - the next step makes it again
                     self.once(f"remake {topic} {exc}", f"cannot bridge {topic[0]}: {exc}")
             else:

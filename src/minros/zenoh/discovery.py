@@ -6,23 +6,31 @@ three periods (``LOST_AFTER``) is lost (zenoh-plugin-ros1 ``aloha_declaration.rs
 ``aloha_subscription.rs``; its check runs once per 3 s, so it notices a loss after 3 to 6 s,
 this table after 3 s plus the caller's tick).
 
-``RemoteTable`` is what a bridge heard; ``Declarations`` what it sends and when; ``OnceLog``
-keeps a misbehaving peer to one log line per distinct fault.
+``RemoteTable`` is what a bridge heard (and when each resource was first heard: older ones
+keep their bridges when a flood of new ones arrives); ``Declarations`` what it sends and when;
+``OnceLog`` keeps a misbehaving peer to one log line per distinct fault, ``BoundLog`` to one
+line when a bound is first hit and then one a minute; ``TokenBucket`` is the rate at which
+beacons may create bridges.
 """
 
 from __future__ import annotations
 
 import threading
-from typing import Callable, Dict, FrozenSet, List, Optional, Set
+from typing import Callable, Dict, FrozenSet, List, Optional, Set, Tuple
 
 from minros.zenoh.keys import KeyMappingError, Resource, discovery_key, parse_discovery_key
 
-__all__ = ["BEACON_PERIOD", "LOST_AFTER", "Declarations", "OnceLog", "RemoteTable"]
+__all__ = ["BEACON_PERIOD", "LOST_AFTER", "BoundLog", "Chatter", "Declarations", "OnceLog",
+           "RemoteTable", "TableFull", "TokenBucket"]
 
 BEACON_PERIOD = 1.0
 LOST_AFTER = 3.0 * BEACON_PERIOD
 #: bound on the resources remembered from peers (a peer inventing keys cannot grow it further)
 MAX_REMOTE = 20000
+
+
+class TableFull(KeyMappingError):
+    """A new remote resource while the table holds ``max_entries``."""
 
 
 class OnceLog:
@@ -50,6 +58,78 @@ class OnceLog:
         return True
 
 
+class BoundLog:
+    """One line when a bound is first hit, then at most one every ``interval`` seconds with
+    how many times it was hit meanwhile (a flood must not flood the log)."""
+
+    def __init__(self, log: Callable[[str], None], interval: float = 60.0) -> None:
+        self._log = log
+        self.interval = interval
+        self._last: Dict[str, float] = {}
+        self._count: Dict[str, int] = {}
+        self._lock = threading.Lock()
+
+    def __call__(self, bound: str, text: str, now: float) -> bool:
+        """``text`` about ``bound``, logged unless said within the interval; True if logged."""
+        with self._lock:
+            last = self._last.get(bound)
+            if last is not None and now - last < self.interval:
+                self._count[bound] = self._count.get(bound, 0) + 1
+                return False
+            count = self._count.pop(bound, 0)
+            self._last[bound] = now
+        more = f" ({count} more times since the last report)" if count else ""
+        self._log(text + more)
+        return True
+
+
+class Chatter:
+    """At most ``budget`` lines every ``interval`` seconds (the bridges made and lost for
+    remote beacons: a peer that keeps inventing names must not grow the log at its pace);
+    the first line after a quiet spell says how many were not written."""
+
+    def __init__(self, log: Callable[[str], None], budget: int = 100,
+                 interval: float = 60.0) -> None:
+        self._log = log
+        self.budget = budget
+        self.interval = interval
+        self._start = -float("inf")
+        self._written = 0
+        self._quiet = 0
+
+    def __call__(self, text: str, now: float) -> bool:
+        if now - self._start >= self.interval:
+            if self._quiet:
+                self._log(f"{self._quiet} more lines about bridges for remote beacons were "
+                          f"not written (at most {self.budget} every {self.interval:g} s)")
+            self._start, self._written, self._quiet = now, 0, 0
+        if self._written >= self.budget:
+            self._quiet += 1
+            return False
+        self._written += 1
+        self._log(text)
+        return True
+
+
+class TokenBucket:
+    """``rate`` tokens a second, at most ``burst`` saved up (times are arguments)."""
+
+    def __init__(self, rate: float, burst: float, now: float = 0.0) -> None:
+        self.rate = rate
+        self.burst = burst
+        self.tokens = burst
+        self._at = now
+
+    def take(self, now: float) -> bool:
+        """One token if there is one."""
+        self.tokens = min(self.burst, self.tokens + (now - self._at) * self.rate)
+        self._at = now
+        if self.tokens >= 1.0:
+            self.tokens -= 1.0
+            return True
+        return False
+
+
 class RemoteTable:
     """The remote resources heard in beacons, each with the time it was last heard."""
 
@@ -57,6 +137,7 @@ class RemoteTable:
         self.lost_after = lost_after
         self.max_entries = max_entries
         self._last: Dict[str, float] = {}
+        self._first: Dict[str, float] = {}
         self._resource: Dict[str, Resource] = {}
         self._lock = threading.Lock()
 
@@ -74,9 +155,10 @@ class RemoteTable:
                 self._last[key] = now
                 return None
             if len(self._last) >= self.max_entries:
-                raise KeyMappingError(f"more than {self.max_entries} remote resources: "
-                                      f"ignoring [{key}]")
+                raise TableFull(f"more than {self.max_entries} remote resources: "
+                                f"ignoring [{key}]")
             self._last[key] = now
+            self._first[key] = now
             self._resource[key] = resource
         return resource
 
@@ -86,15 +168,33 @@ class RemoteTable:
             lost = [k for k, t in self._last.items() if now - t > self.lost_after]
             for key in lost:
                 del self._last[key]
+                del self._first[key]
             return [self._resource.pop(key) for key in lost]
 
     def resources(self) -> FrozenSet[Resource]:
         with self._lock:
             return frozenset(self._resource.values())
 
+    def first_heard(self) -> Dict[Tuple[str, str, str], float]:
+        """When each remote topic or service (name, type, md5sum) was first heard, by any
+        of the beacons that name it, since it was last lost."""
+        with self._lock:
+            out: Dict[Tuple[str, str, str], float] = {}
+            for key, resource in self._resource.items():
+                first = self._first[key]
+                topic = resource.topic
+                if first < out.get(topic, float("inf")):
+                    out[topic] = first
+            return out
+
+    def __len__(self) -> int:
+        with self._lock:
+            return len(self._last)
+
     def clear(self) -> None:
         with self._lock:
             self._last.clear()
+            self._first.clear()
             self._resource.clear()
 
 

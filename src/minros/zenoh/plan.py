@@ -13,6 +13,12 @@ zenoh-bridge-ros1's rules in its default ``auto`` mode (``topic_bridge.rs``,
   with ``CLIENT_BRIDGING_MODE=auto``), unless a local node serves that name: ROS has one
   provider per service name.
 
+What remote beacons alone ask for (a local publisher for a remote one that no local node
+subscribes to, a local subscriber for a remote subscriber with no local publisher, a remote
+service) is bounded by :func:`limit_remote`: at most ``cap`` such bridges, the first-heard
+kept, so that a flood of beacons cannot displace the bridges of the peers heard before it, nor
+grow the master and the process without bound; what the local graph asks for is not limited.
+
 The local graph never includes the bridge's own node, so what it publishes for remote
 publishers is not declared back. A process has one publisher and one subscriber per topic
 name: when several types meet on one name, one is chosen (the local node's) and the others
@@ -22,11 +28,11 @@ are reported in ``conflicts``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Dict, FrozenSet, Iterable, List, Set, Tuple
+from typing import Dict, FrozenSet, Iterable, List, Mapping, Set, Tuple
 
 from minros.zenoh.keys import Resource
 
-__all__ = ["Plan", "Topic", "plan"]
+__all__ = ["Plan", "Topic", "limit_remote", "plan", "remote_only"]
 
 #: (name, type, md5sum)
 Topic = Tuple[str, str, str]
@@ -97,3 +103,32 @@ def plan(local: Iterable[Resource], remote: Iterable[Resource]) -> Plan:
     proxies = _choose("service", offered, set(), conflicts)
     return Plan(declare=local, outlets=outlets, inlets=inlets, queryables=queryables,
                 proxies=proxies, conflicts=tuple(conflicts))
+
+
+def remote_only(wanted: Plan, local: Iterable[Resource]) -> Dict[str, FrozenSet[Topic]]:
+    """The bridges of ``wanted`` that exist for remote beacons alone, by kind (``inlets``,
+    ``outlets``, ``proxies``): no local node publishes, subscribes or serves their topic."""
+    local = frozenset(local)
+    subs = {r.topic for r in local if r.kind == "sub"}
+    pubs = {r.topic for r in local if r.kind == "pub"}
+    return {"inlets": frozenset(t for t in wanted.inlets if t not in subs),
+            "outlets": frozenset(t for t in wanted.outlets if t not in pubs),
+            "proxies": wanted.proxies}
+
+
+def limit_remote(wanted: Plan, local: Iterable[Resource],
+                 first_heard: Mapping[Topic, float], cap: int) -> Tuple[Plan, int]:
+    """``wanted`` with at most ``cap`` bridges that exist for remote beacons alone, those
+    first heard kept (then by name); and how many were left out."""
+    only = remote_only(wanted, local)
+    ranked = sorted(((first_heard.get(t, float("inf")), t, kind)
+                     for kind, topics in only.items() for t in topics))
+    if len(ranked) <= cap:
+        return wanted, 0
+    dropped: Dict[str, Set[Topic]] = {"inlets": set(), "outlets": set(), "proxies": set()}
+    for _first, topic, kind in ranked[max(0, cap):]:
+        dropped[kind].add(topic)
+    limited = Plan(declare=wanted.declare, outlets=wanted.outlets - dropped["outlets"],
+                   inlets=wanted.inlets - dropped["inlets"], queryables=wanted.queryables,
+                   proxies=wanted.proxies - dropped["proxies"], conflicts=wanted.conflicts)
+    return limited, len(ranked) - max(0, cap)

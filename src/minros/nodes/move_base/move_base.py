@@ -3,16 +3,22 @@
 **This is not the ROS navigation stack.** It serves move_base's interface, so that scripts
 sending navigation goals have a partner, with a planner and controller small enough to read
 (:mod:`minros.sim.planner`): A* over the map inflated by the robot's radius, a pure-pursuit
-follower that stops for laser points in its way, replanning around them, and one recovery
-(turning in place, then replanning) before giving up. No costmap layers, no DWA, no AMCL;
-localization is whatever publishes ``map -> odom`` (``minros sim`` does, perfectly).
+follower that stops for laser points in its way, replanning around them, and move_base's
+executive: when no progress is made (no valid command for ``controller_patience``, or less
+than ``oscillation_distance`` travelled in ``oscillation_timeout``, or no plan), its default
+recovery behaviours run in turn (clear far obstacles, rotate, clear all but the nearest,
+rotate), and then the goal is aborted with the reason, so every goal ends with a status. No
+costmap layers, no DWA, no AMCL; localization is whatever publishes ``map -> odom``
+(``minros sim`` does, perfectly).
 
 Interfaces, as move_base's:
 
 * action server ``move_base`` (move_base_msgs/MoveBase): goals in any frame tf can transform
   to the global frame (``map``, ``odom``, ``base_footprint``...), transformed once when they
-  arrive; SUCCEEDED "Goal reached."; ABORTED with the reason (invalid quaternion, unknown
-  frame, goal off the map or in an obstacle, no path even after recovery, no map);
+  arrive; SUCCEEDED "Goal reached."; ABORTED with the reason (invalid quaternion, a position
+  with nans or infs, unknown frame, goal off the map or in an obstacle, no map; move_base's
+  "Failed to find a valid plan/control" or "Robot is oscillating" texts after the recovery
+  behaviours, followed by what was wrong in brackets);
   a new goal preempts the current one;
 * ``move_base_simple/goal`` (geometry_msgs/PoseStamped): re-sent as an action goal on
   ``move_base/goal``, as move_base does (the 2D Nav Goal tool of Rviz publishes there);
@@ -26,8 +32,11 @@ Parameters (private): ``global_costmap/global_frame`` (map), ``global_costmap/ro
 ``global_costmap/inflation_radius`` (1.0) and ``cost_scaling_factor`` (3.0) as TurtleBot3's
 navigation configuration, ``global_costmap/lethal_cost_threshold`` (100),
 ``controller_frequency`` (20), ``planner_frequency`` (0: plan when needed),
-``planner_patience`` (5 s without a map), ``controller_patience`` (15 s blocked before
-recovery), ``recovery_behavior_enabled`` (true), and the follower's ``max_vel_x`` (0.22),
+``planner_patience`` (5 s without a map), ``controller_patience`` (15 s without a valid
+command before recovery), ``oscillation_timeout`` (10 s) and ``oscillation_distance`` (0.2 m)
+as TurtleBot3's (move_base's default timeout is 0, off), ``conservative_reset_dist`` (3.0),
+``recovery_behavior_enabled`` and ``clearing_rotation_allowed`` (true), and the follower's
+``max_vel_x`` (0.22),
 ``max_vel_theta`` (1.5), ``xy_goal_tolerance`` (0.08), ``yaw_goal_tolerance`` (0.17),
 ``lookahead`` (0.35).
 """
@@ -46,8 +55,7 @@ from minros.sim import planner
 from minros.sim.grid import GridMap
 
 INVALID_QUATERNION = "Aborting on goal because it was sent with an invalid quaternion"
-NO_PLAN = "Failed to find a valid plan. Even after executing recovery behaviors."
-NO_CONTROL = "Failed to find a valid control. Even after executing recovery behaviors."
+INVALID_POSITION = "Aborting on goal because it was sent with a non-finite position"
 #: how long the follower may be blocked before it replans around what the laser sees
 REPLAN_WHEN_BLOCKED = 1.0
 
@@ -102,8 +110,12 @@ class MoveBase:
         self.controller_frequency = max(1.0, _param("controller_frequency", 20.0))
         self.planner_frequency = max(0.0, _param("planner_frequency", 0.0))
         self.planner_patience = _param("planner_patience", 5.0)
-        self.controller_patience = _param("controller_patience", 15.0)
-        self.recovery_enabled = _param("recovery_behavior_enabled", True)
+        defaults = planner.ProgressParams()
+        self.progress_params = planner.ProgressParams(**{
+            name: _param(name, getattr(defaults, name)) for name in (
+                "controller_patience", "oscillation_timeout", "oscillation_distance",
+                "recovery_behavior_enabled", "clearing_rotation_allowed",
+                "conservative_reset_dist")})
 
         self.PoseStamped, self.Twist, self.Path = PoseStamped, Twist, Path
         self.MoveBaseActionGoal = MoveBaseActionGoal
@@ -195,10 +207,19 @@ class MoveBase:
 
     # -- geometry
 
+    @staticmethod
+    def check_position(pose_stamped: Any) -> None:
+        """GoalRejected for a position with nans or infs (before tf or the planner sees it)."""
+        p = pose_stamped.pose.position
+        problem = planner.position_problem(p.x, p.y, p.z)
+        if problem:
+            raise GoalRejected(f"{INVALID_POSITION} {problem}; discarding it as a navigation goal")
+
     def to_global(self, pose_stamped: Any) -> Tuple[float, float, float]:
         """(x, y, yaw) of a PoseStamped in the map frame, with the latest transform."""
         import rospy
 
+        self.check_position(pose_stamped)
         source = pose_stamped.header.frame_id
         if not source:
             raise GoalRejected("The goal pose has no frame_id: set header.frame_id (e.g. map)")
@@ -306,6 +327,7 @@ class MoveBase:
             hint = " (set orientation.w: 1.0 for a heading of 0)" if "zero" in problem else ""
             rospy.logerr(problem + hint)
             raise GoalRejected(INVALID_QUATERNION)
+        self.check_position(goal.target_pose)
         if not self.wait_for_map():
             raise GoalRejected("move_base has no map: is map_server publishing on "
                                f"{self.map_sub.resolved_name}?")
@@ -340,13 +362,14 @@ class MoveBase:
         self.stop()
         rate = rospy.Rate(self.controller_frequency)
         dt = 1.0 / self.controller_frequency
+        now = rospy.get_time
         state = "planning"
-        recovered = False
         follower: planner.Follower | None = None
         blocked_since: float | None = None
-        now = rospy.get_time
-        last_valid_control = last_plan = now()
+        progress = planner.Progress(self.progress_params, self.costmap_params.robot_radius, now())
+        why, trigger = "", "controlling"  # what went wrong last, for the abort's text
         marks: List[Tuple[float, float]] = []
+        last_plan = now()
         while not rospy.is_shutdown():
             if self.server.is_preempt_requested():
                 if self.server.is_new_goal_available():
@@ -356,8 +379,8 @@ class MoveBase:
                     except GoalRejected as exc:
                         self._abort(str(exc))
                         return
-                    state, recovered, marks, blocked_since = "planning", False, [], None
-                    last_valid_control = now()
+                    state, marks, blocked_since = "planning", [], None
+                    progress.reset(now())
                 else:
                     self.stop()
                     self.server.set_preempted()
@@ -366,12 +389,13 @@ class MoveBase:
                 pose = self.robot_pose()
             except GoalRejected as exc:
                 self.stop()
-                if now() - last_valid_control > self.controller_patience:
+                if progress.control_failed(now()):
                     self._abort(str(exc))
                     return
                 rospy.logwarn_throttle(2.0, f"{rospy.get_name()}: {exc}")
                 rate.sleep()
                 continue
+            progress.moved(now(), pose[0], pose[1])
             if state == "planning":
                 try:
                     path = self.make_plan(pose[:2], target[:2], marks)
@@ -379,38 +403,26 @@ class MoveBase:
                     self._abort(str(exc))
                     return
                 except planner.NoPath as exc:
-                    reason = str(exc)
                     if exc.about_goal:
-                        self._abort(f"No path to the goal: {reason}")
+                        self._abort(f"No path to the goal: {exc}")
                         return
-                    if not self.recovery_enabled or recovered:
-                        self._abort(f"{NO_PLAN} ({reason})")
-                        return
-                    rospy.logwarn(f"{rospy.get_name()}: no plan ({reason}); rotating to look around")
-                    state = "recovery"
+                    why, trigger, state = str(exc), "planning", "recovery"
                 else:
                     follower = planner.Follower(path, target[2], self.follower_params)
                     self.plan_pub.publish(self._path_msg(path, target[2]))
                     rospy.loginfo(f"{rospy.get_name()}: plan of {planner.path_length(path):.2f} m")
-                    state = "controlling"
-                    last_plan = last_valid_control = now()
-            if state == "recovery":
-                if not self._rotate_recovery():
-                    continue  # preempted or shut down: the loop's top handles it
-                recovered, marks, state = True, [], "planning"
-                with self.lock:
-                    self.marks = []
-                continue
+                    progress.planned()
+                    state, last_plan = "controlling", now()
+            if state == "controlling" and follower is not None:
+                t = now()
+                if progress.oscillating(t):
+                    self.stop()
+                    why = (f"it moved less than {self.progress_params.oscillation_distance} m "
+                           f"in {self.progress_params.oscillation_timeout} s")
+                    trigger, state = "oscillation", "recovery"
             if state == "controlling" and follower is not None:
                 v, w, status = follower.step(pose[0], pose[1], pose[2], dt, self.obstacles(pose))
-                feedback = MoveBaseFeedback()
-                feedback.base_position.header.frame_id = self.map_frame
-                feedback.base_position.header.stamp = rospy.Time.now()
-                feedback.base_position.pose.position.x = pose[0]
-                feedback.base_position.pose.position.y = pose[1]
-                feedback.base_position.pose.orientation.z = math.sin(pose[2] / 2)
-                feedback.base_position.pose.orientation.w = math.cos(pose[2] / 2)
-                self.server.publish_feedback(feedback)
+                self._feedback(MoveBaseFeedback(), pose)
                 if status == "done":
                     self.stop()
                     rospy.loginfo(f"{rospy.get_name()}: Goal reached.")
@@ -419,31 +431,65 @@ class MoveBase:
                 t = now()
                 if status == "blocked":
                     self.stop()
-                    blocked_since = blocked_since or t
-                    if t - blocked_since > REPLAN_WHEN_BLOCKED:
-                        # plan around what the laser sees now (in the map frame)
-                        marks = self._marks(pose)
-                        blocked_since = None
-                        state = "planning"
-                    if t - last_valid_control > self.controller_patience:
-                        if self.recovery_enabled and not recovered:
-                            state = "recovery"
-                        else:
-                            self._abort(NO_CONTROL)
-                            return
+                    if progress.control_failed(t):
+                        why = self._blocked_reason(follower, t - progress.last_valid_control)
+                        trigger, state = "controlling", "recovery"
+                    else:
+                        blocked_since = blocked_since or t
+                        if t - blocked_since > REPLAN_WHEN_BLOCKED:
+                            # plan around what the laser sees now (in the map frame)
+                            marks = self._marks(pose)
+                            blocked_since = None
+                            state = "planning"
                 else:
                     blocked_since = None
-                    last_valid_control = t
+                    progress.controlled(t)
                     cmd = self.Twist()
                     cmd.linear.x, cmd.angular.z = v, w
                     self.vel_pub.publish(cmd)
                     if self.planner_frequency > 0 and t - last_plan > 1.0 / self.planner_frequency:
                         state = "planning"
+            if state == "recovery":
+                behavior = progress.next_recovery(trigger)
+                if behavior is None:
+                    self._abort(f"{planner.EXHAUSTED[trigger]} ({why})")
+                    return
+                rospy.logwarn(f"{rospy.get_name()}: no progress ({why}); recovery "
+                              f"{progress.index} of {len(progress.behaviors)}: {behavior.name}")
+                if behavior.kind == "rotate":
+                    if not self._rotate_recovery():
+                        continue  # preempted or shut down: the loop's top handles it
+                else:
+                    marks = planner.clear_marks(marks, pose[0], pose[1], behavior.reset_distance)
+                    with self.lock:
+                        self.marks = list(marks)
+                progress.recovered(now())
+                state, blocked_since = "planning", None
+                continue
             rate.sleep()
         self.stop()
         if self.server.is_active():
             self.server.set_aborted(MoveBaseResult(),
                                     "Aborting on the goal because the node has been killed")
+
+    def _feedback(self, feedback: Any, pose: Tuple[float, float, float]) -> None:
+        import rospy
+
+        feedback.base_position.header.frame_id = self.map_frame
+        feedback.base_position.header.stamp = rospy.Time.now()
+        feedback.base_position.pose.position.x = pose[0]
+        feedback.base_position.pose.position.y = pose[1]
+        feedback.base_position.pose.orientation.z = math.sin(pose[2] / 2)
+        feedback.base_position.pose.orientation.w = math.cos(pose[2] / 2)
+        self.server.publish_feedback(feedback)
+
+    def _blocked_reason(self, follower: planner.Follower, seconds: float) -> str:
+        where = ""
+        if follower.blocking is not None:
+            bx, by = follower.blocking
+            where = (f": a laser point {math.hypot(bx, by):.2f} m from the robot ({bx:+.2f}, "
+                     f"{by:+.2f} in {self.base_frame}) is in its way")
+        return f"no valid velocity command for {seconds:.1f} s{where}"
 
     def _marks(self, pose: Tuple[float, float, float]) -> List[Tuple[float, float]]:
         points = self.obstacles(pose)

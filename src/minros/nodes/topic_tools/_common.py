@@ -14,9 +14,13 @@ def program_args(argv: Optional[List[str]]) -> List[str]:
 
 
 def base_name(topic: str) -> str:
-    """The node name ROS's programs derive from a topic: its last part."""
+    """The node name ROS's programs derive from a topic: its last part. ValueError for a name
+    that has none (``//``), which ROS's programs refuse before they contact a master."""
     name = topic.rstrip("/").rsplit("/", 1)[-1]
-    return name or "topic"
+    if not name:
+        raise ValueError(f'Base name extracted from "{topic}" is an empty string: '
+                         "give a topic name")
+    return name
 
 
 def usage_error(usage: str, problem: str = "") -> int:

@@ -32,7 +32,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     except ValueError as exc:
         return usage_error(USAGE, str(exc))
     in_topic = args[0]
-    init(base_name(in_topic) + "_drop", argv)
+    try:
+        name = base_name(in_topic) + "_drop"
+    except ValueError as exc:
+        return usage_error(USAGE, str(exc))
+    init(name, argv)
     output = RawOutput(args[3] if len(args) == 4 else in_topic + "_drop")
 
     def on_message(msg: Any) -> None:

@@ -45,6 +45,8 @@ class Mux:
             self._subscribe(topic)
         self._announce()
         minros.Service(f"{ns}/select", MuxSelect, self.on_select)
+        # the service switch_mux calls (ROS's mux keeps it for backward compatibility)
+        minros.Service(f"{out_topic}_select", MuxSelect, self.on_select_deprecated)
         minros.Service(f"{ns}/add", MuxAdd, self.on_add)
         minros.Service(f"{ns}/delete", MuxDelete, self.on_delete)
         minros.Service(f"{ns}/list", MuxList, self.on_list)
@@ -73,8 +75,15 @@ class Mux:
             self._announce()
             return MuxSelectResponse(prev_topic=previous)
 
+    def on_select_deprecated(self, req: Any) -> Any:
+        minros.logwarn("the <topic>_select service is deprecated; use mux/select instead")
+        return self.on_select(req)
+
     def on_add(self, req: Any) -> Any:
         with self.lock:
+            if req.topic == NONE_TOPIC:
+                raise minros.ServiceException(
+                    f"cannot add {NONE_TOPIC}: it is reserved for selecting no input")
             topic = minros.resolve_name(req.topic)
             if topic == minros.resolve_name(self.output.topic):
                 raise minros.ServiceException(f"cannot add the mux's own output {topic}")
@@ -88,13 +97,15 @@ class Mux:
     def on_delete(self, req: Any) -> Any:
         with self.lock:
             topic = minros.resolve_name(req.topic)
-            was_selected = topic == self.table.selected
+            if topic == self.table.selected:
+                # as ROS's mux (ros_comm #2863): the input in use stays until another is selected
+                raise minros.ServiceException(
+                    f"tried to delete the currently selected topic [{topic}]: select another "
+                    f"input (or {NONE_TOPIC}) first")
             if not self.table.delete(topic):
                 raise minros.ServiceException(
                     f"tried to delete non-subscribed topic: [{topic}]")
             self.subscribers.pop(topic).unregister()
-            if was_selected:
-                self._announce()
             minros.loginfo(f"mux deleted input: [{topic}]")
             return MuxDeleteResponse()
 
@@ -110,7 +121,11 @@ def main(argv: Optional[List[str]] = None) -> int:
         return 0
     if len(args) < 2:
         return usage_error(USAGE)
-    init(base_name(args[0]) + "_mux", argv)
+    try:
+        name = base_name(args[0]) + "_mux"
+    except ValueError as exc:
+        return usage_error(USAGE, str(exc))
+    init(name, argv)
     initial = minros.get_param("~initial_topic", "") or None
     try:
         Mux(args[0], args[1:], initial)

@@ -46,7 +46,11 @@ def main(argv: Optional[List[str]] = None) -> int:
             return usage_error(USAGE)
     except ValueError as exc:
         return usage_error(USAGE, str(exc))
-    init(base_name(in_topic) + "_throttle", argv)
+    try:
+        name = base_name(in_topic) + "_throttle"
+    except ValueError as exc:
+        return usage_error(USAGE, str(exc))
+    init(name, argv)
     output = RawOutput(out_topic or in_topic + "_throttle")
     wall = bool(minros.get_param("~wall_clock", False))
 

@@ -1,5 +1,6 @@
 """rosrun xacro xacro FILE [name:=value ...]: PyPI's xacro (ROS's own, 2.x) with $(find pkg)
-answered by minros's package lookup (through the ament_index_python stand-in)."""
+answered by minros's package lookup (through the ament_index_python stand-in), and noetic's
+xacro 1.14 behaviour where 2.x differs (minros.nodes.xacro.noetic)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     except ImportError:
         print("xacro: the xacro package is not installed (pip install xacro)", file=sys.stderr)
         return 2
+    from minros.nodes.xacro.noetic import apply
+
+    apply(xacro)
     if argv is not None:
         sys.argv = list(argv)
     # roslaunch passes __name:= and __log:= to nodes; xacro reads name:=value as its own args

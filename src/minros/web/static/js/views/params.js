@@ -1,6 +1,8 @@
 // Parameters: the parameter server's tree, live (the master pushes changes), each value shown
 // and edited as YAML (as rosparam set reads it: 1 is an int, 1.0 a double, [1, 2] a list);
 // and the dynamic_reconfigure servers as forms (sliders for ranges, menus for enums).
+// A string of several lines (a URDF on /robot_description, a launch file's text) is shown as
+// text, folded under its first line and its size, and edited in a text box.
 
 import {clear, errorLine, fill, h} from "../ui.js";
 
@@ -9,6 +11,7 @@ const DESCRIPTION_TYPE = "dynamic_reconfigure/ConfigDescription";
 export function createParamsView(app) {
   const leaves = new Map();  // name -> {yaml, type}
   const open = new Set(["/"]);
+  const openText = new Set();  // names of the multi-line strings shown unfolded
   const tree = h("div", {class: "param-tree"});
   const newName = h("input", {type: "text", placeholder: "/name", class: "param-name"});
   const newValue = h("input", {type: "text", placeholder: "value as YAML, e.g. 1.5 or [a, b]", class: "param-value",
@@ -77,7 +80,62 @@ export function createParamsView(app) {
     fill(tree, leaves.size || !loaded ? renderChildren(root) : h("p", {class: "muted"}, "No parameters."));
   }
 
+  // the text of a multi-line string: the server sends it as a double-quoted scalar, which is
+  // JSON (pagemodel.dumps_yaml); null for every other value
+  function multiline(leaf) {
+    if (leaf.type !== "string" || !leaf.yaml.startsWith('"')) return null;
+    try {
+      const text = JSON.parse(leaf.yaml);
+      // a line ending in a newline ("noetic\n", as ROS sets /rosdistro) stays one line
+      return typeof text === "string" && text.replace(/\n$/, "").includes("\n") ? text : null;
+    } catch (err) {
+      return null;
+    }
+  }
+
+  function textRow(key, leaf, text) {
+    const lines = text.split("\n");
+    const count = text.endsWith("\n") ? lines.length - 1 : lines.length;
+    const first = (lines.find((line) => line.trim()) || "").trim();
+    const shown = first.length > 80 ? first.slice(0, 80) + "…" : first;
+    const details = h("details", {class: "param-text", open: openText.has(leaf.name), ontoggle: () => {
+      if (details.open) openText.add(leaf.name);
+      else openText.delete(leaf.name);
+    }},
+      h("summary", {}, h("code", {}, shown), h("span", {class: "muted"}, ` ${count} lines, ${text.length} characters`)),
+      h("pre", {class: "param-pre"}, text),
+      h("button", {class: "small", onclick: () => edit()}, "Edit"));
+    const row = h("div", {class: "param-row", "data-param": leaf.name},
+      h("span", {class: "param-key"}, key), details, h("span", {class: "muted param-type"}, leaf.type),
+      h("button", {class: "small", title: `delete ${leaf.name}`, onclick: () => remove(leaf.name)}, "×"));
+    const edit = () => {
+      const area = h("textarea", {class: "param-edit-text", rows: String(Math.min(24, count + 1)), spellcheck: "false"});
+      area.value = text;
+      const error = errorLine();
+      const save = async () => {
+        try {  // sent as a double-quoted scalar: the text exactly, whatever it holds
+          await app.conn.request("param_set", {name: leaf.name, yaml: JSON.stringify(area.value)});
+          openText.add(leaf.name);
+        } catch (err) {
+          error.show(err.message);
+          area.focus();
+        }
+      };
+      area.addEventListener("keydown", (e) => {
+        if (e.key === "Enter" && (e.ctrlKey || e.metaKey)) save();
+        if (e.key === "Escape") render();
+      });
+      details.replaceWith(h("span", {class: "param-editing"}, area,
+        h("button", {class: "small", onclick: save, title: "Ctrl+Enter"}, "Save"),
+        h("button", {class: "small", onclick: () => render(), title: "Escape"}, "Cancel"), error));
+      area.focus();
+    };
+    return row;
+  }
+
   function leafRow(key, leaf) {
+    const text = multiline(leaf);
+    if (text !== null) return textRow(key, leaf, text);
     const value = h("span", {class: "param-yaml", title: "click to edit", tabindex: "0"}, leaf.yaml);
     const row = h("div", {class: "param-row", "data-param": leaf.name},
       h("span", {class: "param-key"}, key), value, h("span", {class: "muted param-type"}, leaf.type),

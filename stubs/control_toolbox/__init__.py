@@ -1,0 +1,1 @@
+"""control_toolbox: message package stand-in provided by minros."""

@@ -1,0 +1,1 @@
+"""controller_manager_msgs: message package stand-in provided by minros."""
