@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import glob
 import os
+import re
 import subprocess
 import sys
 import threading
@@ -176,6 +177,7 @@ def _pythons() -> List[str]:
     return found
 
 
+@pytest.mark.slow  # starts a Python per interpreter
 @pytest.mark.parametrize("python", _pythons())
 def test_a_subscriber_gone_at_interpreter_shutdown_prints_no_traceback(python, tmp_path):
     """Issue 38 item 10: on Python 3.12 a clean exit printed ``RuntimeError: can't create new
@@ -211,6 +213,23 @@ def test_the_transport_layer_keeps_the_shape_the_review_asked_for():
     accepts = [(p.name, line) for p in (src / "node").glob("*.py")
                for line in p.read_text().splitlines() if ".accept()" in line]
     assert len(accepts) == 1 and accepts[0][0] == "tcpros_server.py", accepts
+
+
+def test_services_run_on_the_seam_not_a_socket_loop_of_their_own():
+    """Issue 36: a service connection's two ends are transports of the seam, as a topic's are
+    (the header exchange, frames and stats of TCPROSTransport); client/services.py does no
+    socket I/O of its own."""
+    from minros.transport.base import Transport
+    from minros.transport.tcpros_base import TCPROSTransport
+    from minros.transport.tcpros_service import ServiceClientEnd, ServiceServerEnd
+
+    assert issubclass(ServiceClientEnd, TCPROSTransport) and issubclass(ServiceServerEnd,
+                                                                        TCPROSTransport)
+    assert issubclass(TCPROSTransport, Transport)
+    text = (ROOT / "src" / "minros" / "client" / "services.py").read_text()
+    io = [line for line in text.splitlines()
+          if re.search(r"\.(recv|recv_into|sendall|sendmsg)\(|sockets\.(send_all|read_)", line)]
+    assert io == [], io
 
 
 # --------------------------------------------------------------------------- the seam's capabilities
