@@ -299,7 +299,11 @@ def test_the_image_view_gets_1080p_over_shared_memory_from_a_minros_camera(graph
         assert frame[:500].mean() > 240 and frame[580:].mean() < 15
         # the tap lives while a viewer does: ask which transport it took with one open
         with urllib.request.urlopen(url, timeout=30) as viewer:
-            viewer.read1(65536)
+            seen = b""
+            while seen.count(b"Content-Length: ") < 2:  # a frame came through this viewer's tap
+                chunk = viewer.read1(65536)
+                assert chunk, "the stream ended"
+                seen += chunk
             master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{graph.port}/")
             uri = master.lookupNode("/test", "/minros_web")[2]
             with SlaveClient(uri, "/test", timeout=10) as web:
