@@ -47,9 +47,11 @@ Scenarios
   from the same publisher: % of one core the tool uses.
 
 ``--trace`` adds "minros+trace": minros with every process writing a wire trace of every frame
-(MINROS_TRACE, MINROS_TRACE_FRAMES=all), the cost of ``minros trace``. ``--baseline PY`` adds
-"baseline": minros run by another interpreter, e.g. a venv of another checkout, so two versions
-are compared in one interleaved run.
+(MINROS_TRACE, MINROS_TRACE_FRAMES=all), the cost of ``minros trace``. ``--baseline PY|DIR``
+adds "baseline": minros run by another interpreter (e.g. a venv of another checkout), or a
+checkout's ``src/`` and ``stubs/`` run by the minros workers' interpreter (PYTHONPATH; its
+bytecode cached outside the checkout, which is left as it is), so two versions are compared in
+one interleaved run.
 
 This same file is also the worker: ``--role ...`` runs one side of a scenario, in whichever
 Python runs it (the venv's for minros and raw, /usr/bin/python3 for rospy), and prints one JSON
@@ -850,17 +852,23 @@ class Runner:
     def command(self, who: str, role: str, extra: list) -> tuple:
         if who == "roscpp":
             return [self.roscpp, *extra], self.env(True)
-        python = {"rospy": REFERENCE_PYTHON, "baseline": self.args.baseline}.get(
+        baseline_dir = os.path.isdir(self.args.baseline) if self.args.baseline else False
+        python = {"rospy": REFERENCE_PYTHON,
+                  "baseline": self.args.minros_python if baseline_dir else self.args.baseline}.get(
             who, self.args.minros_python)
         env = self.env(who == "rospy")
         if who != "rospy":
             env["MINROS_SHM"] = "1" if self.shm else "0"
+        if who == "baseline" and baseline_dir:
+            env.update(baseline_env(self.args.baseline))
         if who == "minros+trace":
-            # both processes append to one fresh trace, every frame of it
+            # both processes append to one fresh trace, every frame of it (and keep to the
+            # transport of the row: a traced process takes shared memory only when asked)
             path = os.path.join(self.home, "bench-trace.jsonl")
             if os.path.exists(path):
                 os.remove(path)
-            env.update(MINROS_TRACE=path, MINROS_TRACE_FRAMES="all")
+            env.update(MINROS_TRACE=path, MINROS_TRACE_FRAMES="all",
+                       MINROS_TRACE_SHM="1" if self.shm else "0")
         return [python, os.path.abspath(__file__), "--role", role, *extra], env
 
     def pair(self, who: str, first: tuple, second: tuple, timeout: float = 90,
@@ -1045,7 +1053,7 @@ class Runner:
 
     def intra(self, who: str, kind: str):
         """Frames/s one minros process delivers to itself with intraprocess=True."""
-        if who != "minros":
+        if who not in ("minros", "baseline"):
             return None
         command, env = self.command(who, "intra-flood", ["--kind", kind, "--queue", "10",
                                                         "--seconds", str(self.args.seconds)])
@@ -1058,7 +1066,7 @@ class Runner:
     def bringup(self, who: str, nodes: int = 100, topics: int = 10):
         """Seconds from starting ``nodes`` nodes (``topics`` publishers and subscribers each, in a
         ring) until every one of their connections is made."""
-        if who not in ("minros", "rospy"):
+        if who not in ("minros", "rospy", "baseline"):
             return None
         procs = []
         start = time.time()
@@ -1093,16 +1101,18 @@ class Runner:
     def tool_cpu(self, who: str, verb: str):
         """% of one core ``rostopic hz|echo`` spends on a 10 kHz std_msgs/String topic (the same
         minros publisher for every tool)."""
-        if who not in ("minros", "rospy"):
+        if who not in ("minros", "rospy", "baseline"):
             return None
-        if who == "minros":
-            tool = [self.args.minros_python, "-m", "minros", "topic", verb, "/bench_rate"]
-        else:
+        tool_env = self.env(who == "rospy")
+        if who == "rospy":
             tool = [REFERENCE_PYTHON, "/usr/bin/rostopic", verb, "/bench_rate"]
+        else:  # minros's tool, of this tree or the baseline's (its interpreter and path)
+            (python, *_), tool_env = self.command(who, "", [])
+            tool = [python, "-m", "minros", "topic", verb, "/bench_rate"]
         seconds = max(self.args.seconds, 3.0)
         procs = []
         try:
-            procs.append(subprocess.Popen(tool, env=self.env(who == "rospy"), stdout=subprocess.DEVNULL,
+            procs.append(subprocess.Popen(tool, env=tool_env, stdout=subprocess.DEVNULL,
                                           stderr=subprocess.DEVNULL))
             pub_cmd = self.command("minros", "rate-pub", ["--kind", "small", "--hz", "10000",
                                                          "--seconds", str(seconds + 1.0)])
@@ -1226,6 +1236,17 @@ def _python_version(python: str) -> str:
     return f"{python} {out.stdout.strip()}"
 
 
+def baseline_env(checkout: str) -> dict:
+    """What runs another checkout's minros with this venv's interpreter: its src/ and stubs/
+    first on the path (before this checkout's editable install), and its bytecode in a cache
+    of its own, outside it."""
+    checkout = os.path.abspath(checkout)
+    cache = os.path.join(tempfile.gettempdir(), "minros-bench-pycache",
+                         hashlib.sha1(checkout.encode()).hexdigest()[:12])
+    return {"PYTHONPATH": os.pathsep.join(os.path.join(checkout, d) for d in ("src", "stubs")),
+            "PYTHONPYCACHEPREFIX": cache}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--role", choices=sorted(ROLES), help=argparse.SUPPRESS)
@@ -1249,14 +1270,21 @@ def main(argv=None) -> int:
                         ",".join(s[1] for s in SCENARIOS))
     parser.add_argument("--trace", action="store_true",
                         help="add minros+trace: minros writing a wire trace of every frame")
-    parser.add_argument("--baseline", default="", metavar="PY",
-                        help="add 'baseline': minros run by this interpreter (another checkout's venv)")
+    parser.add_argument("--baseline", default="", metavar="PY|DIR",
+                        help="add 'baseline': minros run by this interpreter (another checkout's "
+                             "venv), or the checkout DIR's src/ and stubs/ run by the minros "
+                             "workers' interpreter")
     args = parser.parse_args(argv)
     if args.role:
         ROLES[args.role](args)
         return 0
     byte_compile_minros()
-    if args.baseline:  # its checkout, when the interpreter is that checkout's .venv
+    if args.baseline and os.path.isdir(args.baseline):  # a checkout: compiled where it runs
+        subprocess.run([args.minros_python, "-c", "import compileall, sys; [compileall.compile_dir("
+                        "d, quiet=1) for d in sys.argv[1:]]",
+                        *(os.path.join(args.baseline, d) for d in ("src", "stubs"))],
+                       env=dict(os.environ, **baseline_env(args.baseline)), check=True)
+    elif args.baseline:  # its checkout, when the interpreter is that checkout's .venv
         byte_compile_minros(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(args.baseline)))))
     load = (_load(),)
     runner = Runner(args)

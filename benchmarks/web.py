@@ -5,9 +5,12 @@
 
 Scenario 1, video: a minros publisher sends 1920x1080 bgr8 sensor_msgs/Image at 30 Hz. At the
 same time, on one ``minros web``: a Foxglove client (node, Foxglove's @foxglove/ws-protocol and
-@foxglove/rosmsg-serialization, tests/web/js) subscribed to the topic, an MJPEG viewer
-(``/stream?topic=``) and two *stalled* clients that subscribed and then stopped reading (a
-Foxglove client and an MJPEG viewer). The rates the two live clients receive are set beside the
+@foxglove/rosmsg-serialization, tests/web/js) subscribed to the topic, the page's image view
+(the MJPEG stream ``/stream?topic=...&quality=80`` that ``images.js`` opens) and two *stalled*
+clients that subscribed and then stopped reading (a Foxglove client and an MJPEG viewer). The
+note says which transport the server's tap of the camera took (getBusInfo of /minros_web:
+MINROSSHM between minros processes of one host, once the server connects through the node's
+protocols). The rates the two live clients receive are set beside the
 raw topic rate a plain ROS subscriber sees. The server's --send-timeout is raised above the run
 so the stalled clients stay connected throughout.
 
@@ -498,6 +501,20 @@ def port_open(port: int) -> bool:
         return False
 
 
+def tap_transport(master: int, topic: str) -> str:
+    """The transport of ``minros web``'s subscription to ``topic`` (its getBusInfo)."""
+    import xmlrpc.client
+
+    try:
+        uri = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{master}/").lookupNode(
+            "/bench", "/minros_web")[2]
+        info = xmlrpc.client.ServerProxy(uri).getBusInfo("/bench")[2]
+    except (OSError, IndexError, xmlrpc.client.Error):
+        return "?"
+    kinds = sorted({row[3] for row in info if row[4] == topic and row[2] == "i"})
+    return "+".join(kinds) or "?"
+
+
 def web_env(env: dict, web_src: str | None) -> dict:
     """The environment of the server: another source tree's minros first when asked."""
     return dict(env, PYTHONPATH=os.path.join(web_src, "src") + os.pathsep + os.path.join(
@@ -531,8 +548,10 @@ def run(seconds: float, web_src: str | None = None) -> list:
         for t in stalled:
             t.start()
         time.sleep(1)
+        tap = tap_transport(master, "/camera/image_raw")  # the stalled clients' tap, live
         mjpeg: dict = {}
-        viewer = threading.Thread(target=mjpeg_rate, args=(f"{http}/stream?topic=/camera/image_raw", seconds, mjpeg))
+        viewer = threading.Thread(target=mjpeg_rate, args=(
+            f"{http}/stream?topic=/camera/image_raw&quality=80", seconds, mjpeg))
         viewer.start()
         fox = subprocess.run(["node", os.path.join(JS, "foxglove_client.mjs"), "bench", ws_url,
                               "/camera/image_raw", str(seconds)], capture_output=True, text=True,
@@ -545,9 +564,10 @@ def run(seconds: float, web_src: str | None = None) -> list:
         fox_hz = fox_line[0]["bench"]["hz"] if fox_line else float("nan")
         decoded = fox_line[0]["bench"]["decodedOk"] if fox_line else False
         rows.append(("1080p bgr8 @30 Hz -> Foxglove client (node), 2 stalled clients", pub_hz, raw_hz,
-                     fox_hz, None, f"decoded: {decoded}"))
-        rows.append(("1080p bgr8 @30 Hz -> MJPEG viewer /stream, 2 stalled clients", pub_hz, raw_hz,
-                     mjpeg.get("hz", float("nan")), None, "JPEG q95, encoded once per frame"))
+                     fox_hz, None, f"decoded: {decoded}; tap over {tap}"))
+        rows.append(("1080p bgr8 @30 Hz -> the page's image view (/stream q80), 2 stalled",
+                     pub_hz, raw_hz, mjpeg.get("hz", float("nan")), None,
+                     f"JPEG encoded once per frame; tap over {tap}"))
 
         # 2: 1,000 small messages per second to rosbridge clients
         span = seconds + 8

@@ -1,14 +1,18 @@
 """An in-memory, socket-like byte stream pair for transport tests (httpcore's MockStream,
 goroslib's io.ReadWriter): the methods of ``minros.transport.streams.Stream``, a bounded buffer
 per direction so a test can make a subscriber slow or leave a frame half-sent, and no file
-descriptor (``wait_writable`` instead of poll).
+descriptor (``wait_writable``/``wait_readable`` instead of poll). File descriptors passed with
+``sendmsg`` (SCM_RIGHTS, as MINROSSHM's segments travel) arrive with the byte they were sent
+with, duplicated, in ``recvmsg_into``'s ancillary data.
 
     pub_end, sub_end = MemoryStream.pair(capacity=4096)
 """
 
 from __future__ import annotations
 
+import os
 import socket
+import struct
 import threading
 import time
 from typing import Any, Iterable, Tuple
@@ -30,6 +34,8 @@ class MemoryStream:
         self.closed = False
         self._timeout: float | None = None
         self.sent_total = 0
+        #: descriptors sent by the peer: [offset in inbox, fd], in order
+        self.fds: list = []
 
     @classmethod
     def pair(cls, capacity: int = 1 << 20) -> Tuple[MemoryStream, MemoryStream]:
@@ -64,7 +70,16 @@ class MemoryStream:
 
     def sendmsg(self, buffers: Iterable[Any], ancdata: Iterable[Any] = (), flags: int = 0) -> int:
         data = b"".join(bytes(memoryview(b)) for b in buffers)
-        return self.send(data, flags)
+        fds = []
+        for level, kind, raw in ancdata:
+            if level == socket.SOL_SOCKET and kind == socket.SCM_RIGHTS:
+                fds.extend(struct.unpack(f"{len(raw) // 4}i", raw))
+        with self._cond:
+            at = len(self.peer.inbox)
+            sent = self.send(data, flags)
+            if sent and fds:  # they go with the first byte, as over a Unix socket
+                self.peer.fds.extend([at, os.dup(fd)] for fd in fds)
+            return sent
 
     def send(self, data: Any, flags: int = 0) -> int:
         view = memoryview(data).cast("B")
@@ -109,6 +124,30 @@ class MemoryStream:
         target[:len(data)] = data
         return len(data)
 
+    def recvmsg_into(self, buffers: Any, ancbufsize: int = 0, flags: int = 0) -> tuple:
+        """Into the first buffer; the descriptors sent with the bytes received come along."""
+        target = memoryview(buffers[0]).cast("B")
+        with self._cond:
+            self._wait(lambda: bool(self.inbox) or self._eof(), flags)
+            if self.closed or self.read_shut:
+                return 0, [], 0, None
+            n = min(len(target), len(self.inbox))
+            if self.fds:  # a read stops before the next descriptor's byte, as the kernel's
+                later = [at for at, _ in self.fds if at > 0]
+                n = min([n, *later])
+            target[:n] = self.inbox[:n]
+            del self.inbox[:n]
+            fds = [fd for at, fd in self.fds if at < n]
+            self.fds = [[at - n, fd] for at, fd in self.fds if at >= n]
+            self._cond.notify_all()
+        ancdata = [(socket.SOL_SOCKET, socket.SCM_RIGHTS, struct.pack(f"{len(fds)}i", *fds))] \
+            if fds else []
+        return n, ancdata, 0, None
+
+    def wait_readable(self, timeout: float) -> bool:
+        with self._cond:
+            return self._cond.wait_for(lambda: bool(self.inbox) or self._eof(), timeout)
+
     # -- the rest of a socket -----------------------------------------------------------------
 
     def shutdown(self, how: int) -> None:
@@ -122,7 +161,10 @@ class MemoryStream:
     def close(self) -> None:
         with self._cond:
             self.closed = True
+            fds, self.fds = self.fds, []
             self._cond.notify_all()
+        for _, fd in fds:
+            os.close(fd)
 
     def fileno(self) -> int:
         return -1
@@ -141,6 +183,9 @@ class MemoryStream:
 
     def setsockopt(self, *args: Any) -> None:
         pass
+
+    def setblocking(self, flag: bool) -> None:
+        self._timeout = None if flag else 0.0
 
     def pending(self) -> int:
         """Bytes waiting for this end to read."""

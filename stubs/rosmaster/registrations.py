@@ -11,11 +11,13 @@ from minros.master.registrations import NodeRef, Registrations  # noqa: F401
 
 def shutdown_node_task(api: str, caller_id: str, reason: str) -> None:
     """Ask the node at ``api`` to shut down (bounded; a dead node is no error)."""
-    from minros.tools.master import call_node
+    from minros.tools.master import TOOL_TIMEOUT
+    from minros.wire.slaveapi import RemoteError, SlaveClient
 
     try:
-        call_node(api, "shutdown", "/master", f"[{caller_id}] Reason: {reason}")
-    except OSError:
+        with SlaveClient(api, "/master", timeout=TOOL_TIMEOUT) as node:
+            node.shutdown(f"[{caller_id}] Reason: {reason}")
+    except (OSError, RemoteError):
         pass
 
 

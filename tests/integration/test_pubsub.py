@@ -409,9 +409,9 @@ def test_master_restart_reregisters_and_reconnects(scripts, ros_home):
 SYNC_FLOODER = r'''
 import time
 import rospy
-import minros.transport.tcpros_pubsub
+import minros.transport.sendqueue
 from std_msgs.msg import UInt8MultiArray
-minros.transport.tcpros_pubsub.SYNC_SEND_TIMEOUT = 1.0  # rospy's socket timeout is 60 s; shortened for the test
+minros.transport.sendqueue.SYNC_SEND_TIMEOUT = 1.0  # rospy's socket timeout is 60 s; shortened for the test
 rospy.init_node("sync_flooder")
 pub = rospy.Publisher("/sync_flood", UInt8MultiArray, queue_size=None)
 print("ready", flush=True)

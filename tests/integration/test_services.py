@@ -195,12 +195,12 @@ def test_proxy_persistent_reuses_one_connection(adder, master_env):
     proxy = minros.ServiceProxy("/add_two_ints", _srv(), persistent=True)
     try:
         assert [proxy(i + 100, 1).sum for i in range(20)] == [i + 101 for i in range(20)]
-        first_sock = proxy._sock
+        first_end = proxy._end
         proxy(0, 0)
-        assert proxy._sock is first_sock and first_sock is not None
+        assert proxy._end is first_end and first_end is not None
     finally:
         proxy.close()
-    assert proxy._sock is None
+    assert proxy._end is None
 
 
 @pytest.mark.smoke

@@ -26,6 +26,7 @@ import pytest
 import minros
 from minros.client import services
 from minros.exceptions import ServiceException
+from minros.transport import tcpros_service
 from minros.wire import tcpros
 from support import PYTHON, Proc, ros_env
 
@@ -257,8 +258,8 @@ def test_big_request_reaches_a_slow_server(master_env, monkeypatch):
     keeps the send going."""
     from sensor_msgs.srv import SetCameraInfo
 
-    monkeypatch.setattr(services, "_POLL", 0.2)
-    monkeypatch.setattr(services, "SEND_STALL_TIMEOUT", 1.0)
+    monkeypatch.setattr(tcpros_service, "POLL", 0.2)
+    monkeypatch.setattr(tcpros_service, "SEND_STALL_TIMEOUT", 1.0)
     count = 2_000_000
     got = {}
 
@@ -289,8 +290,8 @@ def test_stalled_server_is_given_up_after_the_stall_timeout(master_env, monkeypa
     SEND_STALL_TIMEOUT passes without progress, not at the first poll and not never."""
     from sensor_msgs.srv import SetCameraInfo
 
-    monkeypatch.setattr(services, "_POLL", 0.2)
-    monkeypatch.setattr(services, "SEND_STALL_TIMEOUT", 1.0)
+    monkeypatch.setattr(tcpros_service, "POLL", 0.2)
+    monkeypatch.setattr(tcpros_service, "SEND_STALL_TIMEOUT", 1.0)
     done = threading.Event()
 
     def serve(sock: socket.socket) -> None:

@@ -265,7 +265,8 @@ def test_garbage_notifications_fall_back_to_tcpros_with_one_line(scripts, minros
 def test_the_trace_shows_the_shared_memory_connection(scripts, minros_master, ros_home, tmp_path):
     pub_script, sub_script = scripts
     trace = tmp_path / "run.jsonl"
-    env = ros_env(minros_master, ros_home, {"MINROS_TRACE": str(trace)})
+    # a traced process keeps to TCPROS unless asked (minros trace --shm): asked here
+    env = ros_env(minros_master, ros_home, {"MINROS_TRACE": str(trace), "MINROS_TRACE_SHM": "1"})
     sub = Proc([PYTHON, str(sub_script)], env)
     pub = None
     try:
@@ -285,7 +286,7 @@ def test_the_trace_shows_the_shared_memory_connection(scripts, minros_master, ro
     assert re.search(r'\[4\].*<- 1, "ready on minros-shm\.\d+\.[0-9a-f]+:.*\["MINROSSHM", ', text)
     assert re.search(r"\[5\].*/viewer -> /camera\s+MINROSSHM: Unix socket connection @[0-9a-f]+ -> "
                      r"@minros-shm\.\d+\.[0-9a-f]+ \(shared memory\)", text), text
-    assert re.search(r"\[5\].*/camera -> /viewer\s+shared-memory segment 1: 7 slots of 311296 "
+    assert re.search(r"\[5\].*/camera -> /viewer\s+shared-memory segment 1: 3 slots of 311296 "
                      r"bytes \(its memfd passed with this record\)", text), text
     assert re.search(r"\[6\].*/camera -> /viewer\s+message 1: 307\d\d\d bytes in slot 0 of segment 1 "
                      r"\(shared memory\), received [\d.]+ ms later", text), text
@@ -354,7 +355,7 @@ def test_bus_info_names_the_peer_process(scripts, minros_master, ros_home):
         uri = master.lookupNode("/t", "/camera")[2]
         info = [c for c in xmlrpc.client.ServerProxy(uri).getBusInfo("/t")[2] if c[4] == "/image"]
         assert len(info) == 1 and info[0][3] == "MINROSSHM"
-        assert f"to [pid {sub.pid}]" in info[0][6] and "7 slots of 311296 bytes" in info[0][6]
+        assert f"to [pid {sub.pid}]" in info[0][6] and "3 slots of 311296 bytes" in info[0][6]
     finally:
         for proc in (pub, sub):
             if proc is not None:

@@ -53,8 +53,10 @@ def traced_run(tmp_path_factory):
     ros_home = tmp_path / "ros_home"
     (ros_home / "log").mkdir(parents=True)
     port = free_port()
-    # the TCPROS wire, as courses teach it (MINROSSHM's trace: test_shm_run.py)
-    env = ros_env(port, ros_home, {"MINROS_SHM": "0"})
+    # two minros nodes of one host, and no MINROS_SHM=0: traced, they keep to TCPROS, the wire
+    # courses teach (MINROSSHM's trace, asked with --shm: test_shm_run.py)
+    env = ros_env(port, ros_home)
+    env.pop("MINROS_SHM", None)
     files = {name: tmp_path / f"{name}.jsonl" for name in ("core", "listener", "talker")}
     core = Proc(_traced(files["core"], [PYTHON, "-m", "minros", "core", "-p", str(port)],
                         messages=False), env)
@@ -164,3 +166,28 @@ def test_tshark_decodes_the_pcap_of_the_run(traced_run, tmp_path):
     pub = next(h for h in headers if "callerid=/talker" in h and "topic=/chatter" in h)
     assert f"md5sum={STRING_MD5}" in sub and "tcp_nodelay=0" in sub
     assert "latching=0" in pub and "type=std_msgs/String" in pub
+
+
+def test_traced_minros_nodes_keep_to_tcpros_unless_asked(tmp_path):
+    """Issue 38 item 12: between two minros nodes a trace showed only XML-RPC (they took shared
+    memory). Traced, a node speaks TCPROS only (the run above: the listener offers
+    [["TCPROS"]] with MINROS_SHM unset); with ``minros trace --shm`` shared memory again."""
+    ros_home = tmp_path / "ros_home"
+    (ros_home / "log").mkdir(parents=True)
+    port = free_port()
+    env = ros_env(port, ros_home)
+    env.pop("MINROS_SHM", None)
+    probe = ("import minros.node as n; print([h.protocol for h in n.Node(argv=['p']).protocols])")
+    plain = subprocess.run([PYTHON, "-c", probe], env=env, capture_output=True, text=True,
+                           timeout=60)
+    runs = {}
+    for flags in ([], ["--shm"]):
+        done = subprocess.run([PYTHON, "-m", "minros", "trace", "-o", str(tmp_path / "p.jsonl"),
+                               *flags, "--", PYTHON, "-c", probe],
+                              env=env, capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        runs[tuple(flags)] = done.stdout.strip()
+    if "MINROSSHM" not in plain.stdout:
+        pytest.skip("no shared memory on this system")
+    assert runs[()] == "['TCPROS']"
+    assert runs[("--shm",)] == "['MINROSSHM', 'TCPROS']"

@@ -261,6 +261,59 @@ def read_mjpeg_parts(url: str, count: int, timeout: float = 20) -> tuple:
     return parts, headers
 
 
+#: a minros camera: 1920x1080 bgr8 at 15 Hz, the top half white and the bottom half black
+CAMERA_1080P = r"""
+import rospy
+from sensor_msgs.msg import Image
+
+rospy.init_node("camera_1080p")
+pub = rospy.Publisher("/camera_1080p/image_raw", Image, queue_size=2)
+half = 540 * 1920 * 3
+img = Image(height=1080, width=1920, encoding="bgr8", step=1920 * 3,
+            data=b"\xff" * half + b"\x00" * half)
+rate = rospy.Rate(15)
+while not rospy.is_shutdown():
+    img.header.stamp = rospy.Time.now()
+    pub.publish(img)
+    rate.sleep()
+"""
+
+
+def test_the_image_view_gets_1080p_over_shared_memory_from_a_minros_camera(graph, tmp_path):
+    """Issue 36: minros web's tap connects through the node's protocols, so a minros camera on
+    this host reaches the page's image view (/stream, what images.js opens) over MINROSSHM, at
+    full size (the old receiver offered TCPROS only)."""
+    from minros.transport import shm
+    from minros.wire.slaveapi import SlaveClient
+
+    need(shm.supported(), "no shared memory on this system")
+    script = tmp_path / "camera_1080p.py"
+    script.write_text(CAMERA_1080P)
+    camera = Proc([PYTHON, str(script)], graph.env())
+    url = f"{graph.http}/stream?topic=/camera_1080p/image_raw"
+    try:
+        parts, _ = read_mjpeg_parts(url, 3, timeout=30)
+        assert len(parts) == 3
+        frame = cv2.imdecode(np.frombuffer(parts[-1], np.uint8), cv2.IMREAD_COLOR)
+        assert frame.shape == (1080, 1920, 3)
+        assert frame[:500].mean() > 240 and frame[580:].mean() < 15
+        # the tap lives while a viewer does: ask which transport it took with one open
+        with urllib.request.urlopen(url, timeout=30) as viewer:
+            seen = b""
+            while seen.count(b"Content-Length: ") < 2:  # a frame came through this viewer's tap
+                chunk = viewer.read1(65536)
+                assert chunk, "the stream ended"
+                seen += chunk
+            master = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{graph.port}/")
+            uri = master.lookupNode("/test", "/minros_web")[2]
+            with SlaveClient(uri, "/test", timeout=10) as web:
+                rows = [row for row in web.get_bus_info()
+                        if row[4] == "/camera_1080p/image_raw" and row[2] == "i"]
+        assert rows and {row[3] for row in rows} == {"MINROSSHM"}, rows
+    finally:
+        camera.stop()
+
+
 def test_seed_video_subscriber_frames_appear_at_stream(graph, tmp_path):
     """video_sub.py, unmodified, with opencv-python-headless: its 'camera' window is streamed."""
     fake = tmp_path / "fakecam"
@@ -681,7 +734,7 @@ def test_many_subscriptions_take_no_thread_each(minros_core, ros_home):
             assert threads < 40, threads  # was one a publisher connection: count + 17
             info = subprocess.run([PYTHON, "-m", "minros", "node", "info", "/minros_web"],
                                   env=env, capture_output=True, text=True, timeout=30).stdout
-            assert "/many/t7 [std_msgs/String]" in info and info.count("TCPROS") >= count
+            assert "/many/t7 [std_msgs/String]" in info and info.count("* transport: ") >= count
             pub.stop()
             pub = Proc([PYTHON, "-c", MANY_TOPICS_PUBLISHER, str(count), "second"], env)
             pub.read_until("ready", timeout=30)

@@ -13,6 +13,7 @@ import pytest
 from integration.pubsub_scripts import LISTENER, TALKER
 from interop.test_pubsub_roscpp import NODE_CPP
 from minros.transport import shm as shm_transport
+from minros.wire import shm as wire_shm
 from support import (
     PYTHON,
     REFERENCE_PYTHON,
@@ -94,7 +95,7 @@ def test_reference_publishers_answer_the_offer_with_tcpros(scripts, roscpp_node,
     try:
         pub.read_until("published latched", 30)
         uri = _publisher_uri(debian_rosmaster, "/latched_img")
-        offer = [shm_transport.shm.offer(shm_transport.boot_id()), ["TCPROS"]]
+        offer = [wire_shm.offer(shm_transport.boot_id()), ["TCPROS"]]
         code, _, answer = xmlrpc.client.ServerProxy(uri).requestTopic("/probe", "/latched_img", offer)
         assert code == 1 and answer[0] == "TCPROS" and isinstance(answer[2], int), answer
         # offered alone, it is refused as any protocol they do not know

@@ -24,19 +24,13 @@ MUTABLE_CALLS = {"dict", "list", "set", "defaultdict", "OrderedDict", "deque", "
                  "WeakSet", "WeakValueDictionary", "WeakKeyDictionary", "Lock", "RLock",
                  "Condition", "Event", "local", "count"}
 
-# The page describes transport/ as the transport branch (issue 36's redesign) makes it; that
-# branch is merged after the one that wrote these tables. Until then the tree differs from the
-# page in exactly these paths; once it is merged both sets are idle, and can be emptied.
-#: named by the page, brought by the transport branch
-NOT_YET: Set[str] = {
-    "src/minros/transport/sender.py", "src/minros/transport/sendqueue.py",
-    "src/minros/transport/tcpros_service.py", "src/minros/transport/shm/segment.py",
-    "src/minros/transport/shm/sender.py", "src/minros/transport/shm/receiver.py",
-    "src/minros/transport/shm/handler.py", "src/minros/wire/slaveapi.py",
-    "tests/unit/test_transport_core.py"}
-#: in the tree until then: shm.py (split into transport/shm/), and tools/services.py's own
-#: trace.watch (its probe then connects through transport.tcpros_service)
-GOING: Set[str] = {"src/minros/transport/shm.py", "src/minros/tools/services.py"}
+# Paths the page may name before they are in the tree (a branch that brings them merges after
+# the page), and paths in the tree the page no longer describes (a branch removes them): both
+# empty while page and tree agree.
+#: named by the page, not yet in the tree
+NOT_YET: Set[str] = set()
+#: in the tree, no longer described
+GOING: Set[str] = set()
 
 
 def _rows() -> List[str]:

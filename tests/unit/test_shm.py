@@ -17,11 +17,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from memstream import MemoryStream
 from minros.client.msg import AnyMsg, frame_len, serialize_frame
 from minros.msgs import get_message_class, reader_for
 from minros.transport import shm as shm_transport
 from minros.transport.base import FallBack
 from minros.transport.shm import ShmReceiver, ShmSender, own
+from minros.transport.shm import segment as shm_segment
 from minros.wire import shm, sockets
 from minros.wire.handshake import Handshake, Role
 
@@ -73,11 +75,7 @@ def test_an_answer_from_another_kernel_is_refused():
 
 
 def test_slot_counts_and_sizes():
-    assert shm.slot_count(10) == 12  # queue_size + 2
-    assert shm.slot_count(1) == 3
-    assert shm.slot_count(None) == 3  # synchronous: WINDOW + 1
-    assert shm.slot_count(0) == shm.MAX_SLOTS  # unbounded over TCPROS: capped here
-    assert shm.slot_count(1000) == shm.MAX_SLOTS
+    assert shm.SLOTS == shm.WINDOW + 1 == 3  # whatever the queue_size: the window and one ahead
     assert shm.grown_slot_size(6220854) == 6221824  # the first message, rounded to pages
     assert shm.grown_slot_size(6220855, 6221824) == shm.page_round(6221824 * 3 // 2)
     assert shm.grown_slot_size(20 << 20, 6221824) == 20 << 20
@@ -170,88 +168,61 @@ def test_the_segment_header_must_match_its_announcement():
         shm.check_segment_header(b"MINROSHM", seg)
 
 
-# --------------------------------------------------------------------------- the slot queue
+# --------------------------------------------------------------------------- the slot table
 
 
-def write(queue: shm.SlotQueue, length: int = 100) -> int:
-    index = queue.acquire()
+def write(table: shm.SlotTable, length: int = 100) -> int:
+    index = table.acquire()
     assert index is not None
-    queue.put(("slot", index, length, 0))
+    table.queued(index)
     return index
 
 
 def test_the_window_holds_two_slots_and_done_frees_them():
-    queue = shm.SlotQueue(shm.slot_count(1), 1)
-    a = write(queue)
-    assert queue.ready()
-    _, record = queue.pop()
-    assert record[:4] == b"SLOT"
-    b = write(queue)
-    queue.pop()
-    c = write(queue)
-    assert not queue.ready()  # two in the subscriber's hands: the third waits
-    assert queue.counts() == {"free": 0, "writing": 0, "queued": 1, "notified": 2}
-    queue.done(1, a)
-    assert queue.ready()
-    item, _ = queue.pop()
-    assert item[1] == c
-    queue.done(1, b)
-    queue.done(1, c)
-    assert queue.counts()["free"] == 3
+    table = shm.SlotTable()
+    a = write(table)
+    assert table.room()
+    assert table.announce(a, 0, 100)[:4] == b"SLOT"
+    b = write(table)
+    table.announce(b, 0, 100)
+    c = write(table)
+    assert not table.room()  # two in the subscriber's hands: the third waits
+    assert table.acquire() is None  # and nothing is free to write
+    assert table.counts() == {"free": 0, "writing": 0, "queued": 1, "notified": 2}
+    table.done(1, a)
+    assert table.room()
+    table.announce(c, 0, 100)
+    table.done(1, b)
+    table.done(1, c)
+    assert table.counts()["free"] == 3
 
 
-def test_the_latest_frames_win():
-    """queue_size 2 (4 slots): with the subscriber holding two, six more frames leave only the
-    last two queued, and the slot of a dropped frame is written again."""
-    queue = shm.SlotQueue(shm.slot_count(2), 2)
-    write(queue), queue.pop(), write(queue), queue.pop()  # the window is full
-    written = [write(queue, length=1000 + n) for n in range(6)]
-    assert [item[2] for item in queue.items] == [1004, 1005]
-    assert queue.dropped == 4
-    assert len(set(written)) == 2  # only the two free slots were ever written
-
-
-def test_inline_items_wait_behind_slots_in_order():
-    queue = shm.SlotQueue(3, 10, window=1)
-    write(queue), queue.pop()
-    write(queue)
-    queue.put(("inline", b"small"))
-    assert not queue.ready()  # the small message stays behind the big one: order kept
-    queue.done(1, 0)
-    assert queue.pop()[0][0] == "slot" and queue.pop()[0] == ("inline", b"small")
-
-
-def test_an_unbounded_queue_and_the_limit_drop_oldest_inline_too():
-    queue = shm.SlotQueue(3, 0)
-    for n in range(100):
-        queue.put(("inline", n))
-    assert len(queue.items) == 100
-    queue = shm.SlotQueue(3, 3)
-    for n in range(10):
-        queue.put(("inline", n))
-    assert [i[1] for i in queue.items] == [7, 8, 9]
+def test_a_dropped_frame_frees_its_slot():
+    table = shm.SlotTable()
+    index = write(table)
+    table.abandon(index)  # a queued frame the queue dropped, or a loan given back
+    assert table.counts()["free"] == 3
 
 
 def test_done_for_a_slot_not_held_is_a_protocol_error():
-    queue = shm.SlotQueue(3, 1)
+    table = shm.SlotTable()
     with pytest.raises(shm.ShmError, match="does not hold"):
-        queue.done(1, 0)
-    write(queue), queue.pop()
-    queue.done(1, 0)
+        table.done(1, 0)
+    table.announce(write(table), 0, 100)
+    table.done(1, 0)
     with pytest.raises(shm.ShmError):
-        queue.done(1, 0)  # twice
+        table.done(1, 0)  # twice
 
 
 def test_a_new_segment_keeps_the_held_slots_of_the_old_one_in_the_window():
-    queue = shm.SlotQueue(3, 1)
-    write(queue), queue.pop(), write(queue), queue.pop()
-    write(queue)  # queued in generation 1
-    queue.resize(3, 2)
-    assert not queue.items and queue.dropped == 1
-    write(queue)
-    assert not queue.ready()  # generation 1's two slots are still the subscriber's
-    queue.done(1, 0)
-    assert queue.pop()[1][:8] == shm.slot(2, 0, 0, 100, 3)[:8]
+    table = shm.SlotTable()
+    table.announce(write(table), 0, 100)
+    table.announce(write(table), 0, 100)
+    table.resize(3, 2)
+    index = write(table)
+    assert not table.room()  # generation 1's two slots are still the subscriber's
+    table.done(1, 0)
+    assert table.announce(index, 0, 100)[:8] == shm.slot(2, 0, 0, 100, 3)[:8]
 
 
 # --------------------------------------------------------------------------- both ends
@@ -265,9 +236,20 @@ class Closed:
         self.event.set()
 
 
-def connect(queue_size=10, topic="/t"):
-    """A publisher's and a subscriber's end over a socketpair, negotiated."""
-    pub_sock, sub_sock = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
+#: both ends run over a Unix socketpair (descriptors pass as in a real connection) and over
+#: tests/memstream.py's in-memory stream (as TCPROS's ends are tested)
+STREAMS = ["unix", "memory"]
+
+
+def stream_pair(kind: str, capacity: int = 1 << 20):
+    if kind == "memory":
+        return MemoryStream.pair(capacity)
+    return socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
+
+
+def connect(queue_size=10, topic="/t", stream="unix"):
+    """A publisher's and a subscriber's end over a stream pair, negotiated."""
+    pub_sock, sub_sock = stream_pair(stream)
     closed = Closed()
     sender = ShmSender(pub_sock, topic, queue_size, closed)
     receiver = ShmReceiver(sub_sock, topic)
@@ -304,9 +286,9 @@ def receive(receiver: ShmReceiver, count: int, views: bool = False) -> List[Any]
     return out
 
 
-@pytest.fixture
-def pair():
-    sender, receiver, closed = connect()
+@pytest.fixture(params=STREAMS)
+def pair(request):
+    sender, receiver, closed = connect(stream=request.param)
     yield sender, receiver, closed
     sender.close()
     receiver.close()
@@ -324,8 +306,8 @@ def test_large_messages_come_from_the_slot_small_ones_inline(pair):
     assert [f.__class__ for f in frames] == [memoryview, memoryview, memoryview, bytes]
     assert [bytes(f) for f in frames] == big + [b"small"]
     assert frames[0].readonly
-    seg = sender.segment
-    assert seg is not None and seg.slots == 12 and seg.slot_size == shm.page_round(300_004)
+    seg = sender.memory.segment
+    assert seg is not None and seg.slots == shm.SLOTS and seg.slot_size == shm.page_round(300_004)
     assert settled(sender, lambda: sender.stat_msgs == 4)  # counted once wholly sent
     assert receiver.info().startswith("MINROSSHM connection")
 
@@ -346,7 +328,8 @@ def test_the_publishing_thread_takes_slots_back_itself(monkeypatch):
     """A publisher copying frames back to back holds the GIL: when the window is full it reads
     the subscriber's DONE records itself, not waiting for its watcher thread to get the GIL
     (which took up to the 5 ms switch interval per slot: most frames were dropped)."""
-    monkeypatch.setattr(ShmSender, "_watch", lambda self: None)  # no watcher thread at all
+    idle = threading.Event()
+    monkeypatch.setattr(ShmSender, "_watch", lambda self: idle.wait(TIMEOUT))  # a deaf watcher
     sender, receiver, _ = connect()
     try:
         for n in range(2):
@@ -363,19 +346,21 @@ def test_the_publishing_thread_takes_slots_back_itself(monkeypatch):
         assert got + third == [payload(n, 100_000) for n in range(3)]
         assert sender.slots.in_flight == 1
     finally:
+        idle.set()
         sender.close()
         receiver.close()
 
 
-def test_a_slow_subscriber_never_blocks_the_publisher_and_sees_the_latest():
-    sender, receiver, _ = connect(queue_size=2)
+@pytest.mark.parametrize("stream", STREAMS)
+def test_a_slow_subscriber_never_blocks_the_publisher_and_sees_the_latest(stream):
+    sender, receiver, _ = connect(queue_size=2, stream=stream)
     try:
         for n in range(50):  # the subscriber reads nothing meanwhile
             sender.send(serialize_frame(AnyMsg(payload(n, 200_000))))
         got = receive(receiver, 2)  # the window: the first two
         got += receive(receiver, 2)  # then what the queue kept: the last two
         assert got == [payload(n, 200_000) for n in (0, 1, 48, 49)]
-        assert sender.slots.dropped == 46
+        assert sender.queue.dropped == 46
     finally:
         sender.close()
         receiver.close()
@@ -388,7 +373,7 @@ def test_a_growing_message_gets_a_new_segment(pair):
     sender.send(serialize_frame(AnyMsg(payload(2, 500_000))))
     second = receive(receiver, 1)
     assert bytes(first[0]) == payload(1, 100_000) and second == [payload(2, 500_000)]
-    assert sender.segment.generation == 2
+    assert sender.memory.segment.generation == 2
     sender.send(serialize_frame(AnyMsg(b"x")))
     receive(receiver, 1)
     assert list(receiver.maps) == [2]  # the old mapping went once its frames were done
@@ -547,7 +532,7 @@ def test_a_publisher_gone_mid_record_is_a_frame_error_and_a_clean_end_is_none():
 def test_the_kernel_refusing_memory_falls_back_with_one_line(monkeypatch, caplog, failing, error):
     """The publisher's memfd refused or its memory not there: the subscriber is told (FALL)
     and falls back; the publisher says it once, and declines later offers for the topic."""
-    shm_transport._said.clear()
+    shm_segment._said.clear()
 
     def refuse(*args, **kwargs):
         raise error
@@ -593,8 +578,9 @@ def test_the_subscriber_keeps_reading_after_the_publisher_closed(pair):
     assert receiver.receive() is None
 
 
-def test_a_synchronous_publisher_hands_each_message_over():
-    sender, receiver, _ = connect(queue_size=None)
+@pytest.mark.parametrize("stream", STREAMS)
+def test_a_synchronous_publisher_hands_each_message_over(stream):
+    sender, receiver, _ = connect(queue_size=None, stream=stream)
     got: List[bytes] = []
     thread = threading.Thread(target=lambda: got.extend(receive(receiver, 20)), daemon=True)
     thread.start()
@@ -653,7 +639,7 @@ def test_a_loaned_array_is_published_from_its_slot_without_a_copy(pair, monkeypa
     sender, receiver, _ = pair
     pub = publication(sender)
     view = pub.loan(100_000)
-    seg = sender.segment
+    seg = sender.memory.segment
     assert seg is not None and not view.readonly and view.nbytes == 100_000
     assert seg.slot_size >= shm.LOAN_OFFSET + 100_000 + shm.LOAN_TAIL
     view[:] = payload(5, 100_000)  # filled in place: the slot's memory
@@ -696,7 +682,7 @@ def test_a_stale_loan_is_sent_as_any_message(pair):
     view = pub.loan(100_000)
     view[:] = payload(6, 100_000)
     sender.send(serialize_frame(AnyMsg(payload(1, 900_000))))
-    assert sender.segment.generation == 2
+    assert sender.memory.segment.generation == 2
     pub.publish(image(view))
     got = receive(receiver, 2)
     assert got[0] == payload(1, 900_000) and got[1][-100_000:] == payload(6, 100_000)
@@ -743,3 +729,117 @@ def test_a_message_for_one_connection_leaves_the_lender_alone(pair):
     pub.publish(image(view), connection_override=other)
     assert len(other.frames) == 1 and frame_len(other.frames[0]) > 100_000
     assert sender.slots.counts()["writing"] == 1 and sender.stat_msgs == 0
+
+
+# --------------------------------------------------------------------------- what a subscriber can do
+
+
+def raw_subscriber(queue_size=10):
+    """A publisher's end and the raw socket of a subscriber that reads what it likes."""
+    from minros.wire import tcpros
+
+    pub_sock, sub_sock = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
+    closed = Closed()
+    sender = ShmSender(pub_sock, "/t", queue_size, closed)
+    sub_sock.sendall(tcpros.encode_header({"topic": "/t", "md5sum": "*", "callerid": "/evil",
+                                           "type": "*"}))
+    sender.negotiate(Handshake(Role.PUBLISHER, {"topic": "/t", "type": "*", "md5sum": "*",
+                                                "callerid": "/talker"}), sockets.read_header(pub_sock))
+    sockets.read_header(sub_sock)
+    return sender, sub_sock
+
+
+def received_segment(sub_sock: socket.socket) -> int:
+    """The descriptor that came with the SEGM record."""
+    data, ancdata, _, _ = sub_sock.recvmsg(shm.INLINE_LIMIT, socket.CMSG_SPACE(16))
+    assert data.startswith(shm.SEGM)
+    fds = [fd for level, kind, raw in ancdata if kind == socket.SCM_RIGHTS
+           for fd in struct.unpack(f"{len(raw) // 4}i", raw)]
+    assert len(fds) == 1
+    return fds[0]
+
+
+def test_a_subscriber_cannot_write_what_every_subscriber_reads():
+    """Issue 38 item 1: the memfd passed with SEGM was the publisher's own O_RDWR descriptor,
+    so any same-host process that asked requestTopic could map it writable and change what
+    the others receive. Now it is opened read-only and the memfd is sealed against writes
+    (F_SEAL_FUTURE_WRITE): no writable mapping, no write(2), not even through a read-write
+    reopening of /proc/self/fd."""
+    import ctypes
+    import fcntl
+    import mmap
+
+    sender, sub_sock = raw_subscriber()
+    try:
+        sender.send(serialize_frame(AnyMsg(payload(1, 100_000))))
+        fd = received_segment(sub_sock)
+        size = os.fstat(fd).st_size
+        try:
+            assert fcntl.fcntl(fd, fcntl.F_GETFL) & os.O_ACCMODE == os.O_RDONLY
+            assert fcntl.fcntl(fd, fcntl.F_GET_SEALS) & shm_segment.F_SEAL_FUTURE_WRITE
+            with pytest.raises(PermissionError):
+                mmap.mmap(fd, size, flags=mmap.MAP_SHARED, prot=mmap.PROT_READ | mmap.PROT_WRITE)
+            with pytest.raises(OSError):  # EBADF: not open for writing
+                os.pwrite(fd, b"evil", shm.HEADER_SIZE)
+            again = os.open(f"/proc/self/fd/{fd}", os.O_RDWR)  # the mode of a memfd is 0777
+            try:
+                with pytest.raises(PermissionError):
+                    mmap.mmap(again, size, flags=mmap.MAP_SHARED,
+                              prot=mmap.PROT_READ | mmap.PROT_WRITE)
+                with pytest.raises(PermissionError):
+                    os.pwrite(again, b"evil", shm.HEADER_SIZE)
+            finally:
+                os.close(again)
+            # nor can a read-only mapping be made writable (mprotect)
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.mmap.restype = ctypes.c_void_p
+            libc.mmap.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int, ctypes.c_int,
+                                  ctypes.c_int, ctypes.c_long]
+            libc.mprotect.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int]
+            libc.munmap.argtypes = [ctypes.c_void_p, ctypes.c_size_t]
+            address = libc.mmap(None, size, mmap.PROT_READ, mmap.MAP_SHARED, fd, 0)
+            assert address not in (None, ctypes.c_void_p(-1).value)
+            try:
+                assert libc.mprotect(address, size, mmap.PROT_READ | mmap.PROT_WRITE) == -1
+                assert ctypes.get_errno() in (errno.EACCES, errno.EPERM)
+            finally:
+                libc.munmap(address, size)
+        finally:
+            os.close(fd)
+        # the publisher itself still writes (its own mapping): the next frame arrives intact
+        assert sender.memory.segment is not None
+        sender.memory.segment.write(0, serialize_frame(AnyMsg(payload(2, 100_000))))
+    finally:
+        sender.close()
+        sub_sock.close()
+
+
+def test_deaf_subscribers_hold_three_slots_each_not_their_queue():
+    """Issue 38 item 3: subscribers that never give a slot back cost the publisher
+    queue_size + 2 slots each (10 of them held 746 MB of 1080p segments). Now a segment has
+    SLOTS = 3 whatever the queue_size, and the frames queued behind a deaf subscriber are the
+    publication's own frames, shared by every connection as over TCPROS: the memory one
+    publisher keeps for N deaf subscribers is at most 3 slots each."""
+    from minros.client.publication import Publication
+
+    deaf = [raw_subscriber(queue_size=10) for _ in range(10)]
+    pub = Publication(_Node(), "/t", "/t", get_message_class("sensor_msgs/Image"))
+    pub.queue_size = 10
+    for sender, _ in deaf:
+        pub.add_connection(sender)
+    try:
+        frames = 40
+        for n in range(frames):  # 1 MB images, nobody reads
+            pub.publish(image(payload(n, 1_000_000)))
+        slot_size = deaf[0][0].memory.segment.slot_size
+        for sender, _ in deaf:
+            blocks = os.fstat(sender.memory.segment.fd).st_blocks * 512
+            assert blocks <= shm.HEADER_SIZE + shm.SLOTS * slot_size, blocks
+            assert sender.slots.in_flight == shm.WINDOW and len(sender.queue) == 10
+        queued = {id(item[1]) for sender, _ in deaf for item in sender.queue.items
+                  if item[0] == "frame"}
+        assert len(queued) <= 10  # one frame object per message, whatever the subscribers
+    finally:
+        pub.close()
+        for _, sub_sock in deaf:
+            sub_sock.close()

@@ -1,5 +1,8 @@
 """The TCPROS side of the admission policy: a node's inbound handshakes and the frames a
-service server reads (minros.node, minros.wire.sockets), over loopback sockets."""
+service server reads (minros.node, minros.wire.sockets), over loopback sockets. The node has one
+inbound server: every handshake test runs over its TCP port and over its abstract Unix socket
+(shared memory's), which take the same rules; a subscriber refused there falls back to TCPROS
+at once."""
 
 from __future__ import annotations
 
@@ -13,6 +16,7 @@ import pytest
 from minros.exceptions import TransportTerminated
 from minros.master import Master
 from minros.node import Node
+from minros.transport import shm
 from minros.wire import sockets, tcpros
 from minros.wire.admission import Admission, Connection, Limits, Refused
 
@@ -60,25 +64,56 @@ def master():
     m.stop()
 
 
-def tcpros_node(master: Master, limits: Limits) -> tuple:
+#: the node's listening sockets: its TCP port, and its abstract Unix socket (shared memory)
+LISTENERS = ["tcp", pytest.param("unix", marks=pytest.mark.skipif(
+    not shm.supported(), reason="no shared memory on this system"))]
+
+
+class Address:
+    """Where a test connects: the node's TCP port or its Unix socket's abstract name."""
+
+    def __init__(self, node: Node, kind: str) -> None:
+        self.kind = kind
+        self.node = node
+        if kind == "tcp":
+            self.address: object = ("127.0.0.1", node.tcpros_address()[1])
+        else:
+            self.address = "\0" + node.connections.shm_address()
+
+    def connect(self, timeout: float = 5.0) -> socket.socket:
+        if self.kind == "tcp":
+            return socket.create_connection(self.address, timeout=timeout)  # type: ignore[arg-type]
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.settimeout(timeout)
+        sock.connect(self.address)
+        return sock
+
+    @property
+    def admission(self) -> Admission:
+        listener = self.node.tcpros_server.listener("TCPROS" if self.kind == "tcp" else "MINROSSHM")
+        return listener.admission
+
+
+def tcpros_node(master: Master, limits: Limits, kind: str = "tcp") -> tuple:
     node = Node(argv=["prog", f"__master:={master.uri}", "__hostname:=127.0.0.1"])
     node.init("tcpros_probe", args_key=("tcpros_probe",))
     node.add_publication(FakePublication("/chatter"))
     node.connections.limits = limits
-    return node, node.tcpros_address()[1]
+    return node, Address(node, kind)
 
 
-def handshake(port: int, timeout: float = 2.0) -> dict:
-    with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
+def handshake(address: Address, timeout: float = 2.0) -> dict:
+    with address.connect(timeout) as s:
         s.sendall(tcpros.encode_header({"topic": "/chatter", "md5sum": MD5, "callerid": "/probe",
                                         "type": "std_msgs/String"}))
         return sockets.read_header(s)
 
 
-def test_a_trickled_connection_header_cannot_extend_its_deadline(master):
-    node, port = tcpros_node(master, Limits(head_timeout=0.5))
+@pytest.mark.parametrize("kind", LISTENERS)
+def test_a_trickled_connection_header_cannot_extend_its_deadline(master, kind):
+    node, port = tcpros_node(master, Limits(head_timeout=0.5), kind)
     try:
-        s = socket.create_connection(("127.0.0.1", port), timeout=5)
+        s = port.connect()
         start = time.monotonic()
         s.settimeout(0.1)
         closed = False
@@ -99,39 +134,103 @@ def test_a_trickled_connection_header_cannot_extend_its_deadline(master):
         node.signal_shutdown("test over")
 
 
-def test_an_announced_header_holds_nothing_and_blocks_nobody(master):
-    node, port = tcpros_node(master, Limits())
+@pytest.mark.parametrize("kind", LISTENERS)
+def test_an_announced_header_holds_nothing_and_blocks_nobody(master, kind):
+    node, port = tcpros_node(master, Limits(), kind)
     hostile = []
     try:
         for _ in range(20):
-            s = socket.create_connection(("127.0.0.1", port), timeout=5)
+            s = port.connect()
             s.sendall(struct.pack("<I", 1 << 20) + b"ab")  # a 1 MiB header announced
             hostile.append(s)
         for _ in range(5):
             assert handshake(port) == SERVED
-        assert node.tcpros_server.admission.held() <= 20 * 6
+        assert port.admission.held() <= 20 * 6
     finally:
         for s in hostile:
             s.close()
         node.signal_shutdown("test over")
 
 
-def test_a_full_tcpros_server_closes_its_slowest_handshakes(master):
-    node, port = tcpros_node(master, Limits(max_connections=10, peer_share=1.0))
+@pytest.mark.parametrize("kind", LISTENERS)
+def test_a_full_tcpros_server_closes_its_slowest_handshakes(master, kind):
+    node, port = tcpros_node(master, Limits(max_connections=10, peer_share=1.0), kind)
     tricklers = []
     try:
         for _ in range(15):
-            s = socket.create_connection(("127.0.0.1", port), timeout=5)
+            s = port.connect()
             s.sendall(b"\x10")
             tricklers.append(s)
         for _ in range(5):
             assert handshake(port) == SERVED
-        assert node.tcpros_server.admission.evictions >= 5
-        assert node.tcpros_server.admission.live() <= 10
+        assert port.admission.evictions >= 5
+        assert port.admission.live() <= 10
     finally:
         for s in tricklers:
             s.close()
         node.signal_shutdown("test over")
+
+
+@pytest.mark.parametrize("kind", LISTENERS)
+def test_silent_connections_keep_no_subscriber_off(master, kind):
+    """The probe of issue 38 (item 2): 64 connections that say nothing, on the node's TCP port
+    or its shared-memory socket, and a subscriber's handshake is still answered at once (the
+    old shared-memory server took 64 handshakes at a time and closed every later one: nothing
+    got through for 15 s); with a cap of 32 the silent ones are evicted from the peer holding
+    most, the oldest first."""
+    node, port = tcpros_node(master, Limits(max_connections=32), kind)
+    silent = [port.connect() for _ in range(64)]
+    try:
+        start = time.monotonic()
+        for _ in range(5):
+            assert handshake(port, timeout=5.0) == SERVED
+        assert time.monotonic() - start < 5.0
+        assert port.admission.evictions >= 32 and port.admission.live() <= 32
+    finally:
+        for s in silent:
+            s.close()
+        node.signal_shutdown("test over")
+
+
+@pytest.mark.skipif(not shm.supported(), reason="no shared memory on this system")
+def test_a_subscriber_refused_on_the_shared_memory_socket_falls_back_to_tcpros_at_once(
+        master, monkeypatch):
+    """A refusal by the Unix socket's admission is a FallBack: the subscriber asks again with
+    TCPROS at once (a retry would wait RETRY_FIRST, made far longer than the test's wait)."""
+    from minros.client import subscription
+    from minros.client.publication import Publication
+    from minros.client.subscription import Subscription
+    from std_msgs.msg import String
+
+    monkeypatch.setattr(subscription, "RETRY_FIRST", 60.0)
+    pub_node = Node(argv=["prog", f"__master:={master.uri}", "__hostname:=127.0.0.1"])
+    pub_node.init("refusing_talker", args_key=("refusing_talker",))
+    sub_node = Node(argv=["prog", f"__master:={master.uri}", "__hostname:=127.0.0.1"])
+    sub_node.init("refused_listener", args_key=("refused_listener",))
+    try:
+        pub = Publication(pub_node, "/chatter", "/chatter", String)
+        pub.queue_size = 10
+        pub_node.add_publication(pub)
+        unix = Address(pub_node, "unix").admission
+
+        def refuse(*args, **kwargs):
+            raise Refused("the shared-memory socket is full: try again")
+
+        monkeypatch.setattr(unix, "admit", refuse)
+        got = threading.Event()
+        sub = Subscription(sub_node, "/chatter", "/chatter", String)
+        sub.add_callback(lambda msg: got.set(), None)
+        sub_node.add_subscription(sub)
+        deadline = time.monotonic() + 10.0
+        while not got.is_set() and time.monotonic() < deadline:
+            pub.publish(String("hello"))
+            got.wait(0.05)
+        assert got.is_set(), "the subscriber never got a message"
+        assert [c.protocol for c in sub.connections] == ["TCPROS"]
+        assert [c.transport_type for c in pub.connections] == ["TCPROS"]
+    finally:
+        sub_node.signal_shutdown("test over")
+        pub_node.signal_shutdown("test over")
 
 
 # --------------------------------------------------------------------------- guarded frames
@@ -210,7 +309,7 @@ def test_closing_the_server_wakes_a_connection_blocked_in_recv():
     ended = threading.Event()
     got: list = []
 
-    def dispatch(stream, header, conn):
+    def dispatch(stream, header, conn, listener):
         stream.settimeout(None)
         waiting.set()
         got.append(stream.recv(10))  # what a persistent connection between requests does

@@ -252,4 +252,5 @@ def test_the_handler_refuses_answers_it_cannot_use():
     for answer in (["TCPROS", "h"], ["TCPROS", "h", "80"], ["TCPROS", 5, 80], ["TCPROS", "h", True]):
         with pytest.raises(ValueError, match="invalid protocol choice"):
             handler.connect(answer, "/t", 4096, reuse_big=False, tcp_nodelay=False)
-    assert handler.claims({"topic": "/t"}) and not handler.claims({"service": "/s"})
+    assert handler.claims({"topic": "/t"}, "TCPROS") and not handler.claims({"service": "/s"}, "TCPROS")
+    assert not handler.claims({"topic": "/t"}, "MINROSSHM")  # the Unix socket's is shared memory's

@@ -13,6 +13,7 @@ import time
 import pytest
 
 from minros.msgs import get_message_class
+from minros.transport.tcpros_pubsub import TCPROSHandler
 from minros.web.receiver import Receiver
 from minros.web.state import raw_class
 from minros.wire import sockets, tcpros
@@ -30,6 +31,8 @@ class FakeNode:
 
     def __init__(self) -> None:
         self.subscriptions: dict = {}
+        #: the protocols it speaks: TCPROS (the fake publishers speak nothing else)
+        self.protocols = [TCPROSHandler(lambda: ("127.0.0.1", 1))]
 
     def resolve_topic_name(self, name: str) -> str:
         return name

@@ -433,8 +433,9 @@ class Recorder:
     def _node_subscriptions(self) -> List[str]:
         import minros
         from minros import names
-        from minros.tools.master import Master, MasterException, call_node
-        from minros.wire.rosapi import RemoteError, unwrap
+        from minros.tools.master import Master, MasterException
+        from minros.wire.rosapi import RemoteError
+        from minros.wire.slaveapi import SlaveClient
 
         node = names.script_resolve_name("rosbag", self.opts.node or "")
         master = Master(minros.get_caller_id())
@@ -445,7 +446,8 @@ class Recorder:
         finally:
             master.close()
         try:
-            subs = unwrap(call_node(uri, "getSubscriptions", minros.get_caller_id()))
+            with SlaveClient(uri, minros.get_caller_id(), 5.0) as client:
+                subs = client.get_subscriptions()
         except RemoteError:
             return []
         return [t for t, _type in subs]

@@ -17,8 +17,9 @@ from urllib.parse import urlparse
 
 from minros import names
 from minros.tools.common import ToolError, dispatch, option_parser, resolve, run_tool
-from minros.tools.master import Master, MasterException, call_node
+from minros.tools.master import TOOL_TIMEOUT, Master, MasterException
 from minros.wire import rosapi
+from minros.wire.slaveapi import SlaveClient
 
 NAME = "rosnode"
 ID = "/rosnode"
@@ -63,12 +64,9 @@ def get_node_names(master: Master, namespace: str | None = None) -> List[str]:
     return sorted(set(nodes))
 
 
-def _remote(triplet: list) -> object:
-    """The value of a node's answer (rosapi.unwrap, the one place a code is read), or ToolError."""
-    try:
-        return rosapi.unwrap(triplet)
-    except rosapi.RemoteError as exc:
-        raise ToolError(f"remote call failed: {str(exc)[:200]}") from None
+def _remote_error(exc: rosapi.RemoteError) -> ToolError:
+    """A node's non-SUCCESS answer (or a malformed one) as the tool's one line."""
+    return ToolError(f"remote call failed: {str(exc)[:200]}")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -143,13 +141,14 @@ def _lookup_uri(graph: _Graph, state: tuple, topic: str, uri: str) -> str:
 def connection_description(graph: _Graph, node_uri: str) -> str:
     state = graph.master.system_state()
     try:
-        pid = _remote(call_node(node_uri, "getPid", ID))
-        out = f"Pid: {pid}\n"
-        businfo = _remote(call_node(node_uri, "getBusInfo", ID))
+        with SlaveClient(node_uri, ID, TOOL_TIMEOUT) as client:
+            pid = client.get_pid()
+            out = f"Pid: {pid}\n"
+            businfo = client.get_bus_info()
     except OSError:
         raise ToolError(f"Communication with node[{node_uri}] failed!") from None
-    if not isinstance(businfo, list) or not all(isinstance(i, list) and len(i) >= 5 for i in businfo):
-        raise ToolError(f"remote call failed: malformed getBusInfo reply from [{node_uri}]")
+    except rosapi.RemoteError as exc:
+        raise _remote_error(exc) from None
     if businfo:
         out += "Connections:\n"
         for info in businfo:
@@ -211,7 +210,10 @@ def ping(graph: _Graph, node: str, max_count: int | None = None, verbose: bool =
         while True:
             start = time.time()
             try:
-                _remote(call_node(uri, "getPid", ID, timeout=PING_TIMEOUT))
+                with SlaveClient(uri, ID, PING_TIMEOUT) as client:
+                    client.get_pid()
+            except rosapi.RemoteError as exc:
+                raise _remote_error(exc) from None
             except socket.timeout:
                 sys.stdout.flush()
                 print(f"connection to [{node}] timed out", file=sys.stderr)
@@ -317,8 +319,9 @@ def kill_nodes(graph: _Graph, nodes: List[str]) -> Tuple[List[str], List[str]]:
             fail.append(node)
     for node, uri in calls:
         try:
-            call_node(uri, "shutdown", ID, "user request")
-        except OSError:
+            with SlaveClient(uri, ID, TOOL_TIMEOUT) as client:
+                client.shutdown("user request")
+        except (OSError, rosapi.RemoteError):
             pass
         success.append(node)
     return success, fail

@@ -1,6 +1,6 @@
 """``minros trace``: watch the ROS wire. Record a trace, show it, turn it into a pcap.
 
-    minros trace [-o FILE] [--messages] -- COMMAND [ARGS...]   run COMMAND traced
+    minros trace [-o FILE] [--messages] [--shm] -- COMMAND [ARGS...]   run COMMAND traced
     minros trace show [--follow] [--topic T] [--service S] FILE...
     minros trace pcap FILE... -o OUT.pcap
     minros trace dissector [-o minros.lua] [--type TYPE] [FILE...]
@@ -8,6 +8,8 @@
 The first form runs COMMAND with ``MINROS_TRACE=FILE`` in its environment, so it and every
 minros process it starts (a launch file's nodes, a core's rosout) append their events to FILE
 (see :mod:`minros.wire.trace` for what is recorded, ``docs/internals.md`` for the format).
+A traced process keeps to TCPROS, so that two minros nodes show the wire the course teaches
+(they would take shared memory otherwise); ``--shm`` lets them (``MINROS_TRACE_SHM=1``).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import sys
 import time
 from typing import Any, List, Optional
 
-USAGE = """usage: minros trace [-o FILE] [--messages] [--frames N] [--bytes N] [--] COMMAND [ARGS...]
+USAGE = """usage: minros trace [-o FILE] [--messages] [--frames N] [--bytes N] [--shm] [--] COMMAND [ARGS...]
        minros trace show [--follow] [--topic T] [--service S] [--node N] [--frames N|all] [--all] FILE...
        minros trace pcap FILE... [-o OUT.pcap]
        minros trace dissector [-o minros.lua] [--type TYPE]... [FILE...]
@@ -60,11 +62,16 @@ def _record_parser(prog: str) -> argparse.ArgumentParser:
                         help="frames kept per connection and direction (default 1000; 'all')")
     parser.add_argument("--bytes", metavar="N", type=int,
                         help="bytes of each frame kept (default 64)")
+    parser.add_argument("--shm", action="store_true",
+                        help="let minros nodes of this host use shared memory (MINROSSHM) "
+                             "between them; without it a traced process keeps to TCPROS, the "
+                             "wire courses teach")
     parser.add_argument("command", nargs=argparse.REMAINDER, help="the program to run, traced")
     return parser
 
 
 def _record(argv: List[str], prog: str) -> int:
+    from minros.transport import shm
     from minros.wire import trace
 
     if not argv:
@@ -103,6 +110,10 @@ def _record(argv: List[str], prog: str) -> int:
             env[trace.ENV_FRAMES] = args.frames
         if args.bytes is not None:
             env[trace.ENV_BYTES] = str(max(0, args.bytes))
+        if args.shm:
+            env[shm.TRACE_ENV] = "1"
+        else:
+            env.pop(shm.TRACE_ENV, None)
         print(f"{prog}: tracing into {path}; read it with: minros trace show {path}",
               file=sys.stderr)
     return _exec(command, env, prog)

@@ -26,8 +26,9 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 from urllib.parse import urlparse
 
 from minros import packages, rosenv
-from minros.tools.master import Master, MasterException, call_node
-from minros.wire.rosapi import RemoteError, unwrap
+from minros.tools.master import Master, MasterException
+from minros.wire.rosapi import RemoteError
+from minros.wire.slaveapi import SlaveClient
 
 # ---------------------------------------------------------------------------------------------
 # the model (roswtf.model, roswtf.context, roswtf.rules)
@@ -366,9 +367,12 @@ def ping_check(ctx: WtfContext) -> Optional[List[str]]:
     dead = []
     for node in sorted(ctx.nodes):
         try:
-            call_node(uris[node], "getPid", "/roswtf", timeout=NODE_TIMEOUT)
+            with SlaveClient(uris[node], "/roswtf", NODE_TIMEOUT) as client:
+                client.get_pid()
         except (KeyError, OSError):
             dead.append(node)
+        except RemoteError:  # it answered: alive
+            pass
     return dead
 
 
@@ -467,11 +471,10 @@ def _compute_online_context(ctx: WtfContext) -> None:
             return
         t0 = time.time()
         try:
-            answer = call_node(uri, "getBusInfo", "/roswtf", timeout=NODE_TIMEOUT)
+            with SlaveClient(uri, "/roswtf", NODE_TIMEOUT) as client:
+                bus_info, refused = client.get_bus_info(), False
         except OSError:
             return  # ping_check reports it
-        try:
-            bus_info, refused = unwrap(answer), False
         except RemoteError:
             bus_info, refused = None, True
         with lock:

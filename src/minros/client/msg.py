@@ -1,9 +1,10 @@
 """Messages as the client library sends them: rospy's AnyMsg, its publish-argument rules, the
-Header it stamps, and serialization into one length-prefixed frame.
+Header it stamps, and serialization into one length-prefixed frame, for topics and services.
 
 A frame is serialized once per publish and handed to every connection: ``bytes`` for a small
 message (one join), or a tuple of buffers (length prefix first) that a transport sends with
-``sendmsg`` without joining them, so a big array goes out without a copy.
+``sendmsg`` without joining them, so a big array goes out without a copy. A service request is
+the same frame, and a response the same after its ok byte (:func:`serialize_frame`).
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 import struct
 from typing import Any, List
 
-from minros.exceptions import ROSException, ROSSerializationException, SerializationError
+from minros.exceptions import ROSException, ROSSerializationException
 from minros.msgs.message import SERIALIZE_ERRORS
 from minros.names import ANYTYPE
 
@@ -79,21 +80,66 @@ def args_kwds_to_message(data_class: Any, args: tuple, kwds: dict) -> Any:
     return data_class(*args)
 
 
-class _Chunks:
-    """A write-only buffer that keeps the parts a message writes (no concatenation)."""
+class _Parts:
+    """A write-only sink for ``Message.serialize`` that keeps what is written without joining
+    it: big pieces (array and string fields) as they are, runs of small ones joined as they
+    come, so a message of many small fields does not hold thousands of objects. With
+    ``snapshot`` a mutable big piece is copied (a topic's frame may wait in a queue after
+    publish returns); without, it is kept as a byte view (a service's is sent at once)."""
 
-    __slots__ = ("parts", "size")
+    __slots__ = ("_parts", "_small", "_small_size", "size", "snapshot")
 
-    def __init__(self) -> None:
-        self.parts: list = []
+    def __init__(self, snapshot: bool = True) -> None:
+        self._parts: list = []
+        self._small: list = []
+        self._small_size = 0
         self.size = 0
+        self.snapshot = snapshot
 
-    def write(self, data: Any) -> int:
-        if type(data) is not bytes:
-            data = bytes(data)  # mutable buffers are snapshotted: the frame may wait in a queue
-        self.parts.append(data)
-        self.size += len(data)
-        return len(data)
+    def write(self, data: Any) -> None:
+        if data.__class__ is not bytes:
+            data = _piece(data, self.snapshot)
+        size = len(data)
+        self.size += size
+        if size < _SMALL_PART:
+            self._small.append(data)
+            self._small_size += size
+            if self._small_size >= _JOIN_LIMIT:
+                self._flush()
+            return
+        self._flush()
+        self._parts.append(data)
+
+    def _flush(self) -> None:
+        if self._small:
+            self._parts.append(b"".join(self._small))
+            self._small = []
+            self._small_size = 0
+
+    def frame(self, head: bytes) -> Any:
+        """``head``, the length prefix and everything written: bytes when small, else a tuple
+        of buffers (the prefix first, joined with a small first piece)."""
+        self._flush()
+        prefix = head + _U32.pack(self.size)
+        parts = self._parts
+        if self.size <= _JOIN_LIMIT:
+            return b"".join([prefix, *parts])
+        if parts[0].__class__ is bytes and len(parts[0]) < _SMALL_PART:
+            parts[0] = prefix + parts[0]
+        else:
+            parts.insert(0, prefix)
+        return tuple(parts)
+
+
+def _piece(data: Any, snapshot: bool) -> Any:
+    """A written buffer as a frame may hold it: a copy (``snapshot``), or a byte-wise view, so
+    that a partial send can slice it (``cast`` needs C order: anything else is copied)."""
+    if snapshot:
+        return bytes(data)
+    view = memoryview(data)
+    if view.format != "B" or view.ndim != 1:
+        view = view.cast("B") if view.c_contiguous else memoryview(view.tobytes())
+    return view
 
 
 class _Discard:
@@ -104,23 +150,23 @@ class _Discard:
         pass
 
 
-def serialize_frame(msg: Any) -> Any:
-    """Serialize ``msg`` into one frame: ``bytes`` for small messages, else a tuple of buffers
-    (length prefix first) that ``sendmsg`` writes without joining them."""
+def serialize_frame(msg: Any, head: bytes = b"", snapshot: bool = True) -> Any:
+    """``msg`` serialized into one frame: ``head`` (a service response's ok byte), the length
+    prefix and the body; ``bytes`` for small messages, else a tuple of buffers (the prefix at
+    the start of the first) that ``sendmsg`` writes without joining them. ``snapshot``: big
+    mutable pieces are copied (see :class:`_Parts`; a topic's frame may wait in a queue).
+    rospy's ROSSerializationException, naming the field, when one cannot be serialized."""
     parts_of = getattr(msg, "_serialize_parts", None)
-    if parts_of is None:  # not a minros message class (AnyMsg)
-        parts = _parts_written_by(msg)
-    else:
-        parts = []
+    if parts_of is not None:
+        parts: list = []
         try:
             parts_of(parts.append)
         except NotImplementedError:
             # a hand-written genpy-style class: it subclasses Message but only its
             # serialize() is real (the base _serialize_parts is a stub)
-            parts = _parts_written_by(msg)
-        except SERIALIZE_ERRORS:
-            _raise_field_error(msg)
-            raise
+            parts_of = None
+        except SERIALIZE_ERRORS as exc:
+            _raise_field_error(msg, exc)
         else:
             if not msg._zero_copy:
                 # no array fields that could be views of big buffers (strings, numbers, nested
@@ -128,16 +174,42 @@ def serialize_frame(msg: Any) -> Any:
                 body = b"".join(parts)
                 size = len(body)
                 if size <= _JOIN_LIMIT:
-                    return _U32.pack(size) + body
-                return (_U32.pack(size), body)
+                    return (head + _U32.pack(size) + body) if head else _U32.pack(size) + body
+                return (head + _U32.pack(size), body)
+            return _frame(parts, head, snapshot)
+    writer = _Parts(snapshot)
+    try:
+        msg.serialize(writer)
+    except ROSSerializationException as exc:
+        if exc.__class__ is ROSSerializationException:
+            raise
+        raise ROSSerializationException(str(exc)) from None
+    except SERIALIZE_ERRORS as exc:
+        raise ROSSerializationException(str(exc)) from None
+    return writer.frame(head)
+
+
+def _raise_field_error(msg: Any, exc: BaseException) -> None:
+    """Serialize ``msg`` again through serialize(), whose error names the bad field, and raise
+    that as ROSSerializationException."""
+    try:
+        msg.serialize(_Discard)
+    except SERIALIZE_ERRORS as named:
+        raise ROSSerializationException(str(named)) from None
+    raise ROSSerializationException(str(exc)) from None
+
+
+def _frame(parts: list, head: bytes, snapshot: bool) -> Any:
+    """The frame of a generated class's serialized ``parts``."""
     size = 0
     for part in parts:
         size += len(part) if part.__class__ is bytes else memoryview(part).nbytes
+    prefix = head + _U32.pack(size)
     if size <= _JOIN_LIMIT:
-        parts.insert(0, _U32.pack(size))
+        parts.insert(0, prefix)
         return b"".join(parts)
-    out = [_U32.pack(size)]
-    small: list = []
+    out: list = []
+    small: list = [prefix]
     for part in parts:  # coalesce the many small field writes around the big ones
         n = len(part) if part.__class__ is bytes else memoryview(part).nbytes
         if n < _SMALL_PART:
@@ -146,35 +218,10 @@ def serialize_frame(msg: Any) -> Any:
         if small:
             out.append(b"".join(small))
             small = []
-        # mutable buffers are snapshotted: the frame may wait in a queue after publish returns
-        out.append(part if part.__class__ is bytes else bytes(part))
+        out.append(part if part.__class__ is bytes else _piece(part, snapshot))
     if small:
         out.append(b"".join(small))
     return tuple(out)
-
-
-def _parts_written_by(msg: Any) -> list:
-    """What ``msg.serialize(buff)`` writes, as a list of ``bytes`` (copies: a frame may wait in
-    a queue after publish returns)."""
-    chunks = _Chunks()
-    try:
-        msg.serialize(chunks)
-    except ROSSerializationException:
-        raise
-    except SERIALIZE_ERRORS as exc:
-        raise ROSSerializationException(str(exc)) from None
-    return chunks.parts
-
-
-def _raise_field_error(msg: Any) -> None:
-    """Serialize ``msg`` again through serialize(), whose error names the bad field, and raise
-    that as ROSSerializationException."""
-    try:
-        msg.serialize(_Discard)
-    except SerializationError as exc:
-        raise ROSSerializationException(str(exc)) from None
-    except SERIALIZE_ERRORS as exc:
-        raise ROSSerializationException(str(exc)) from None
 
 
 def frame_len(frame: Any) -> int:

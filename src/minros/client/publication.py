@@ -7,8 +7,10 @@ added by the protocol handler that accepted the subscriber. A publication made w
 ``intraprocess=True`` hands subscribers of this process the message object itself, through
 the connections that take objects (``takes_objects``: the intra-process links); the others
 get the frame, serialized only when one of them is there. ``loan(nbytes)`` lends the memory of
-a message's large array from a shared-memory connection's slot, so that publishing it copies
-nothing (the other connections get the frame as usual). The publication keeps what ROS
+a message's large array from a connection that can send it in place (``lend``: a shared-memory
+slot), so that publishing it copies nothing (the other connections get the frame as usual).
+What each connection can do is declared by the transport seam (``minros.transport.base``), so
+``publish`` is one loop over the connections, whatever their protocols. The publication keeps what ROS
 keeps per topic: the latched message (sent first to every new subscriber), the sequence number,
 the SubscribeListeners, the user's extra header fields.
 
@@ -50,12 +52,10 @@ class Publication:
         self.type: str = data_class._type
         self.md5sum: str = data_class._md5sum
         self.connections: List[Transport] = []
-        #: the connections that take message objects (intra-process links), also in connections
-        self.takers: List[Any] = []
         #: subscribers of this process get the published objects themselves (shared)
         self.intraprocess = False
-        #: the loan not published yet: (the connection that lent it, its Loan)
-        self._loan: Tuple[Any, Any] | None = None
+        #: the loan not published yet: (the connection that lent it, its loan)
+        self._loan: Tuple[Transport, Any] | None = None
         self.lock = threading.RLock()
         self.listeners: List[Any] = []
         self.headers: Dict[str, str] = {}
@@ -91,9 +91,6 @@ class Publication:
                 transport.close()
                 return False
             self.connections = self.connections + [transport]
-            takes_objects = getattr(transport, "takes_objects", False)
-            if takes_objects:
-                self.takers = self.takers + [transport]
             if self.is_latch and self.latch is not None:
                 self._send_one(transport, self.latch)
         for listener in list(self.listeners):
@@ -113,7 +110,6 @@ class Publication:
             if transport not in self.connections:
                 return
             self.connections = [c for c in self.connections if c is not transport]
-            self.takers = [c for c in self.takers if c is not transport]
             remaining = len(self.connections)
         for listener in list(self.listeners):
             try:
@@ -126,22 +122,16 @@ class Publication:
 
     # -- publishing --------------------------------------------------------------------------
 
-    def _send_one(self, conn: Any, msg: Any) -> None:
+    def _send_one(self, conn: Transport, msg: Any) -> None:
         """Called with the lock held: ``msg`` to one connection."""
-        if getattr(conn, "takes_objects", False):
-            self.seq += 1
-            stamp_header(msg, self.seq)
-            conn.put(msg)
-        else:
-            conn.send(self._serialize(msg))
-
-    def _serialize(self, msg: Any) -> Any:
-        """Called with the lock held: Header.seq auto-fill, then one serialization."""
         self.seq += 1
         stamp_header(msg, self.seq)
+        if conn.takes_objects:
+            conn.put(msg)
+            return
         frame = serialize_frame(msg)
         self.message_data_sent += frame_len(frame) - 4
-        return frame
+        conn.send(frame)
 
     def publish(self, msg: Any, connection_override: Transport | None = None) -> None:
         """Send ``msg`` to every connection, or to ``connection_override`` only (rospy's way
@@ -154,35 +144,34 @@ class Publication:
             if self.is_latch:
                 self.latch = msg
             conns = self.connections if connection_override is None else [connection_override]
+            loan = self._loan
             if not conns:
                 self._give_back()
                 return
-            # Header auto-fill, then one serialization for every connection
+            # Header auto-fill, then one serialization for every connection that takes frames
             self.seq += 1
-            if getattr(msg, "_has_header", False):
+            try:
+                has_header = msg._has_header
+            except AttributeError:  # not a message class of ours (rospy code's own)
+                has_header = False
+            if has_header:
                 stamp_header(msg, self.seq)
-            takers = self.takers
-            if connection_override is not None:
-                takers = [t for t in takers if t is connection_override]
-            if takers:  # intra-process links: the object itself
-                for taker in takers:
-                    taker.put(msg)
-                if len(takers) == len(conns):
-                    return
-                conns = [c for c in conns if c not in takers]
-            lender = None
-            loan = self._loan
-            if loan is not None and any(c is loan[0] for c in conns):
-                # a loaned array: its connection copies nothing
-                lender = self._publish_loaned(msg)
-                if lender is not None:
-                    conns = [c for c in conns if c is not lender]
-                    if not conns:
-                        return
-            frame = serialize_frame(msg)
-            if lender is None:  # else counted once already
-                self.message_data_sent += (len(frame) if frame.__class__ is bytes else frame_len(frame)) - 4
+            frame = None
             for conn in conns:
+                if conn.takes_objects:  # an intra-process link: the object itself
+                    conn.put(msg)
+                    continue
+                if loan is not None and conn is loan[0]:
+                    self._loan = None
+                    size = self._send_loaned(conn, loan[1], msg)
+                    loan = None
+                    if size:  # the array's own slot: nothing copied
+                        self.message_data_sent += size
+                        continue
+                if frame is None:
+                    frame = serialize_frame(msg)
+                    self.message_data_sent += (len(frame) if frame.__class__ is bytes
+                                               else frame_len(frame)) - 4
                 conn.send(frame)
 
     # -- loans -------------------------------------------------------------------------------
@@ -198,8 +187,7 @@ class Publication:
             self._give_back()
             if not self.is_latch and not self.intraprocess and nbytes:
                 for conn in self.connections:
-                    lend = getattr(conn, "lend", None)
-                    loaned = lend(nbytes) if lend is not None else None
+                    loaned = conn.lend(nbytes)
                     if loaned is not None:
                         self._loan = (conn, loaned)
                         return loaned.view
@@ -211,18 +199,18 @@ class Publication:
         if loan is not None:
             loan[0].give_back(loan[1])
 
-    def _publish_loaned(self, msg: Any) -> Any:
-        """Called with the lock held: send ``msg`` in place to the connection that lent its
-        array, if it holds the loan; that connection, or None."""
-        conn, loaned = self._loan  # type: ignore[misc]
-        self._loan = None
+    @staticmethod
+    def _send_loaned(conn: Transport, loaned: Any, msg: Any) -> int:
+        """Called with the lock held: send ``msg`` in place to ``conn``, which lent its array
+        (``loaned``); the bytes sent, or 0 when it could not be (the loan went back: the
+        message is sent as any other)."""
         view = loaned.view
         parts: List[Any] = []
         try:
             msg._serialize_parts(parts.append)
-        except Exception:  # noqa: BLE001 - serialize_frame says what is wrong, below
+        except Exception:  # noqa: BLE001 - serialize_frame says what is wrong, after this
             conn.give_back(loaned)
-            return None
+            return 0
         address = _address(view)
         for i, part in enumerate(parts):
             if part.__class__ is memoryview and part.nbytes == view.nbytes and \
@@ -230,12 +218,9 @@ class Publication:
                 head = b"".join(parts[:i])
                 tail = b"".join(parts[i + 1:])
                 size = len(head) + view.nbytes + len(tail)
-                if conn.send_loaned(loaned, _U32.pack(size) + head, tail):
-                    self.message_data_sent += size
-                    return conn
-                return None
+                return size if conn.send_loaned(loaned, _U32.pack(size) + head, tail) else 0
         conn.give_back(loaned)  # the message does not hold it
-        return None
+        return 0
 
     # -- bookkeeping -------------------------------------------------------------------------
 

@@ -15,8 +15,10 @@ Client side: ``ServiceProxy`` looks the service up on the master for every call 
 persistent), connects, exchanges headers, sends one request and reads one response. It works
 without ``init_node`` (caller id ``/unnamed``). All error texts are rospy's.
 
-The header codec, framing and response encoding are the pure functions of ``minros.wire.tcpros``;
-this module only moves their bytes through sockets.
+Both ends are transports of the seam, as a topic's are (``minros.transport.tcpros_service``:
+the stream, the header exchange, bounded sends, frames read under admission); requests and
+responses are serialized as topic frames are (``client.msg.serialize_frame``). This module holds what
+a service is: the handler's rules, the proxy's, and rospy's error texts.
 """
 
 from __future__ import annotations
@@ -24,7 +26,6 @@ from __future__ import annotations
 import itertools
 import logging
 import socket
-import struct
 import sys
 import threading
 import time
@@ -36,18 +37,21 @@ from typing import Any, Callable, Dict
 
 from minros import names, node
 from minros.client.log import logerr, loginfo, logwarn, logwarn_throttle
-from minros.client.msg import stamp_header
+from minros.client.msg import serialize_frame, stamp_header
 from minros.exceptions import (
     ROSException,
     ROSInterruptException,
+    ROSSerializationException,
+    SerializationError,
     ServiceException,
     TransportException,
     TransportInitError,
     TransportTerminated,
 )
 from minros.msgs import reader_for
-from minros.transport.tcpros_base import connect, negotiate
-from minros.wire import admission, sockets, tcpros
+from minros.transport import tcpros_service
+from minros.transport.tcpros_service import ServiceClientEnd, ServiceServerEnd, connect_service
+from minros.wire import admission, tcpros
 from minros.wire.handshake import Handshake, Role, State
 from minros.wire.masterapi import MasterError, RemoteError
 from minros.wire.rosapi import ROSRPC, ParameterInvalid, parse_rosrpc_uri
@@ -67,36 +71,15 @@ WAIT_FOR_SERVICE_INTERVAL = 0.3
 CONNECT_TIMEOUT = 10.0
 #: rospy's text when the peer closes the connection before a whole message arrived
 _PEER_GONE = "unable to receive data from sender, check sender's logs for details"
-#: a send waiting for a peer that reads nothing wakes up this often to notice node shutdown
-#: (a wait for a request or a response blocks in recv: shutdown wakes it by closing the socket)
-_POLL = 1.0
-#: a send gives up on a peer that took no byte for this long (the bound topics.SYNC_SEND_TIMEOUT
-#: puts on synchronous publishing). rospy's sendall waits forever; as long as the peer keeps
-#: taking bytes, however slowly, a send goes on.
-SEND_STALL_TIMEOUT = 60.0
-#: frames up to this size are joined into one bytes object (one send call); larger ones keep
-#: their big pieces and go out as scatter-gather, never copied into one buffer
-_JOIN_LIMIT = 65536
-#: serialized pieces smaller than this are joined with their neighbours (fewer buffers)
-_SMALL_PART = 4096
+#: a send gives up on a peer that took no byte for this long (the transport's)
+SEND_STALL_TIMEOUT = tcpros_service.SEND_STALL_TIMEOUT
 #: a request's own buffer starts this small and doubles as its bytes arrive (a lying length
 #: costs nothing: a server must not allocate what a client only announces)
 _FIRST_CHUNK = 64 << 10
 #: the ok byte that starts a successful service response
 _OK = b"\x01"
-_REQUEST_PREFIX = struct.Struct("<I").pack
-_OK_PREFIX = struct.Struct("<BI").pack
 
 _logger = logging.getLogger("rospy.service")
-
-
-# --------------------------------------------------------------------------- sending
-
-def _send_all(sock: socket.socket, data: Any) -> None:
-    """Send ``data`` completely; give up at node shutdown or on a peer stalled for
-    SEND_STALL_TIMEOUT seconds (TransportTerminated)."""
-    sockets.send_all(sock, data, stall_timeout=SEND_STALL_TIMEOUT, stop=node.is_shutdown,
-                     pace=_POLL)
 
 
 # --------------------------------------------------------------------------- server
@@ -194,41 +177,37 @@ class Service:
     def _handle_connection(self, sock: socket.socket, header: Dict[str, str],
                            conn: admission.Connection) -> None:
         """Serve one inbound connection (called in the node's connection thread)."""
+        end = ServiceServerEnd(sock, self.resolved_name, conn, max(self.buff_size, 16),
+                               _FIRST_CHUNK, stop=node.is_shutdown)
         try:
-            self._serve(sock, header, conn)
+            self._serve(end, header, conn)
         except (TransportException, admission.Refused) as exc:
             _logger.debug("service [%s]: connection ended: %s", self.resolved_name, exc)
         finally:
-            sockets.close(sock)
+            end.close()
 
-    def _serve(self, sock: socket.socket, header: Dict[str, str], conn: admission.Connection) -> None:
+    def _serve(self, end: ServiceServerEnd, header: Dict[str, str],
+               conn: admission.Connection) -> None:
         """The exchange, under the TCPROS server's admission policy: a request must arrive by
         a deadline fixed from its length once it starts (a one-shot client must send it
         within the header timeout), its bytes count against the node's budget, and a
         persistent connection waiting for its next request may be closed to make room."""
-        # A blocking socket: the wait for a request is one recv, as is the request itself; a
-        # deadline sets a timeout while it applies (FrameSource), a send waits only when the
-        # client reads nothing (_send_all), and node shutdown or an eviction wakes a thread
-        # blocked here by shutting the socket down (the TCPROS server's close() and evict()).
-        sock.settimeout(None)
         refuse = None
         if self.done:
             refuse = f"[{node.get_caller_id()}] is not a provider of  [{self.resolved_name}]"
         handshake = Handshake(Role.SERVICE_SERVER, self._header_fields(), refuse=refuse)
-        _send_all(sock, handshake.opening_received(header))
+        end.negotiate(handshake, header)
         if handshake.state is State.REJECTED:
             logwarn(f"Could not process inbound connection: {handshake.error}{header}")
             return
         if handshake.state is State.CLOSED:  # a probe: wait_for_service checking we are alive
             return
-        persistent = handshake.persistent
-        reader = tcpros.FrameReader(buff_size=max(self.buff_size, 16), first_chunk=_FIRST_CHUNK)
-        source = sockets.FrameSource(sock, reader, stop=node.is_shutdown, guard=conn)
+        persistent = end.persistent
         read_request = self._read_request
         conn.release(idle=True)
         while not self.done:
             wait_until = None if persistent else time.monotonic() + conn.limits.head_timeout
-            frame = source.next(wait_until)  # charged, and busy once whole
+            frame = end.next_request(wait_until)  # charged, and busy once whole
             if frame is None:
                 if not persistent:
                     logerr(f"incoming connection failed: {_PEER_GONE}")
@@ -247,7 +226,7 @@ class Service:
             else:
                 del frame
             try:
-                _send_all(sock, self._respond(request))
+                end.send_all(self._respond(request))
             except TransportTerminated as exc:
                 if not node.is_shutdown():
                     # the client left (or stalled) mid-response: one line, then the next one
@@ -261,7 +240,7 @@ class Service:
             conn.release(idle=True)
 
     def _respond(self, request: Any) -> Any:
-        """What answers ``request`` (bytes or buffers for ``_send_all``): ok + response, or
+        """What answers ``request`` (bytes or buffers for the connection's send): ok + response, or
         not-ok + error text."""
         try:
             response = self.handler(request)
@@ -270,13 +249,8 @@ class Service:
             seq = next(self._seqs)  # atomic: connections are served in threads of their own
             self.seq = seq
             stamp_header(response, seq)
-            frame = _small_frame(response, _OK_PREFIX)
-            if frame is not None:
-                return frame
-            buff = _Buffer()
-            response.serialize(buff)
-            # ok byte + length, then the response as written (not copied into one buffer)
-            return buff.frame(_OK + tcpros.frame_prefix(buff.size))
+            # ok byte + length, then the response as serialized (big fields not copied)
+            return serialize_frame(response, _OK, snapshot=False)
         except ServiceException as exc:
             return tcpros.encode_service_error(f"service cannot process request: {exc}")
         except Exception as exc:
@@ -286,80 +260,6 @@ class Service:
             except Exception:  # a broken error handler must not kill the connection
                 _logger.exception("service [%s]: error handler failed", self.resolved_name)
             return tcpros.encode_service_error(f"error processing request: {exc}")
-
-
-def _small_frame(msg: Any, prefix: Callable[..., bytes]) -> Any:
-    """The frame of a message without array fields (strings and numbers: the usual request
-    and response), serialized through its generated code in one piece: ``bytes``, or for a
-    big one its prefix and body. None for any other message, and on a bad field value (the
-    general path, ``serialize()``, names the field)."""
-    if getattr(msg, "_zero_copy", True):
-        return None
-    parts: list = []
-    try:
-        msg._serialize_parts(parts.append)
-    except Exception:  # noqa: BLE001 - serialize() raises it again, with the field's name
-        return None
-    body = b"".join(parts)
-    size = len(body)
-    head = prefix(1, size) if prefix is _OK_PREFIX else prefix(size)
-    if size <= _JOIN_LIMIT:
-        return head + body
-    return [head, body]
-
-
-class _Buffer:
-    """Write-only sink for ``Message.serialize`` that keeps what is written without joining it.
-
-    Big pieces (array and string fields) are kept as they are, without a copy; runs of small
-    ones are joined as they come, so a message of many small fields does not hold thousands
-    of objects. The frame is sent right after serialization, in the same thread, so pieces of
-    mutable buffers need no snapshot.
-    """
-
-    __slots__ = ("_parts", "_small", "_small_size", "size")
-
-    def __init__(self) -> None:
-        self._parts: list = []
-        self._small: list = []
-        self._small_size = 0
-        self.size = 0
-
-    def write(self, data: Any) -> None:
-        if data.__class__ is not bytes:
-            view = memoryview(data)
-            if view.format != "B" or view.ndim != 1:
-                # byte-wise, so that a partial send can slice it (cast needs C order)
-                view = view.cast("B") if view.c_contiguous else memoryview(view.tobytes())
-            data = view
-        size = len(data)
-        self.size += size
-        if size < _SMALL_PART:
-            self._small.append(data)
-            self._small_size += size
-            if self._small_size >= _JOIN_LIMIT:
-                self._flush()
-            return
-        self._flush()
-        self._parts.append(data)
-
-    def _flush(self) -> None:
-        if self._small:
-            self._parts.append(b"".join(self._small))
-            self._small = []
-            self._small_size = 0
-
-    def frame(self, prefix: bytes) -> list:
-        """``prefix`` + everything written, as a list of buffers for ``_send_all``."""
-        self._flush()
-        parts = self._parts
-        if self.size <= _JOIN_LIMIT:
-            return [b"".join([prefix, *parts])]  # one small send
-        if parts[0].__class__ is bytes and len(parts[0]) < _SMALL_PART:
-            parts[0] = prefix + parts[0]
-        else:
-            parts.insert(0, prefix)
-        return parts
 
 
 # --------------------------------------------------------------------------- client
@@ -410,10 +310,10 @@ def _close_proxies(reason: str = "") -> None:
     with _proxies_lock:
         proxies = list(_open_proxies)
     for proxy in proxies:
-        sock = proxy._sock
-        if sock is not None:
+        end = proxy._end
+        if end is not None:
             try:
-                sock.shutdown(socket.SHUT_RDWR)
+                end.stream.shutdown(socket.SHUT_RDWR)
             except OSError:
                 pass
 
@@ -452,9 +352,7 @@ class ServiceProxy:
         self.uri: str | None = None
         self.seq = 0
         self.buff_size = DEFAULT_BUFF_SIZE
-        self._sock: socket.socket | None = None
-        self._source: sockets.FrameSource | None = None
-        self._server_header: Dict[str, str] = {}
+        self._end: ServiceClientEnd | None = None
         self._lock = threading.Lock()  # one call at a time on a persistent connection
 
     def wait_for_service(self, timeout: float | None = None) -> None:
@@ -469,34 +367,31 @@ class ServiceProxy:
         fields.update({str(k): str(v) for k, v in self.headers.items()})  # user headers win, as in rospy
         return fields
 
-    def _open(self) -> None:
+    def _open(self) -> ServiceClientEnd:
         """Look the service up, connect and exchange headers; ServiceException on failure."""
         uri = _lookup_service(self.resolved_name)
         self.uri = uri
         host, port = parse_rosrpc_uri(uri)
         try:
-            sock = connect(host, port, CONNECT_TIMEOUT, nodelay=True)
+            end = connect_service(host, port, self.resolved_name, CONNECT_TIMEOUT,
+                                  stop=node.is_shutdown, buff_size=self.buff_size)
         except OSError as exc:
             raise ServiceException(f"unable to connect to service: {exc}") from None
         try:
-            header = negotiate(sock, Handshake(Role.SERVICE_CLIENT, self._header_fields()),
-                               send=_send_all)
+            end.negotiate(Handshake(Role.SERVICE_CLIENT, self._header_fields()))
         except (TransportException, OSError) as exc:
-            sockets.close(sock)
+            end.close()
             raise ServiceException(f"unable to connect to service: {exc}") from None
         # blocking: a call is one send and one recv; node shutdown wakes a call waiting
         # for its response by shutting the socket down (_close_proxies)
-        sock.settimeout(None)
-        self._sock = sock
+        self._end = end
         _watch_proxy(self)
-        self._server_header = header
-        self._source = sockets.FrameSource(sock, tcpros.FrameReader(buff_size=self.buff_size, ok_byte=True),
-                                           stop=node.is_shutdown)
+        return end
 
     def _drop(self) -> None:
-        sock, self._sock = self._sock, None
-        self._source = None
-        sockets.close(sock)
+        end, self._end = self._end, None
+        if end is not None:
+            end.close()
 
     def call(self, *args: Any, **kwds: Any) -> Any:
         """Call the service; returns the response message.
@@ -509,21 +404,16 @@ class ServiceProxy:
         if getattr(request, "_type", None) != self.request_class._type:
             raise TypeError(f"request object type [{request.__class__}] does not match service type [{self.request_class}]")
         with self._lock:
-            if self._sock is None:
-                self._open()
+            end = self._end if self._end is not None else self._open()
             try:
                 # as rospy: a request is numbered once connected, and sent in that order
                 self.seq += 1
                 stamp_header(request, self.seq)
-                frame = _small_frame(request, _REQUEST_PREFIX)
-                if frame is None:
-                    buff = _Buffer()
-                    request.serialize(buff)
-                    frame = buff.frame(tcpros.frame_prefix(buff.size))
-                assert self._sock is not None and self._source is not None
-                _send_all(self._sock, frame)
-                del frame  # its joined small fields need not live while the response comes in
-                reply = self._source.next()
+                try:
+                    frame = serialize_frame(request, snapshot=False)
+                except ROSSerializationException as exc:  # genpy's, as rospy raises it
+                    raise SerializationError(str(exc)) from None
+                reply = end.call(frame)
                 if reply is None:
                     raise TransportTerminated(_PEER_GONE)
             except TransportException as exc:
@@ -536,7 +426,7 @@ class ServiceProxy:
             except BaseException:
                 self._drop()
                 raise
-            header = self._server_header
+            header = end.header
             if not self.persistent:
                 self._drop()
         ok, data = reply
@@ -568,13 +458,13 @@ def _probe_service(resolved_name: str, timeout: float) -> str | None:
     except RemoteError as exc:  # OSError (master down) goes to the caller
         raise TransportInitError(f"master lookup failed: {exc}") from None
     host, port = parse_rosrpc_uri(uri)
-    sock = connect(host, port, timeout, nodelay=True)
+    end = connect_service(host, port, resolved_name, timeout, stop=node.is_shutdown)
     try:
-        negotiate(sock, Handshake(Role.SERVICE_CLIENT, {
+        end.negotiate(Handshake(Role.SERVICE_CLIENT, {
             "probe": "1", "md5sum": "*", "callerid": node.get_caller_id(),
-            "service": resolved_name}), send=_send_all)
+            "service": resolved_name}))
     finally:
-        sockets.close(sock)
+        end.close()
     return uri
 
 

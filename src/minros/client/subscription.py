@@ -19,19 +19,19 @@ import errno
 import logging
 import threading
 import traceback
-from typing import TYPE_CHECKING, Any, Callable, Dict, List, Tuple
+from typing import TYPE_CHECKING, Any, Callable, Collection, Dict, List, Tuple
 
 from minros.client import log
-from minros.transport.base import FallBack, ProtocolHandler, Transport
+from minros.transport.base import FallBack, Transport, subscriber_header
 from minros.wire import tcpros
 from minros.wire.handshake import Handshake, Rejected, Role
-from minros.wire.rosapi import RemoteError, unwrap
-from minros.wire.xmlrpc import ServerProxy
+from minros.wire.rosapi import RemoteError
+from minros.wire.slaveapi import SlaveClient
 
 if TYPE_CHECKING:
     from minros.node import Node
 
-__all__ = ["PublisherConnection", "Subscription"]
+__all__ = ["GiveUp", "PublisherConnection", "Subscription", "connect_publisher"]
 
 _logger = logging.getLogger("minros.client.topics")
 
@@ -41,12 +41,50 @@ REQUEST_TOPIC_TIMEOUT = 5.0
 RETRY_FIRST, RETRY_MAX = 0.5, 8.0
 
 
-class _GiveUp(Exception):
+class GiveUp(Exception):
     """The publisher will not serve us: do not try again."""
 
 
 def _is_refused(exc: BaseException) -> bool:
     return isinstance(exc, ConnectionRefusedError) or getattr(exc, "errno", None) == errno.ECONNREFUSED
+
+
+def connect_publisher(node: Node, pub_uri: str, fields: Dict[str, str], *,
+                      excluded: Collection[str] = (), buff_size: int = tcpros.DEFAULT_BUFF_SIZE,
+                      reuse_big: bool = False, tcp_nodelay: bool = False,
+                      attach: Callable[[Transport], bool] | None = None) -> Transport | None:
+    """How a subscriber of ``node`` connects to the publisher at ``pub_uri`` (every
+    Subscriber's connection and ``minros web``'s taps): ``requestTopic`` offering the
+    node's protocols in its order (less ``excluded``, TCPROS always), the chosen
+    protocol's ``connect``, then the subscriber's header exchange with ``fields``.
+
+    ``attach(transport)`` is told of the transport as soon as it exists (so that closing
+    the connection meanwhile reaches it) and says whether to go on: when it says no, the
+    transport is closed and None returned. Raises GiveUp (the publisher will not serve
+    this topic), FallBack (its ``protocol`` cannot carry the connection: ask again
+    without it), ValueError (an answer the handler cannot use), OSError, HeaderError or
+    Rejected (the connection failed)."""
+    protocols = node.protocols
+    offers = [h for h in protocols[:-1] if h.protocol not in excluded] + protocols[-1:]
+    try:
+        with SlaveClient(pub_uri, node.caller_id, REQUEST_TOPIC_TIMEOUT) as publisher:
+            answer = publisher.request_topic(fields["topic"], [h.offer() for h in offers])
+    except RemoteError as exc:
+        raise GiveUp(f"requestTopic: {exc}") from None
+    handler = next((h for h in offers if h.protocol == answer[0]), None)
+    if handler is None:
+        raise GiveUp(f"publisher returned invalid protocol choice: {answer}")
+    try:
+        transport = handler.connect(answer, fields["topic"], buff_size, reuse_big,
+                                    tcp_nodelay)
+        if attach is not None and not attach(transport):
+            transport.close()
+            return None
+        transport.negotiate(Handshake(Role.SUBSCRIBER, fields))
+    except FallBack as exc:
+        exc.protocol = handler.protocol
+        raise
+    return transport
 
 
 class PublisherConnection:
@@ -123,34 +161,29 @@ class PublisherConnection:
                         self.connected = False
                         local.close()
                     return
+                self.transport = None
                 try:
-                    handler, answer = self._request_topic()
-                except OSError as exc:
-                    if _is_refused(exc):
-                        _logger.debug("publisher %s is gone: %s", self.pub_uri, exc)
-                        return
-                    handler = None
-                    _logger.debug("requestTopic to %s failed: %s", self.pub_uri, exc)
-                except _GiveUp as exc:
+                    if self._connect():
+                        interval = RETRY_FIRST
+                        self._receive_loop()
+                except FallBack as exc:  # the next protocol, at once
+                    self._fall_back(exc)
+                    continue
+                except (GiveUp, ValueError) as exc:  # will not serve us, or cannot be used
                     _logger.debug("not connecting to %s: %s", self.pub_uri, exc)
                     return
-                if handler is not None:
-                    try:
-                        if self._connect(handler, answer):
-                            interval = RETRY_FIRST
-                            self._receive_loop()
-                    except FallBack as exc:  # the next protocol, at once
-                        self._fall_back(handler, exc)
-                        continue
-                    except ValueError as exc:  # an answer the handler cannot use
-                        _logger.debug("not connecting to %s: %s", self.pub_uri, exc)
-                        return
-                    except (OSError, tcpros.HeaderError, tcpros.FrameError, Rejected) as exc:
+                except (OSError, tcpros.HeaderError, tcpros.FrameError, Rejected) as exc:
+                    if self.transport is None and isinstance(exc, OSError):  # requestTopic
+                        if _is_refused(exc):
+                            _logger.debug("publisher %s is gone: %s", self.pub_uri, exc)
+                            return
+                        _logger.debug("requestTopic to %s failed: %s", self.pub_uri, exc)
+                    else:
                         self._report(exc)
-                    finally:
-                        self.connected = False
-                        if self.transport is not None:
-                            self.transport.close()
+                finally:
+                    self.connected = False
+                    if self.transport is not None:
+                        self.transport.close()
                 if self.done or node.is_shutdown_requested():
                     return
                 if self.pub_uri not in self.sub.publisher_uris:
@@ -173,61 +206,36 @@ class PublisherConnection:
             log.logwarn(f"[{self.sub.resolved_name}] connection to publisher "
                         f"[{self.pub_uri}] failed: {text}")
 
-    def _fall_back(self, handler: ProtocolHandler, exc: FallBack) -> None:
-        """``handler``'s protocol cannot carry this connection: one line, and it is not
+    def _fall_back(self, exc: FallBack) -> None:
+        """The protocol of ``exc`` cannot carry this connection: one line, and it is not
         offered to this publisher again."""
-        self.excluded.add(handler.protocol)
+        protocol = exc.protocol or (self.transport.protocol if self.transport else "")
+        self.excluded.add(protocol)
         if not self.done and not self.sub.node.is_shutdown_requested():
-            log.logwarn(f"[{self.sub.resolved_name}] {handler.protocol} with publisher "
+            log.logwarn(f"[{self.sub.resolved_name}] {protocol} with publisher "
                         f"[{self.pub_uri}] failed: {exc}; falling back to the next protocol")
 
-    def _offers(self) -> List[ProtocolHandler]:
-        protocols = self.sub.node.protocols
-        return [h for h in protocols[:-1] if h.protocol not in self.excluded] + protocols[-1:]
-
-    def _request_topic(self) -> Tuple[ProtocolHandler, List[Any]]:
-        """Ask the publisher for a connection, offering the protocols the node speaks."""
-        node = self.sub.node
-        proxy = ServerProxy(self.pub_uri, timeout=REQUEST_TOPIC_TIMEOUT)
-        offers = self._offers()
-        try:
-            answer = unwrap(proxy.requestTopic(node.caller_id, self.sub.resolved_name,
-                                               [handler.offer() for handler in offers]))
-        except RemoteError as exc:
-            raise _GiveUp(f"requestTopic: {exc}") from None
-        finally:
-            proxy.close()
-        if isinstance(answer, list) and answer:
-            for handler in offers:
-                if handler.protocol == answer[0]:
-                    return handler, answer
-        raise _GiveUp(f"publisher returned invalid protocol choice: {answer}")
-
-    def _connect(self, handler: ProtocolHandler, answer: List[Any]) -> bool:
+    def _connect(self) -> bool:
+        """Connect to the publisher (``connect_publisher``); False when closed meanwhile."""
         sub = self.sub
-        data_class = sub.data_class
-        self.transport = transport = handler.connect(
-            answer, sub.resolved_name, sub.buff_size,
-            reuse_big=not getattr(data_class, "_keeps_buffer", True), tcp_nodelay=sub.tcp_nodelay)
-        if self.done:  # closed while connecting: close() did not see the transport
-            transport.close()
+        transport = connect_publisher(
+            sub.node, self.pub_uri, self._fields(), excluded=self.excluded,
+            buff_size=sub.buff_size, reuse_big=not getattr(sub.data_class, "_keeps_buffer", True),
+            tcp_nodelay=sub.tcp_nodelay, attach=self._attach)
+        if transport is None:
             return False
-        transport.negotiate(Handshake(Role.SUBSCRIBER, self._fields()))
         self.connected = True
         return True
+
+    def _attach(self, transport: Transport) -> bool:
+        self.transport = transport
+        return not self.done  # closed while connecting: close() did not see the transport
 
     def _fields(self) -> Dict[str, str]:
         """Our connection header."""
         sub = self.sub
-        data_class = sub.data_class
-        return {
-            "topic": sub.resolved_name,
-            "message_definition": data_class._full_text,
-            "tcp_nodelay": "1" if sub.tcp_nodelay else "0",
-            "md5sum": data_class._md5sum,
-            "type": data_class._type,
-            "callerid": sub.node.caller_id,
-        }
+        return subscriber_header(sub.resolved_name, sub.data_class, sub.node.caller_id,
+                                 sub.tcp_nodelay)
 
     def _receive_loop(self) -> None:
         sub = self.sub

@@ -209,10 +209,13 @@ def list_processes(roslaunch_uris: Optional[Sequence[str]] = None) -> List[NetPr
     uris = list(roslaunch_uris or get_roslaunch_uris() or [])
     procs: List[NetProcess] = []
     for uri in uris:
-        from minros.tools.master import call_node
+        from minros.tools.master import TOOL_TIMEOUT
+        from minros.wire.xmlrpc import ServerProxy
 
+        # roslaunch's process API (no node API: no caller id), one call per roslaunch
         try:
-            active, dead = unwrap(call_node(uri, "list_processes"))
+            with ServerProxy(uri, timeout=TOOL_TIMEOUT) as launcher:
+                active, dead = unwrap(launcher.list_processes())
         except (OSError, ValueError, TypeError, xmlrpc.client.Error, RemoteError):
             continue
         procs += [NetProcess(a[0], a[1], True, uri) for a in active]

@@ -8,7 +8,10 @@ import threading
 from typing import Any, Callable, Deque, Dict, List, OrderedDict, Set, Tuple
 
 from minros.master.log import log as _log
-from minros.wire import xmlrpc
+from minros.wire.slaveapi import SlaveClient
+
+#: the caller id of every call the master makes to a node
+MASTER_CALLER_ID = "/master"
 
 #: Timeout of one callback (publisherUpdate, paramUpdate, shutdown) to a node, in seconds.
 CALLBACK_TIMEOUT = 5.0
@@ -27,6 +30,11 @@ class CallbackPool:
     same coalescing key (e.g. ``publisherUpdate`` for one topic) is replaced by the newer one, so a
     slow node gets the latest state rather than an ever-growing queue. Each call is bounded by
     ``timeout``.
+
+    ``args`` are the call's XML-RPC parameters as on the wire, the caller id (``/master``)
+    first; the calls go through one :class:`~minros.wire.slaveapi.SlaveClient` per node, kept
+    alive (the 256 most recent), which fills the caller id in itself. ``on_result`` gets the
+    node's answer as it came (the triplet), or the exception the call ended in.
     """
 
     def __init__(self, workers: int = CALLBACK_WORKERS, timeout: float = CALLBACK_TIMEOUT,
@@ -43,7 +51,7 @@ class CallbackPool:
         self._busy: Set[str] = set()
         self._threads: List[threading.Thread] = []
         self._stopped = False
-        self._proxies: OrderedDict[str, Any] = collections.OrderedDict()
+        self._proxies: OrderedDict[str, SlaveClient] = collections.OrderedDict()
         self._proxies_lock = threading.Lock()
 
     def queue(self, api: str, method: str, args: Tuple[Any, ...], coalesce: Any | None = None,
@@ -114,14 +122,15 @@ class CallbackPool:
 
     def _xmlrpc_call(self, api: str, method: str, args: Tuple[Any, ...]) -> Any:
         with self._proxies_lock:
-            proxy = self._proxies.pop(api, None)
-            if proxy is None:
-                proxy = xmlrpc.ServerProxy(api, timeout=self.timeout)
-            self._proxies[api] = proxy
+            node = self._proxies.pop(api, None)
+            if node is None:
+                node = SlaveClient(api, MASTER_CALLER_ID, timeout=self.timeout)
+            self._proxies[api] = node
             while len(self._proxies) > 256:
                 _old_api, old = self._proxies.popitem(last=False)
                 old.close()
-        return getattr(proxy, method)(*args)
+        # args[0] is the caller id, which the client sends itself
+        return node.raw(method, *args[1:])
 
     def _forget_proxy(self, api: str) -> None:
         with self._proxies_lock:

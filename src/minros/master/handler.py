@@ -9,7 +9,7 @@ import os
 import threading
 from typing import Any, Callable, Dict, List, Tuple
 
-from minros.master.callbacks import CallbackPool
+from minros.master.callbacks import MASTER_CALLER_ID, CallbackPool
 from minros.master.log import log as _log
 from minros.master.params import ParamDictionary, _snapshot
 from minros.master.registrations import Caller, RegistrationManager
@@ -56,19 +56,19 @@ class MasterHandler:
     def _bump_node(self, old_api: str, caller_id: str) -> None:
         _log.warning("new node registered with same name [%s]: shutting down %s", caller_id, old_api)
         self._pool.queue(old_api, "shutdown",
-                         ("/master", f"[{caller_id}] Reason: new node registered with same name"))
+                         (MASTER_CALLER_ID, f"[{caller_id}] Reason: new node registered with same name"))
 
     def _notify_topic_subscribers(self, topic: str) -> None:
         pub_uris = self._reg.publishers.get_apis(topic)
         for sub_api in self._reg.subscribers.get_apis(topic):
-            self._pool.queue(sub_api, "publisherUpdate", ("/master", topic, pub_uris),
+            self._pool.queue(sub_api, "publisherUpdate", (MASTER_CALLER_ID, topic, pub_uris),
                              coalesce=("publisherUpdate", topic))
 
     def _notify_param_subscribers(self, updates: List[Tuple[List[Caller], str, Any]]) -> None:
         for callers, key, value in updates:
             value = _snapshot(value)  # the tree's own dict may change before the call is made
             for _caller_id, caller_api in callers:
-                self._pool.queue(caller_api, "paramUpdate", ("/master", key, value),
+                self._pool.queue(caller_api, "paramUpdate", (MASTER_CALLER_ID, key, value),
                                  coalesce=("paramUpdate", key),
                                  on_result=functools.partial(self._param_update_result, caller_api,
                                                              key))
@@ -83,7 +83,7 @@ class MasterHandler:
         if watcher_api in self._graph_sent:
             return  # one in flight: its answer sends the newest version
         self._graph_sent[watcher_api] = self._graph_version
-        self._pool.queue(watcher_api, "graphUpdate", ("/master", self._graph_version),
+        self._pool.queue(watcher_api, "graphUpdate", (MASTER_CALLER_ID, self._graph_version),
                          on_result=functools.partial(self._graph_update_result, watcher_api))
 
     def _graph_update_result(self, watcher_api: str, result: Any) -> None:

@@ -1,5 +1,6 @@
-"""The node's connections: the transports it speaks and the TCPROS server that takes inbound
-connections (started on first use, as rospy's), handing each to what its header names.
+"""The node's connections: the transports it speaks and the one inbound server that takes
+every connection to this node (started on first use, as rospy's TCPROS server), on its TCP port
+and, for shared memory, its abstract Unix socket, handing each to what its header names.
 
 One object owns the server and the protocol list, so the Node only asks: its address, the
 answer to a requestTopic offer, a same-process link. It reads what it needs from the other
@@ -14,7 +15,7 @@ from typing import Any, Callable, Dict, List, Tuple
 from minros.exceptions import ROSInitException
 from minros.node.names import NodeNames
 from minros.node.registries import Registries
-from minros.node.tcpros_server import TCPROS_LIMITS, TCPROSServer
+from minros.node.tcpros_server import TCP, TCPROS_LIMITS, TCPROSServer
 from minros.transport import intraprocess, shm
 from minros.transport.base import ProtocolHandler, Transport
 from minros.transport.tcpros_pubsub import TCPROSHandler
@@ -37,7 +38,7 @@ class Connections:
         #: minros peers) when this system has it, TCPROS last
         self.protocols: List[ProtocolHandler] = [TCPROSHandler(lambda: self.tcpros_address())]
         if shm.supported():
-            self.protocols.insert(0, shm.ShmHandler(registries.publications.get, shutdown_requested))
+            self.protocols.insert(0, shm.ShmHandler(self.shm_address))
         self.host = ""  # the advertised host, set by start()
         self.port = 0  # the TCPROS port asked for (0: any free port)
         self.allowed: Any = None  # ROS_ALLOWED_HOSTS, set by start()
@@ -58,6 +59,12 @@ class Connections:
                 self.server = server
             return self.host, self.server.port
 
+    def shm_address(self) -> str:
+        """The name of the server's abstract Unix socket (listening from the first call)."""
+        self.tcpros_address()
+        assert self.server is not None
+        return self.server.unix_name()
+
     def answer_protocol(self, topic: str, offer: Any) -> List[Any] | None:
         """requestTopic: the answer to one offered protocol, None if we do not speak it."""
         if not isinstance(offer, list) or not offer:
@@ -76,8 +83,10 @@ class Connections:
             return None
         return intraprocess.link(pub, fields)
 
-    def dispatch(self, stream: Any, header: Dict[str, str], conn: admission.Connection) -> str | None:
-        """Hand an inbound connection to what its header names; the error text when it cannot be."""
+    def dispatch(self, stream: Any, header: Dict[str, str], conn: admission.Connection,
+                 listener: str = TCP) -> str | None:
+        """Hand an inbound connection (that arrived on the server's socket of protocol
+        ``listener``) to what its header names; the error text when it cannot be."""
         kind = route(header)
         caller_id = self._names.caller_id
         if kind == "topic":
@@ -89,11 +98,13 @@ class Connections:
                     header, caller_id, self._registries.publication_types()) or (
                     f"[{caller_id}] is not a publisher of [{header['topic']}]")
             for handler in self.protocols:
-                if handler.claims(header):
+                if handler.claims(header, listener):
                     handler.accept(stream, header, pub)  # Rejected when it refused
                     return None
             return "no transport takes this connection"
         if kind == "service":
+            if listener != TCP:
+                return "a shared-memory connection carries a topic"
             serve = self._registries.services.get(header["service"])
             if serve is None:
                 return f"[{caller_id}] is not a provider of [{header['service']}]"

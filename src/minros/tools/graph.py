@@ -23,8 +23,9 @@ import threading
 import time
 from typing import Dict, Iterator, List, Optional, Set, Tuple
 
-from minros.tools.master import Master, MasterException, call_node
-from minros.wire.rosapi import RemoteError, unwrap
+from minros.tools.master import Master, MasterException
+from minros.wire.rosapi import RemoteError
+from minros.wire.slaveapi import SlaveClient
 
 logger = logging.getLogger("rosgraph.graph")
 
@@ -227,17 +228,18 @@ class Graph:
     def _node_refresh_businfo(self, node: str, uri: str, bad_node: bool = False) -> bool:
         """Ask ``node`` for its connections and update topics and edges."""
         try:
-            answer = call_node(uri, "getBusInfo", _ROS_NAME, timeout=0.2 if bad_node else 1.0)
-        except Exception as exc:  # noqa: BLE001 - any failure puts the node on the bad list
+            with SlaveClient(uri, _ROS_NAME, 0.2 if bad_node else 1.0) as client:
+                bus_info = client.get_bus_info()
+        except RemoteError as exc:  # it answered, but not with its connections
+            if bad_node:
+                self._unmark_bad_node(node)
+            logger.error("cannot get stats info from node [%s]: %s", node, exc)
+            return False
+        except Exception as exc:  # noqa: BLE001 - any other failure puts the node on the bad list
             self._mark_bad_node(node, str(exc))
             return False
         if bad_node:
             self._unmark_bad_node(node)
-        try:
-            bus_info = unwrap(answer)
-        except RemoteError as exc:
-            logger.error("cannot get stats info from node [%s]: %s", node, exc)
-            return False
         updated = False
         for info in bus_info:
             if len(info) < 5:  # a node answering garbage

@@ -10,7 +10,6 @@ camelCase calls and a bounded timeout, so no tool hangs on a dead master.
 from __future__ import annotations
 
 import sys
-import xmlrpc.client
 from typing import Any, Dict, List, Tuple
 
 from minros import names, rosenv
@@ -25,7 +24,7 @@ from minros.wire.xmlrpc import ServerProxy
 
 __all__ = [
     "Error", "Failure", "Master", "MasterError", "MasterException", "MasterFailure",
-    "MasterIOError", "QUIET_NAMES", "ROSMasterException", "call_node", "get_master_uri",
+    "MasterIOError", "QUIET_NAMES", "ROSMasterException", "get_master_uri",
     "is_online", "is_quiet",
 ]
 
@@ -47,20 +46,6 @@ def is_quiet(name: str) -> bool:
 def get_master_uri(argv: List[str] | None = None) -> str:
     """``__master:=`` beats ``ROS_MASTER_URI``; default ``http://localhost:11311/``."""
     return rosenv.get_master_uri(remapped=rosenv.remapped_master(sys.argv if argv is None else argv))
-
-
-def call_node(uri: str, method: str, *args: Any, timeout: float = TOOL_TIMEOUT) -> list:
-    """Raw triplet of ``method`` on a node's XML-RPC API (OSError on network failure)."""
-    try:
-        proxy = ServerProxy(uri, timeout=timeout)
-    except ValueError as exc:
-        raise OSError(str(exc)) from None
-    try:
-        return getattr(proxy, method)(*args)
-    except (xmlrpc.client.Fault, xmlrpc.client.ProtocolError, xmlrpc.client.ResponseError) as exc:
-        raise OSError(f"XML-RPC error from {uri}: {exc}") from None
-    finally:
-        proxy.close()
 
 
 #: rosgraph.masterapi's names for the same classes

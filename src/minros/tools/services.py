@@ -2,15 +2,15 @@
 
 ``rosservice type``/``info``/``args`` and ``minros web`` learn a service's type and md5sum the
 way rosservice does: connect to its ``rosrpc://`` URI, send a header with ``probe=1`` (and md5sum
-``*``), and read the header the server answers with; no request is sent.
+``*``), and read the header the server answers with; no request is sent. The connection is a
+service client's end of the transport seam (``minros.transport.tcpros_service``).
 """
 
 from __future__ import annotations
 
-import socket
 from typing import Dict
 
-from minros.wire import sockets, tcpros, trace
+from minros.transport.tcpros_service import connect_service
 from minros.wire.rosapi import parse_rosrpc_uri
 
 __all__ = ["PROBE_TIMEOUT", "probe_service"]
@@ -29,7 +29,9 @@ def probe_service(uri: str, service: str, caller_id: str,
     tcpros.HeaderError when the server cannot be asked or answers garbage.
     """
     host, port = parse_rosrpc_uri(uri)
-    with trace.watch(socket.create_connection((host, port), timeout=timeout), "connect") as sock:
-        sock.sendall(tcpros.encode_header({"probe": "1", "md5sum": "*", "callerid": caller_id,
-                                           "service": service}))
-        return sockets.read_header(sock, MAX_HEADER)
+    end = connect_service(host, port, service, timeout)
+    try:
+        return end.probe({"probe": "1", "md5sum": "*", "callerid": caller_id,
+                          "service": service}, MAX_HEADER)
+    finally:
+        end.close()

@@ -5,14 +5,21 @@ A :class:`Transport` is one end of one topic connection, whatever carries it: it
 (its side of the connection-header exchange), sends frames (the publisher's end), receives
 frames (the subscriber's end) and closes. A frame is what ``serialize_frame`` makes: a
 serialized message with its 4-byte length prefix, as ``bytes`` or, for a big message, a tuple
-of buffers whose first is the prefix.
+of buffers, the prefix at the start of the first.
+
+A transport also says what else it can do for a publication, with defaults every other
+transport inherits, so the publication needs to know no protocol: ``takes_objects``/``put``
+(an intra-process link hands over the message object itself), ``lend``/``give_back``/
+``send_loaned`` (shared memory lends a slot for a message's large array, so publishing copies
+nothing), ``release`` (a subscriber's end whose frames borrow its buffers gives them back).
 
 A :class:`ProtocolHandler` is one protocol a node speaks: what a subscriber offers in
 ``requestTopic`` and how it connects to what the publisher chose; what a publisher answers to
-an offer; and which inbound connections it takes. A node keeps an ordered list of them
-(:attr:`minros.node.Node.protocols`: a subscriber offers them in that order, TCPROS last), so
-another transport joins by adding its handler there; the topic API (``minros.client``) only
-ever sees ``Transport``.
+an offer; and which inbound connections it takes (the node has one inbound server; each of its
+listening sockets, TCP or abstract Unix, is named by the protocol it serves). A node keeps an
+ordered list of them (:attr:`minros.node.Node.protocols`: a subscriber offers them in that
+order, TCPROS last), so another transport joins by adding its handler there; the topic API
+(``minros.client``) only ever sees ``Transport``.
 
 A transport that cannot carry a connection after all (shared memory refused by the kernel, a
 peer breaking the protocol) raises :class:`FallBack`: the subscriber logs it once and asks the
@@ -31,7 +38,7 @@ from minros.msgs import reader_for
 from minros.wire.handshake import Handshake
 
 __all__ = ["FallBack", "Frame", "ProtocolHandler", "PublicationSide", "Transport",
-           "next_connection_id"]
+           "next_connection_id", "subscriber_header"]
 
 #: a length-prefixed message: bytes, or a tuple of buffers (prefix first) sent without a join
 Frame = Union[bytes, Tuple[Any, ...]]
@@ -42,7 +49,9 @@ _ids_lock = threading.Lock()
 
 class FallBack(TransportException):
     """This protocol cannot carry the connection (the reason is the text): connect again with
-    the next protocol the node speaks."""
+    the next protocol the node speaks. ``protocol`` names the one that failed, once known."""
+
+    protocol = ""
 
 
 def next_connection_id() -> int:
@@ -99,6 +108,34 @@ class Transport(abc.ABC):
     #: ``receive``: a transport whose messages borrow its buffers makes a message that the
     #: callbacks kept its own here (shared memory)
     settle: Callable[[Any], None] | None = None
+
+    def release(self) -> None:  # noqa: B027 - most transports lend nothing
+        """The subscriber is done with the frames of the last ``receive``: a transport whose
+        frames borrow its buffers may reuse them now (``receive`` does this itself first; a
+        reader that waits for the stream to be readable before receiving calls it)."""
+
+    # -- what a publication may ask of a connection (the defaults: frames only) -------------
+
+    #: the publication hands this end message objects (``put``), not frames
+    takes_objects = False
+
+    def put(self, msg: Any) -> None:
+        """Hand over the message object itself (a transport that ``takes_objects``)."""
+        raise TransportException(f"a {self.protocol} connection takes frames, not objects")
+
+    def lend(self, nbytes: int) -> Any:
+        """Memory for a message's large array of ``nbytes`` that this connection can send
+        without a copy (an object with a writable ``view``), or None (the default)."""
+        return None
+
+    def give_back(self, loan: Any) -> None:  # noqa: B027 - nothing is lent by default
+        """A loan of :meth:`lend` not published after all."""
+
+    def send_loaned(self, loan: Any, head: bytes, tail: bytes) -> bool:
+        """Send the message whose array is ``loan``'s memory (``head``: its frame up to the
+        array, length prefix included; ``tail``: the rest). False when it cannot (the caller
+        sends the frame as usual)."""
+        return False
 
     @abc.abstractmethod
     def close(self) -> None:
@@ -162,16 +199,31 @@ class ProtocolHandler(abc.ABC):
         an answer this handler cannot use; OSError when the publisher cannot be reached.
         ``reuse_big``: the subscriber is done with a big frame before it receives again."""
 
-    def claims(self, header: Dict[str, str]) -> bool:
-        """Whether an inbound TCP connection opening with ``header`` is this protocol's: the
-        node's TCPROS server gives it to the first handler that claims it (TCPROS, last in
-        the node's list, claims every topic connection)."""
+    def claims(self, header: Dict[str, str], listener: str) -> bool:
+        """Whether an inbound connection opening with ``header`` on the node's listening
+        socket of protocol ``listener`` (``"TCPROS"``: its TCP port) is this protocol's: the
+        node's server gives it to the first handler that claims it (TCPROS, last in the
+        node's list, claims every topic connection on the TCP port)."""
         return False
 
     def accept(self, stream: Any, header: Dict[str, str], publication: PublicationSide) -> None:
         """Take an inbound connection this handler claimed, for ``publication``: negotiate
         and add the publisher's end to it; raises ``Rejected`` after refusing."""
-        raise TransportException(f"{self.protocol} takes no inbound TCP connections")
+        raise TransportException(f"{self.protocol} takes no inbound connections")
 
     def close(self) -> None:  # noqa: B027 - most handlers run nothing of their own
         """The node is shutting down: stop what this handler runs of its own (a server)."""
+
+
+def subscriber_header(topic: str, data_class: Any, caller_id: str,
+                      tcp_nodelay: bool = False) -> Dict[str, str]:
+    """A subscriber's connection header for ``topic`` of ``data_class``, whatever the protocol
+    (every subscriber of the node and ``minros web``'s taps send this one)."""
+    return {
+        "topic": topic,
+        "message_definition": data_class._full_text,
+        "tcp_nodelay": "1" if tcp_nodelay else "0",
+        "md5sum": data_class._md5sum,
+        "type": data_class._type,
+        "callerid": caller_id,
+    }

@@ -20,6 +20,7 @@ import threading
 import time
 from typing import Any, Callable, Deque, Dict, List
 
+from minros.msgs import reader_for
 from minros.transport.base import Frame, PublicationSide, Transport, next_connection_id
 from minros.wire.handshake import Handshake
 
@@ -49,8 +50,10 @@ class IntraProcessPublisher(Transport):
     takes_objects = True
 
     def __init__(self, queue: _Queue, header: Dict[str, str],
-                 on_close: Callable[[Transport], Any]) -> None:
+                 on_close: Callable[[Transport], Any], data_class: Any = None) -> None:
         self.id = next_connection_id()
+        self.read: Callable[[Any], Any] = reader_for(data_class) if data_class is not None \
+            else _same
         self.queue = queue
         self.header = header  # the subscriber's side of it
         self.stat_msgs = 0
@@ -72,7 +75,10 @@ class IntraProcessPublisher(Transport):
         return f"INTRAPROCESS connection to [{self.endpoint_id}]"
 
     def send(self, frame: Frame) -> None:
-        raise TypeError("an intra-process link takes message objects (put), not frames")
+        """A frame (rospy code writing bytes to each connection): read into a new message, as
+        a subscriber over a socket would get it, and handed over."""
+        body = frame if frame.__class__ is bytes else b"".join(frame)  # type: ignore[arg-type]
+        self.put(self.read(memoryview(body)[4:]))
 
     def put(self, msg: Any) -> None:
         """Hand ``msg`` over; drops the oldest waiting one when the queue is full."""
@@ -161,9 +167,13 @@ class IntraProcessSubscriber(Transport):
         publisher = self.publisher
         if not publisher.done:
             publisher.done = True
-            # the publication takes its own lock: never from a thread that may hold it
-            threading.Thread(target=publisher.on_close, args=(publisher,), daemon=True,
-                             name="minros-intraprocess-close").start()
+            # the publication takes its own lock: never from a thread that may hold it (at
+            # interpreter shutdown, when no thread may start, the publication is going too)
+            try:
+                threading.Thread(target=publisher.on_close, args=(publisher,), daemon=True,
+                                 name="minros-intraprocess-close").start()
+            except RuntimeError:
+                pass
 
 
 def _same(msg: Any) -> Any:
@@ -175,7 +185,8 @@ def link(publication: PublicationSide, fields: Dict[str, str]) -> IntraProcessSu
     ``publication``; returns the subscriber's end, the publisher's end joined the
     publication (which sends it the latched message first)."""
     queue = _Queue(publication.queue_size)
-    publisher = IntraProcessPublisher(queue, dict(fields), publication.remove_connection)
+    publisher = IntraProcessPublisher(queue, dict(fields), publication.remove_connection,
+                                      publication.data_class)
     subscriber = IntraProcessSubscriber(queue, publication.header_fields(), publisher)
     publication.add_connection(publisher)
     return subscriber

@@ -11,12 +11,11 @@ from __future__ import annotations
 import socket
 from typing import Any, Callable, Dict
 
-from minros.transport.base import Transport, next_connection_id
-from minros.transport.streams import addresses
+from minros.transport.streams import StreamTransport
 from minros.wire import sockets, trace
 from minros.wire.handshake import Handshake, Rejected, State
 
-__all__ = ["TCPROS", "TCPROSTransport", "connect", "negotiate"]
+__all__ = ["TCPROS", "TCPROSTransport", "connect", "negotiate", "tcpros_info"]
 
 #: the protocol's name in requestTopic
 TCPROS = "TCPROS"
@@ -69,29 +68,17 @@ def connect(host: str, port: int, timeout: float = CONNECT_TIMEOUT,
     return traced
 
 
-class TCPROSTransport(Transport):
+class TCPROSTransport(StreamTransport):
     """What both ends of a TCPROS topic connection keep: the stream and its addresses, the
     peer's header, the counters."""
 
     protocol = TCPROS
 
-    def __init__(self, stream: Any, topic: str) -> None:
-        self.id = next_connection_id()
-        self.stream = stream
-        self.topic = topic
-        self.header: Dict[str, str] = {}
-        self.stat_msgs = 0
-        self.done = False
-        self.local, self.remote = addresses(stream)
-        try:
-            self.fileno = stream.fileno()
-        except OSError:
-            self.fileno = -1
-
     def info(self) -> str:
-        return (f"TCPROS connection on port {self.local[1]} to [{self.remote[0]}:{self.remote[1]}"
-                f" on socket {self.fileno}]")
+        return tcpros_info(self.local, self.remote, self.fileno)
 
-    def close(self) -> None:
-        self.done = True
-        sockets.close(self.stream)
+
+def tcpros_info(local: Any, remote: Any, fileno: int) -> str:
+    """getBusInfo's line for a TCPROS connection, as rospy writes it."""
+    return (f"TCPROS connection on port {local[1]} to [{remote[0]}:{remote[1]}"
+            f" on socket {fileno}]")

@@ -106,7 +106,8 @@ def name_taken(name: str, argv: Optional[List[str]] = None) -> Optional[str]:
     wins): a live node already holds it. None when it is free, or held by a node that no
     longer answers (a stale registration, which init_node replaces as rospy does)."""
     from minros import names
-    from minros.tools.master import Master, MasterError, MasterIOError, call_node
+    from minros.tools.master import Master, MasterError, MasterIOError
+    from minros.wire.slaveapi import RemoteError, SlaveClient
 
     argv = list(sys.argv if argv is None else argv)
     given = names.load_mappings(argv).get("__name", name)
@@ -119,10 +120,9 @@ def name_taken(name: str, argv: Optional[List[str]] = None) -> Optional[str]:
     finally:
         master.close()
     try:
-        code, _msg, pid = call_node(uri, "getPid", resolved, timeout=2.0)
-    except OSError:
-        return None
-    if code != 1:
+        with SlaveClient(uri, resolved, timeout=2.0) as node:
+            pid = node.get_pid()
+    except (OSError, RemoteError):
         return None
     return (f"a node named {resolved} is already running (pid {pid}, {uri}); another with its "
             "name would shut it down, as ROS does. Stop that one, or start this one under a "

@@ -347,7 +347,8 @@ class PageSession(RosbridgeSession):
         node = msg["node"]
 
         def work() -> Dict[str, Any]:
-            from minros.tools.master import call_node
+            from minros.wire.rosapi import RemoteError
+            from minros.wire.slaveapi import SlaveClient
 
             graph = self.state.graph
             info = pagemodel.node_info(graph, node)
@@ -358,11 +359,10 @@ class PageSession(RosbridgeSession):
             info["uri"] = uri
             if uri:
                 try:
-                    info["pid"] = call_node(uri, "getPid", self.state.caller_id,
-                                            timeout=NODE_TIMEOUT)[2]
-                    bus = call_node(uri, "getBusInfo", self.state.caller_id, timeout=NODE_TIMEOUT)
-                    info["connections"] = pagemodel.connections(bus[2])
-                except OSError as exc:
+                    with SlaveClient(uri, self.state.caller_id, NODE_TIMEOUT) as client:
+                        info["pid"] = client.get_pid()
+                        info["connections"] = pagemodel.connections(client.get_bus_info())
+                except (OSError, RemoteError) as exc:
                     info["error"] = f"Communication with node[{uri}] failed! ({exc})"
             else:
                 info["error"] = f"cannot contact [{node}]: unknown node"

@@ -7,16 +7,16 @@ server 2,017 threads and 238 MB (a thread and a 64 KB receive buffer per connect
 
 :class:`Receiver` holds the web node's subscriptions instead. One thread (``minros-web-receive``)
 waits on every publisher connection with a selector and hands each message's bytes to the
-topic's listener; a few workers (``minros-web-connect``) do what blocks, asking the publisher
-for the topic (``requestTopic``), connecting and exchanging connection headers, then pass the
-socket to that thread. The protocol is a subscriber's TCPROS, from the transport layer's parts
-(:func:`minros.transport.tcpros_base.connect` and ``negotiate`` running a subscriber's
-:class:`minros.wire.handshake.Handshake`) and :mod:`minros.wire.tcpros`'s framing; each
-subscription is a :class:`minros.node.Subscription` in
-the node's registry, so the master's ``publisherUpdate`` and ``getBusStats``/``getBusInfo``
-reach it as they reach a Subscriber. A connection that fails or ends is tried again after
-0.5 s, doubling to 8 s, while the master still lists its publisher, as Subscriber does; a
-publisher that refuses the connection (gone) or the topic is given up.
+topic's listener; a few workers (``minros-web-connect``) do what blocks, connecting as every
+Subscriber does (:func:`minros.client.subscription.connect_publisher`: ``requestTopic`` with the
+node's protocols, shared memory first between minros processes of one host, the chosen
+protocol's ``connect`` and the subscriber's header exchange), then pass the transport to that
+thread, which receives from it when its stream is readable. Each subscription is a
+:class:`minros.node.Subscription` in the node's registry, so the master's ``publisherUpdate`` and
+``getBusStats``/``getBusInfo`` reach it as they reach a Subscriber. A connection that fails or
+ends is tried again after 0.5 s, doubling to 8 s, while the master still lists its publisher,
+as Subscriber does; a publisher that refuses the connection (gone) or the topic is given up; a
+protocol that cannot carry it (shared memory refused) is left out for that publisher, at once.
 
 Listeners run in the receive thread, as a Subscriber's callbacks run in its: they must only
 queue (every listener of ``minros web`` does).
@@ -36,18 +36,17 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import minros
-from minros.transport import tcpros_base
-from minros.wire import sockets, tcpros
-from minros.wire.handshake import Handshake, Rejected, Role
-from minros.wire.rosapi import RemoteError, unwrap
-from minros.wire.xmlrpc import ServerProxy
+from minros.client.subscription import GiveUp, connect_publisher
+from minros.transport.base import FallBack, Transport, subscriber_header
+from minros.wire import tcpros
+from minros.wire.handshake import Rejected
 
 #: the receive buffer of a connection: messages larger than this get a buffer of their own
 #: as they arrive, so a small one keeps thousands of idle connections cheap
 BUFF_SIZE = 4096
 CONNECT_WORKERS = 4
-CONNECT_TIMEOUT = 10.0
-REQUEST_TIMEOUT = 5.0
+#: receives of one connection per wake-up of the receive thread
+READS_PER_WAKE = 4
 FIRST_RETRY = 0.5
 MAX_RETRY = 8.0
 
@@ -57,69 +56,60 @@ Deliver = Callable[[Any, Dict[str, str]], None]
 _conn_ids = itertools.count(1)
 
 
-class _GiveUp(Exception):
-    """The publisher will not serve this topic: no retry."""
-
-
 class _Connection:
     """One publisher of one subscription: connected by a worker, then read by the receive
-    thread. ``sock`` and ``reader`` are the receive thread's once registered."""
+    thread. ``transport`` is the receive thread's once registered."""
 
     def __init__(self, sub: RawSubscription, pub_uri: str) -> None:
         self.id = next(_conn_ids)
         self.sub = sub
         self.pub_uri = pub_uri
-        self.sock: Any = None
-        self.reader: Optional[tcpros.FrameReader] = None
-        self.header: Dict[str, str] = {}
+        self.transport: Optional[Transport] = None
         self.connected = False
         self.done = False
         self.retry = FIRST_RETRY
         self.reported: set = set()
-        self.stat_bytes = 0
-        self.stat_msgs = 0
-        self.local: Tuple[Any, ...] = ("", 0)
-        self.remote: Tuple[Any, ...] = ("", 0)
-        self.fileno = -1
+        #: protocols not offered to this publisher any more (they fell back)
+        self.excluded: set = set()
+
+    @property
+    def header(self) -> Dict[str, str]:
+        return self.transport.header if self.transport is not None else {}
+
+    @property
+    def protocol(self) -> str:
+        return self.transport.protocol if self.transport is not None else ""
+
+    @property
+    def stat_bytes(self) -> int:
+        return self.transport.stat_bytes if self.transport is not None else 0
+
+    @property
+    def stat_msgs(self) -> int:
+        return self.transport.stat_msgs if self.transport is not None else 0
 
     def info(self) -> str:
-        return (f"TCPROS connection on port {self.local[1]} to [{self.remote[0]}:{self.remote[1]}"
-                f" on socket {self.fileno}]")
+        return self.transport.info() if self.transport is not None else ""
 
     # -- the worker's part -------------------------------------------------------------------
 
-    def connect(self) -> Any:
-        """requestTopic, connect and exchange headers (blocking, bounded); the socket."""
+    def connect(self) -> Transport:
+        """requestTopic, connect and exchange headers (blocking, bounded); the transport,
+        its stream non-blocking (the receive thread reads it when it is readable)."""
         sub = self.sub
-        proxy = ServerProxy(self.pub_uri, timeout=REQUEST_TIMEOUT)
+        fields = subscriber_header(sub.resolved_name, sub.data_class, sub.node.caller_id, True)
         try:
-            params = unwrap(proxy.requestTopic(sub.node.caller_id, sub.resolved_name,
-                                               [[tcpros.TCPROS]]))
-        except RemoteError as exc:
-            raise _GiveUp(f"requestTopic: {exc}") from None
-        finally:
-            proxy.close()
-        if (not isinstance(params, list) or len(params) != 3 or params[0] != tcpros.TCPROS
-                or not isinstance(params[1], str) or not isinstance(params[2], int)):
-            raise _GiveUp(f"publisher returned invalid protocol choice: {params}")
-        sock = tcpros_base.connect(params[1], params[2], timeout=CONNECT_TIMEOUT, nodelay=True)
+            transport = connect_publisher(sub.node, self.pub_uri, fields, excluded=self.excluded,
+                                          buff_size=BUFF_SIZE, reuse_big=False, tcp_nodelay=True)
+        except Rejected as exc:  # refused, or not the topic we asked for
+            raise GiveUp(str(exc)) from None
+        assert transport is not None
         try:
-            cls = sub.data_class
-            handshake = Handshake(Role.SUBSCRIBER, {
-                "topic": sub.resolved_name, "message_definition": cls._full_text,
-                "tcp_nodelay": "1", "md5sum": cls._md5sum, "type": cls._type,
-                "callerid": sub.node.caller_id})
-            try:  # reads exactly the header: the messages follow
-                self.header = tcpros_base.negotiate(sock, handshake)
-            except Rejected as exc:  # refused, or not the topic we asked for
-                raise _GiveUp(str(exc)) from None
-            self.local, self.remote = sock.getsockname(), sock.getpeername()
-            self.fileno = sock.fileno()
-            sock.setblocking(False)
+            transport.stream.setblocking(False)  # type: ignore[attr-defined]
         except BaseException:
-            sockets.close(sock)
+            transport.close()
             raise
-        return sock
+        return transport
 
     def failed(self, exc: BaseException) -> None:
         """One line per distinct failure (not one per retry); a publisher killed is quiet."""
@@ -172,7 +162,7 @@ class RawSubscription:
                                      for c in list(self.by_uri.values())]]
 
     def get_stats_info(self) -> list:
-        return [[c.id, c.pub_uri, "i", "TCPROS", self.resolved_name, True, c.info()]
+        return [[c.id, c.pub_uri, "i", c.protocol, self.resolved_name, True, c.info()]
                 for c in list(self.by_uri.values()) if c.connected]
 
     def get_num_connections(self) -> int:
@@ -286,13 +276,17 @@ class Receiver:
             conn.sub.ended(conn)
             return
         try:
-            sock = conn.connect()
-        except _GiveUp as exc:
+            transport = conn.connect()
+        except (GiveUp, ValueError) as exc:
             minros.logdebug(f"[web] not connecting to {conn.pub_uri} for "
                             f"{conn.sub.resolved_name}: {exc}")
             conn.sub.ended(conn)
             return
-        except (OSError, tcpros.HeaderError, tcpros.FrameError, ValueError) as exc:
+        except FallBack as exc:  # the next protocol, at once
+            self._fall_back(conn, exc)
+            self.connect_later(conn, 0.0)
+            return
+        except (OSError, tcpros.HeaderError, tcpros.FrameError) as exc:
             if isinstance(exc, ConnectionRefusedError) or getattr(exc, "errno", None) == errno.ECONNREFUSED:
                 minros.logdebug(f"[web] publisher {conn.pub_uri} is gone: {exc}")
                 conn.sub.ended(conn)
@@ -304,7 +298,14 @@ class Receiver:
             conn.failed(exc)
             self._retry(conn)
             return
-        self._post(lambda: self._register(conn, sock))
+        self._post(lambda: self._register(conn, transport))
+
+    @staticmethod
+    def _fall_back(conn: _Connection, exc: FallBack) -> None:
+        protocol = exc.protocol or conn.protocol
+        conn.excluded.add(protocol)
+        minros.logdebug(f"[web] {protocol} with {conn.pub_uri} for {conn.sub.resolved_name} "
+                        f"failed: {exc}; falling back to the next protocol")
 
     def _retry(self, conn: _Connection) -> None:
         delay, conn.retry = conn.retry, min(conn.retry * 2, MAX_RETRY)
@@ -315,31 +316,40 @@ class Receiver:
     def _at(self, due: float, task: Callable[[], None]) -> None:
         heapq.heappush(self._timers, (due, next(self._seq), task))
 
-    def _register(self, conn: _Connection, sock: Any) -> None:
+    def _register(self, conn: _Connection, transport: Transport) -> None:
         if self._stop or not conn.sub.wanted(conn):
-            sockets.close(sock)
+            transport.close()
             conn.sub.ended(conn)
             return
-        conn.sock = sock
-        conn.reader = tcpros.FrameReader(buff_size=BUFF_SIZE)
+        conn.transport = transport
         conn.connected = True
         conn.retry = FIRST_RETRY
-        self._selector.register(sock, selectors.EVENT_READ, conn)
+        self._selector.register(transport.stream, selectors.EVENT_READ, conn)  # type: ignore[attr-defined]
 
     def _drop(self, conn: _Connection) -> None:
-        """Close ``conn``'s socket (if it has one here) and stop reading it."""
-        sock, conn.sock = conn.sock, None
+        """Close ``conn``'s transport (if it has one here) and stop reading it."""
+        transport = conn.transport
+        was = conn.connected
         conn.connected = False
-        if sock is not None:
+        if transport is not None and was:
             try:
-                self._selector.unregister(sock)
+                self._selector.unregister(transport.stream)  # type: ignore[attr-defined]
             except (KeyError, ValueError):
                 pass
-            sockets.close(sock)
+        if transport is not None:
+            transport.close()
 
     def _ended(self, conn: _Connection, exc: Optional[BaseException]) -> None:
-        """The publisher closed the connection (or broke it): try again while it is listed."""
+        """The publisher closed the connection (or broke it): try again while it is listed
+        (at once without a protocol that fell back)."""
         self._drop(conn)
+        if isinstance(exc, FallBack):
+            self._fall_back(conn, exc)
+            if conn.sub.wanted(conn) and not self._stop:
+                self.connect_later(conn, 0.0)
+            else:
+                conn.sub.ended(conn)
+            return
         if exc is not None:
             conn.failed(exc)
         if conn.sub.wanted(conn) and not self._stop:
@@ -348,35 +358,35 @@ class Receiver:
             conn.sub.ended(conn)
 
     def _read(self, conn: _Connection) -> None:
-        reader, sock = conn.reader, conn.sock
-        if reader is None or sock is None:
-            return
-        try:
-            n = sock.recv_into(reader.recv_buffer())
-            if not n:
-                reader.eof()
-                self._ended(conn, None)
-                return
-            conn.stat_bytes += n
-            frames = reader.received_frames(n)
-        except (BlockingIOError, InterruptedError):
-            return
-        except (OSError, tcpros.FrameError) as exc:
-            self._ended(conn, exc)
-            return
-        deliver, header = conn.sub.deliver, conn.header
-        for frame in frames:
-            conn.stat_msgs += 1
-            if conn.done:
+        """The stream is readable: what it brought (a few receives at most, so that one busy
+        topic cannot hold the others; the last one also says an error the good frames before
+        it waited on)."""
+        transport = conn.transport
+        for _ in range(READS_PER_WAKE):
+            if transport is None or not conn.connected or conn.transport is not transport:
                 return
             try:
-                deliver(frame, header)
-            except Exception as exc:  # one listener's bug must not stop the others' topics
-                minros.logerr(f"[web] delivering {conn.sub.resolved_name} failed: {exc}")
-        try:
-            reader.frames()  # raises a framing error the good frames before it waited on
-        except tcpros.FrameError as exc:
-            self._ended(conn, exc)
+                frames = transport.receive()
+            except (BlockingIOError, InterruptedError):
+                return
+            except (OSError, tcpros.FrameError, FallBack) as exc:
+                self._ended(conn, exc)
+                return
+            if frames is None:
+                self._ended(conn, None)
+                return
+            deliver, header = conn.sub.deliver, transport.header
+            for frame in frames:
+                transport.stat_msgs += 1
+                if conn.done:
+                    return
+                if frame.__class__ is memoryview:  # a slot of shared memory: it goes back next
+                    frame = frame.tobytes()
+                try:
+                    deliver(frame, header)
+                except Exception as exc:  # one listener's bug must not stop the others' topics
+                    minros.logerr(f"[web] delivering {conn.sub.resolved_name} failed: {exc}")
+            transport.release()  # the slots go back now, not when the publisher next sends
 
     @staticmethod
     def _run(task: Callable[..., None], *args: Any) -> None:

@@ -1,6 +1,6 @@
 """MINROSSHM, minros's same-host shared-memory protocol for topics, without I/O: the
 ``requestTopic`` offer and answer, the records both ends exchange, the segment's layout, and
-the publisher's slot queue. ``minros.transport.shm`` moves the bytes; everything a peer can
+the publisher's slot table. ``minros.transport.shm`` moves the bytes; everything a peer can
 get wrong is checked here and raises :class:`ShmError` (the transport then falls back to
 TCPROS).
 
@@ -33,24 +33,31 @@ go inline, so small messages cost what they cost over TCPROS (one send, one rece
 
 The segment: a header page (``SEGMENT_MAGIC``, version, generation, slots, slot_size), then
 ``slots`` slots of ``slot_size`` bytes (page multiples), sized from the first large message
-(a larger one later makes a new segment, half as large again). Slots = queue_size + 2 for a
-publisher's queue_size (3 for a synchronous publisher): ``WINDOW`` = 2 are in the subscriber's
-hands at most, the others hold frames queued at the publisher, one is being written.
+(a larger one later makes a new segment, half as large again). A publisher's segment has
+``SLOTS`` = ``WINDOW`` + 1 = 3 slots whatever its queue_size: ``WINDOW`` = 2 in the
+subscriber's hands at most, one written ahead. The frames queued behind them wait at the
+publisher as frames, shared with every other connection as over TCPROS, and are copied into a
+slot only when one is free; so a subscriber that reads nothing holds three slots of the
+publisher's memory, never its whole queue.
+
+The memfd passed with SEGM is sealed against writes by anyone but the publisher's own mapping
+(``F_SEAL_FUTURE_WRITE``: no new writable mapping, no ``write(2)``, through whatever descriptor
+or reopened ``/proc`` path), and the descriptor itself is opened read-only: a subscriber cannot
+change what the others read.
 """
 
 from __future__ import annotations
 
-import collections
 import struct
-from typing import Any, Deque, Dict, List, Optional, Set, Tuple, Union
+from typing import Any, Dict, List, Optional, Set, Tuple, Union
 
 __all__ = [
-    "BOOT_ID_PATH", "DONE", "FALL", "HEADER_SIZE", "INLINE", "INLINE_LIMIT", "LOAN_OFFSET", "LOAN_TAIL", "MAX_SLOTS",
-    "PROTOCOL", "SEGM", "SEGMENT_MAGIC", "SLOT", "VERSION", "WINDOW", "Done", "DoneReader",
-    "Fallback", "NoticeReader", "Segment", "ShmError", "Slot", "SlotQueue",
-    "answer", "check_offer", "check_segment_header", "done", "fallback", "grown_slot_size",
-    "inline_head", "offer", "page_round", "parse_answer", "segment", "segment_header",
-    "slot", "slot_count",
+    "BOOT_ID_PATH", "DONE", "FALL", "HEADER_SIZE", "INLINE", "INLINE_LIMIT", "LOAN_OFFSET",
+    "LOAN_TAIL", "MAX_SLOTS", "PROTOCOL", "SEGM", "SEGMENT_MAGIC", "SLOT", "SLOTS", "VERSION",
+    "WINDOW", "Done", "DoneReader", "Fallback", "NoticeReader", "Segment", "ShmError", "Slot",
+    "SlotTable", "answer", "check_offer", "check_segment_header", "done", "fallback",
+    "grown_slot_size", "inline_head", "offer", "page_round", "parse_answer", "segment",
+    "segment_header", "slot",
 ]
 
 #: the protocol's name in requestTopic
@@ -63,7 +70,9 @@ BOOT_ID_PATH = "/proc/sys/kernel/random/boot_id"
 INLINE_LIMIT = 64 << 10
 #: slots the subscriber may hold at once (notified and not DONE)
 WINDOW = 2
-#: the most slots a publisher's segment has, whatever its queue_size
+#: the slots of a publisher's segment: the window and one written ahead
+SLOTS = WINDOW + 1
+#: the most slots a segment may announce (a subscriber refuses more)
 MAX_SLOTS = 64
 #: the segment's first page: its header
 HEADER_SIZE = 4096
@@ -133,16 +142,6 @@ def parse_answer(answer: List[Any], boot_id: str) -> str:
 
 def page_round(size: int) -> int:
     return (size + PAGE - 1) // PAGE * PAGE
-
-
-def slot_count(queue_size: Optional[int]) -> int:
-    """Slots of a publisher's segment: queue_size + 2 (a synchronous publisher queues nothing;
-    queue_size 0, unbounded over TCPROS, keeps MAX_SLOTS)."""
-    if queue_size is None:
-        return WINDOW + 1
-    if queue_size <= 0:
-        return MAX_SLOTS
-    return max(WINDOW + 1, min(queue_size + 2, MAX_SLOTS))
 
 
 def grown_slot_size(needed: int, current: int = 0) -> int:
@@ -340,101 +339,68 @@ class DoneReader(_Reader):
         return out
 
 
-# --------------------------------------------------------------------------- the publisher's queue
-
-#: an item of a connection's queue: ``("inline", frame)``, or ``("slot", index, length,
-#: offset)``: a frame of ``length`` bytes written at ``offset`` in slot ``index``
-Item = Union[Tuple[str, Any], Tuple[str, int, int, int]]
+# --------------------------------------------------------------------------- the publisher's slots
 
 FREE, WRITING, QUEUED, NOTIFIED = range(4)
 
 
-class SlotQueue:
-    """The publisher's end of one connection, without I/O: which slots are free, being
-    written, queued or in the subscriber's hands, and the queue of what waits to be sent.
+class SlotTable:
+    """The publisher's slots of one connection, without I/O: which are free, being written,
+    queued (written, waiting to be announced) or in the subscriber's hands, of which at most
+    ``window`` at once (announced with SLOT, not yet given back with DONE).
 
-    ``limit`` bounds the queue (the publication's queue_size; 0 or None: unbounded; the oldest
-    item is dropped, as TCPROS drops its oldest queued frame). A slot is notified only while
-    fewer than ``WINDOW`` are in the subscriber's hands; a slot is written only when free, or
-    by taking back the oldest queued one, whose frame is dropped: the latest frames win.
-    """
+    What waits to be sent, and which of it is dropped, is the connection's queue
+    (``minros.transport.sendqueue``, as over TCPROS); this table only says where a frame may
+    be written and when it may be announced."""
 
-    def __init__(self, slots: int, limit: Optional[int], window: int = WINDOW,
-                 generation: int = 1) -> None:
+    def __init__(self, slots: int = SLOTS, window: int = WINDOW, generation: int = 1) -> None:
         self.generation = generation
         self.state: List[int] = []
         self.window = window
-        self.limit = limit or 0
-        self.items: Deque[Any] = collections.deque()
         self.notified: Set[Tuple[int, int]] = set()  # (generation, slot), older ones included
         self.seq = 0
-        self.dropped = 0
         self.resize(slots, generation)
 
     def resize(self, slots: int, generation: int) -> None:
-        """A new segment: every slot is free; queued slots of the old one are dropped (the
-        subscriber still holds the notified ones, which count against the window)."""
+        """A new segment: every slot is free (the subscriber still holds the notified slots
+        of the old one, which count against the window)."""
         self.generation = generation
         self.state = [FREE] * slots
-        kept = [item for item in self.items if item[0] == "inline"]
-        self.dropped += len(self.items) - len(kept)
-        self.items = collections.deque(kept)
 
     @property
     def in_flight(self) -> int:
         return len(self.notified)
 
+    def room(self) -> bool:
+        """Whether one more slot may be announced now."""
+        return len(self.notified) < self.window
+
     def acquire(self) -> Optional[int]:
-        """A slot to write a frame into, or None when the subscriber holds every slot."""
+        """A free slot to write a frame into (now being written), or None."""
         state = self.state
         for index, value in enumerate(state):
             if value == FREE:
                 state[index] = WRITING
                 return index
-        for item in self.items:  # the oldest queued frame gives way to the new one
-            if item[0] == "slot":
-                self.items.remove(item)
-                self.dropped += 1
-                state[item[1]] = WRITING
-                return int(item[1])
         return None
 
     def abandon(self, index: int) -> None:
-        """A slot acquired and not queued after all."""
-        if self.state[index] == WRITING:
+        """A slot being written and not queued after all, or a queued one whose frame was
+        dropped: free again."""
+        if self.state[index] in (WRITING, QUEUED):
             self.state[index] = FREE
 
-    def put(self, item: Item) -> List[Item]:
-        """Queue ``item`` (an inline frame, or a slot written); returns what the queue limit dropped to make room (their slots are free)."""
-        if item[0] == "slot":
-            self.state[item[1]] = QUEUED
-        self.items.append(item)
-        dropped: List[Item] = []
-        while self.limit and len(self.items) > self.limit:
-            old = self.items.popleft()
-            if old[0] == "slot":
-                self.state[old[1]] = FREE
-            dropped.append(old)
-            self.dropped += 1
-        return dropped
+    def queued(self, index: int) -> None:
+        """Slot ``index`` holds its frame and waits to be announced."""
+        self.state[index] = QUEUED
 
-    def ready(self) -> bool:
-        """Whether the queue's first item may be sent now."""
-        if not self.items:
-            return False
-        return self.items[0][0] == "inline" or len(self.notified) < self.window
-
-    def pop(self) -> Tuple[Item, Optional[bytes]]:
-        """The first item (``ready()`` said so) and, for a slot, its SLOT record: the slot is
-        the subscriber's until it says DONE."""
-        item = self.items.popleft()
-        if item[0] != "slot":
-            return item, None
-        index = item[1]
+    def announce(self, index: int, offset: int, length: int) -> bytes:
+        """The SLOT record of queued slot ``index`` (``room()`` said so): the slot is the
+        subscriber's until it says DONE."""
         self.state[index] = NOTIFIED
         self.notified.add((self.generation, index))
         self.seq += 1
-        return item, slot(self.generation, index, item[3], item[2], self.seq)
+        return slot(self.generation, index, offset, length, self.seq)
 
     def done(self, generation: int, index: int) -> None:
         """The subscriber is through with a slot; ShmError for one it does not hold."""

@@ -14,12 +14,12 @@ import select
 import socket
 import struct
 import time
-from typing import Any, Callable, Deque, Dict, Optional
+from typing import Any, Callable, Deque, Dict, Optional, Tuple
 
 from minros.exceptions import TransportTerminated
 from minros.wire import tcpros
 
-__all__ = ["FrameSource", "close", "read_header", "send_all"]
+__all__ = ["FrameSource", "close", "peer_credentials", "peer_pid", "read_header", "send_all"]
 
 #: the most of a connection header received at once
 _HEADER_CHUNK = 65536
@@ -28,6 +28,7 @@ _MAX_IOV = 512
 _HAS_SENDMSG = hasattr(socket.socket, "sendmsg")
 #: a send that takes what fits and never blocks
 MSG_DONTWAIT: int = getattr(socket, "MSG_DONTWAIT", 0)
+_CREDS = struct.Struct("3i")
 
 
 def _never() -> bool:
@@ -46,6 +47,23 @@ def close(sock: Optional[socket.socket]) -> None:
         sock.close()
     except OSError:
         pass
+
+
+def peer_credentials(sock: Any) -> Tuple[int, int, int] | None:
+    """``(pid, uid, gid)`` of the process at the other end of a Unix socket (SO_PEERCRED), or
+    None (another kind of stream)."""
+    try:
+        creds = sock.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED, _CREDS.size)
+        pid, uid, gid = _CREDS.unpack(creds)
+    except (OSError, AttributeError, struct.error):
+        return None
+    return int(pid), int(uid), int(gid)
+
+
+def peer_pid(sock: Any) -> int:
+    """The pid of the process at the other end of a Unix socket (0 when unknown)."""
+    creds = peer_credentials(sock)
+    return creds[0] if creds is not None else 0
 
 
 def _recv_exact(sock: socket.socket, size: int, deadline: float | None,

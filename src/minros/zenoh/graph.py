@@ -21,10 +21,11 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Tuple
 
-from minros.tools.master import Master, call_node
+from minros.tools.master import Master
 from minros.tools.services import probe_service
 from minros.wire import sockets, tcpros
-from minros.wire.rosapi import RemoteError, unwrap
+from minros.wire.rosapi import RemoteError
+from minros.wire.slaveapi import SlaveClient
 from minros.zenoh.keys import KeyMappingError, Resource, data_key
 
 __all__ = ["LocalGraph", "PublisherInfo", "Snapshot", "probe_publisher"]
@@ -60,8 +61,8 @@ def probe_publisher(node_uri: str, topic: str, caller_id: str,
     """The connection header the publisher of ``topic`` at ``node_uri`` answers with.
     OSError or tcpros.HeaderError when it cannot be asked or refuses."""
     try:
-        params = unwrap(call_node(node_uri, "requestTopic", caller_id, topic, [["TCPROS"]],
-                                  timeout=timeout))
+        with SlaveClient(node_uri, caller_id, timeout) as node:
+            params = node.request_topic(topic, [["TCPROS"]])
     except RemoteError as exc:
         raise OSError(f"requestTopic of {topic} at {node_uri}: {exc}") from None
     if not isinstance(params, list) or len(params) != 3 or params[0] != "TCPROS":
