@@ -302,6 +302,7 @@ def _load_in_a_process(path: Path) -> tuple:
     return message, int(grown)
 
 
+@pytest.mark.slow
 def test_a_1mb_png_of_16384_square_rgba_is_refused_from_its_header(tmp_path):
     """1 GiB decoded passed the old limit (MAX_CELLS and 1 GiB): map_server spent 2.1 GB and
     34 s on it. A map needs what its grid needs as 8-bit gray: 256 MiB decoded."""
@@ -325,6 +326,7 @@ def test_the_load_peak_is_bounded_for_any_accepted_file():
         assert mapfile.load_peak_bytes(header) <= 544 << 20
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shape, dtype, mode, image", [
     ((3000, 3000), np.uint8, "trinary", "m.png"),
     ((2000, 2000, 4), np.uint8, "trinary", "m.png"),
@@ -502,6 +504,7 @@ def _alias_nest(levels: int = 8, width: int = 10) -> str:
     return "\n".join(lines) + "\n"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("key", ["origin", "negate", "resolution", "mode", "occupied_thresh"])
 def test_a_nest_of_yaml_aliases_is_one_line_in_bounded_time_and_memory(tmp_path, key):
     """An attacker's 569-byte map YAML whose ``origin`` (or any key an error names) is a nest
