@@ -96,8 +96,11 @@ def acquire_publication(name: str, data_class: Any, intraprocess: bool = False) 
     return pub
 
 
-def acquire_subscription(name: str, data_class: Any) -> Subscription:
-    """The process's subscription to topic ``name``, with one more reference."""
+def acquire_subscription(name: str, data_class: Any,
+                         configure: Callable[[Subscription], None] | None = None) -> Subscription:
+    """The process's subscription to topic ``name``, with one more reference. ``configure``
+    sets a fresh one up before it is announced (its first connection's header and queue are
+    then the caller's: tcp_nodelay, buff_size, queue_size)."""
     _check(name, data_class)
     me = _node_mod.default_node()
     resolved = me.resolve_topic_name(name)
@@ -105,6 +108,8 @@ def acquire_subscription(name: str, data_class: Any) -> Subscription:
                           lambda s: me.add_subscription(s, announce=False), resolved, data_class,
                           "subscriber")
     if fresh:
+        if configure is not None:
+            configure(sub)
         if statistics_factory is not None:
             sub.statistics = statistics_factory(sub)  # before any connection starts
         me.registration.announce_subscription(sub)
@@ -130,11 +135,12 @@ class Topic:
     _kind = ""
     impl: Any
 
-    def __init__(self, name: str, data_class: Any, intraprocess: bool = False) -> None:
+    def __init__(self, name: str, data_class: Any, intraprocess: bool = False,
+                 configure: Callable[[Any], None] | None = None) -> None:
         if self._kind == "pub":
             self.impl = acquire_publication(name, data_class, intraprocess)
         else:
-            self.impl = acquire_subscription(name, data_class)
+            self.impl = acquire_subscription(name, data_class, configure)
         self.name = self.impl.resolved_name
         self.resolved_name = self.impl.resolved_name
         self.data_class = data_class
@@ -227,24 +233,32 @@ class Subscriber(Topic):
     def __init__(self, name: str, data_class: Any, callback: Callable | None = None,
                  callback_args: Any = None, queue_size: int | None = None,
                  buff_size: int = DEFAULT_BUFF_SIZE, tcp_nodelay: bool = False) -> None:
-        super().__init__(name, data_class)
-        impl = self.impl
-        if queue_size is not None:
-            if queue_size == -1:
-                queue_size = None
-            elif queue_size == 0:
-                raise ROSException("queue size may not be set to zero")
-            elif type(queue_size) is not int:
-                raise ROSException("queue size must be an integer")
-            impl.queue_size = queue_size
+        set_queue = queue_size is not None
+        if queue_size == -1:
+            queue_size = None
+        elif queue_size == 0:
+            raise ROSException("queue size may not be set to zero")
+        elif set_queue and type(queue_size) is not int:
+            raise ROSException("queue size must be an integer")
         if buff_size != DEFAULT_BUFF_SIZE:
             if type(buff_size) is not int:
                 raise ROSException("buffer size must be an integer")
             if buff_size <= 0:
                 raise ROSException("buffer size must be a positive integer")
-            impl.buff_size = buff_size
-        if tcp_nodelay:
-            impl.tcp_nodelay = True
+
+        def configure(impl: Any) -> None:
+            if set_queue:
+                impl.queue_size = queue_size
+            if buff_size != DEFAULT_BUFF_SIZE:
+                impl.buff_size = buff_size
+            if tcp_nodelay:
+                impl.tcp_nodelay = True
+
+        # a fresh subscription is set up before it is announced, so its first connections
+        # already ask for tcp_nodelay; a shared one takes the settings as rospy's does
+        super().__init__(name, data_class, configure=configure)
+        impl = self.impl
+        configure(impl)
         self.callback = callback
         self.callback_args = callback_args
         if callback is not None:
