@@ -337,8 +337,12 @@ print("serving", flush=True)
 rospy.spin()
 '''
 
+# A caller started from a shell's background job inherits SIGINT ignored (POSIX), and Python
+# then leaves it ignored: the caller restores Python's own handler, as at a terminal.
 CALLER = r'''
+import signal
 import sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
 import rospy
 from std_srvs.srv import Trigger
 print("calling", flush=True)
