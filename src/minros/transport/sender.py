@@ -262,6 +262,10 @@ class QueuedSender(StreamTransport):
         while True:
             with cond:
                 while not self.out and not self.done:
+                    if self.queue.items:  # queued while nothing was out: move it now, or
+                        self._pump()  # it waits for good (the writer waits for out only)
+                        if self.out or self.done:
+                            break
                     cond.wait()
                 if self.done:
                     return
