@@ -11,6 +11,7 @@ import re
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any, List
 
@@ -94,6 +95,47 @@ def test_a_full_queue_of_big_frames_backs_off_then_drops_the_oldest(kind, monkey
     assert not sending.is_alive()  # the stalled subscriber did not hold the publisher
     assert waits and all(w == pytest.approx(300_004 / sendqueue.BACKOFF_RATE) for w in waits)
     assert sender.queue.dropped >= 1 and len(sender.queue) <= 1
+    sender.close()
+
+
+def test_a_frame_queued_after_a_back_off_that_saw_the_queue_empty_still_goes():
+    """The writer sends everything while a publisher backs off in a full queue; the frame
+    that publisher then queues must still go. It did not (the writer waited for ``out``
+    only, which nobody filled): a 640x480 flood stalled for good after a few hundred frames
+    (benchmarks/pubsub.py's vga row, issue 36)."""
+    sender, sub_end, _ = sender_over_memory("tcpros", queue_size=1, capacity=4096)
+    frames = [serialize_frame(AnyMsg(bytes([i]) * 300_000)) for i in (1, 2, 3)]
+    total = sum(sum(map(len, f)) if isinstance(f, tuple) else len(f) for f in frames)
+    reading = threading.Event()
+    received = bytearray()
+
+    def subscriber() -> None:  # reads nothing until the publisher backs off
+        reading.wait(TIMEOUT)
+        while len(received) < total:
+            data = sub_end.recv(1 << 16)
+            if not data:
+                return
+            received.extend(data)
+
+    waits: List[float] = []
+    wait = sender.space.wait
+
+    def backing_off(timeout: float) -> bool:  # ... until the writer has sent all it had
+        waits.append(timeout)
+        reading.set()
+        deadline = time.monotonic() + TIMEOUT
+        while (sender.out or sender.busy or sender.queue.items) and time.monotonic() < deadline:
+            wait(0.01)
+        return True
+
+    sender.space.wait = backing_off  # type: ignore[method-assign]
+    reader = threading.Thread(target=subscriber, daemon=True)
+    reader.start()
+    for frame in frames:  # the first is being sent, the second queued, the third backs off
+        sender.send(frame)
+    reader.join(TIMEOUT)
+    assert waits, "the third frame did not back off: the test did not test anything"
+    assert len(received) == total, f"{len(received)} of {total} bytes arrived"
     sender.close()
 
 

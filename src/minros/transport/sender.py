@@ -195,13 +195,8 @@ class QueuedSender(StreamTransport):
         if self.busy or self.done:
             return
         while True:
-            if not self.out:
-                if not self._next_out():
-                    if self._more():
-                        continue
-                    return
-                if self.room_wanted:
-                    self.space.notify()
+            if not self.out and not self._refill():
+                return
             try:
                 sent = self._transmit(self.out, MSG_DONTWAIT)
             except BlockingIOError:
@@ -212,6 +207,16 @@ class QueuedSender(StreamTransport):
             if not self._advance(sent):
                 self.cond.notify_all()  # the writer (or a drain) sends the rest
                 return
+
+    def _refill(self) -> bool:
+        """With the lock, ``out`` empty: move what may go next into ``out`` (and tell a
+        publisher waiting for room); False when nothing may go now."""
+        while not self._next_out():
+            if not self._more():
+                return False
+        if self.room_wanted:
+            self.space.notify()
+        return True
 
     def _advance(self, sent: int) -> bool:
         """``sent`` bytes of ``out`` went: True when all of it did."""
@@ -262,6 +267,10 @@ class QueuedSender(StreamTransport):
         while True:
             with cond:
                 while not self.out and not self.done:
+                    if self.queue.items:  # queued while nothing was out: move it now, or
+                        self._pump()  # it waits for good (the writer waits for out only)
+                        if self.out or self.done:
+                            break
                     cond.wait()
                 if self.done:
                     return
@@ -276,8 +285,10 @@ class QueuedSender(StreamTransport):
                 return
             with cond:
                 self.busy = False
-                if self._advance(sent):
-                    self._pump()
+                if self._advance(sent) and not self.done:
+                    # the next goes the same way, blocking: a non-blocking try right after
+                    # the socket filled up would mostly fail (EAGAIN) and cost a raise
+                    self._refill()
                 cond.notify_all()
 
     # -- the end --------------------------------------------------------------------------------

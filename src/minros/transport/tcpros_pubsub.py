@@ -91,7 +91,10 @@ class TCPROSSender(QueuedSender):
                 self._drain()
                 return
             if not self.busy:  # a busy writer takes it without being told (and a notify
-                self.cond.notify()  # costs a microsecond even with no one waiting)
+                if self.out:  # costs a microsecond even with no one waiting)
+                    self.cond.notify()
+                else:  # the writer sent everything while we backed off: nobody would
+                    self._pump()  # move the queue into out (a flood stalled for good)
         # The writer thread is behind: let it have the GIL now rather than after the
         # interpreter's switch interval (5 ms), or a publishing loop starves it.
         _yield_gil()
