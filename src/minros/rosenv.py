@@ -10,6 +10,7 @@ directory named by its run_id and ``latest`` links to the newest one.
 
 from __future__ import annotations
 
+import functools
 import ipaddress
 import os
 import re
@@ -30,6 +31,7 @@ class MasterURIError(ROSInitException, ValueError):
     the fix. A ValueError, as rosgraph raises for it, and init_node's ROSInitException."""
 
 
+@functools.lru_cache(maxsize=16)  # read on every master call (lookupService ...): parse once
 def _master_uri_problem(uri: str) -> Optional[str]:
     """What is wrong with ``uri`` as a master's URI (rosgraph's test: a scheme and a host, and
     the scheme one XML-RPC speaks), or None."""
