@@ -228,11 +228,14 @@ def test_seed002_any_name_ws(desk: Desk, tmp_path: Path):
         "mkdir -p mypkg/scripts\n"
         + _heredoc("mypkg/scripts/task0_pub.py", TASK0_PUB)
         + _heredoc("mypkg/scripts/task0_sub.py", TASK0_SUB)
-        + "cd ../\n"
+        # the seed's chmod, done before either terminal runs a script (in the publisher's
+        # shell it raced the subscriber's rosrun, which then found the script not executable)
+        + "chmod +x mypkg/scripts/task0_pub.py mypkg/scripts/task0_sub.py\n"
+        "cd ../\n"
         "catkin_make\n")
     # new shells read ~/.bashrc (its kinetic line fails, as it would on a machine without it)
     new_shell = "source ~/.bashrc 2>/dev/null\n"
-    pub = new_shell + f"cd {ws}/src/mypkg/scripts\nchmod +x task0_pub.py task0_sub.py\nrosrun mypkg task0_pub.py\n"
+    pub = new_shell + f"cd {ws}/src/mypkg/scripts\nrosrun mypkg task0_pub.py\n"
     _pubsub(desk, pub, new_shell + "rosrun mypkg task0_sub.py\n", r"I heard Hey There!! \d+\.\d+")
 
 
