@@ -8,6 +8,11 @@ from pathlib import Path
 
 import pytest
 
+# pytest keeps each test module's assert-rewritten bytecode in __pycache__ unless bytecode
+# writing is off (PYTHONDONTWRITEBYTECODE, set on some machines): then every run parses and
+# rewrites all ~200 modules again, 6 of the quick tier's CPU-seconds. The caches are ignored by
+# git; scripts/test.sh unsets the variable for the processes tests start too.
+sys.dont_write_bytecode = False
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 # the page tests' harness (tests/web/page_support.py) beside the pages' sources
 sys.path.insert(0, str(Path(__file__).resolve().parent / "web"))
@@ -230,3 +235,36 @@ def pytest_sessionfinish(session) -> None:
     path = os.environ.get("MINROS_FAILED_LIST")
     if path and not hasattr(session.config, "workerinput"):  # the controller sees every report
         Path(path).write_text("".join(f"{nodeid}\n" for nodeid in _failed))
+
+
+# MINROS_CPU_LOG=FILE: each pytest process adds a line per test file to FILE, the CPU-seconds its
+# tests cost (this process and the processes they started and waited for), so that the test
+# command's time can be spent where it is measured (scripts/test.sh prints the costliest files).
+_cpu: dict[str, float] = {}
+
+
+def _cpu_now() -> float:
+    import resource
+
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    if not os.environ.get("MINROS_CPU_LOG"):
+        yield
+        return
+    start = _cpu_now()
+    yield
+    name = item.nodeid.split("::", 1)[0]
+    _cpu[name] = _cpu.get(name, 0.0) + _cpu_now() - start
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config) -> None:
+    path = os.environ.get("MINROS_CPU_LOG")
+    if path and _cpu:
+        with open(path, "a") as log:
+            log.writelines(f"{cpu:.2f}\t{name}\n" for name, cpu in _cpu.items())
