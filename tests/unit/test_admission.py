@@ -4,11 +4,13 @@ ROS_ALLOWED_HOSTS rules it applies (minros.rosenv)."""
 from __future__ import annotations
 
 import ipaddress
+import threading
+import time
 
 import pytest
 
 from minros import rosenv
-from minros.wire.admission import BUSY, READING, Admission, Limits, Refused
+from minros.wire.admission import BUSY, IDLE, READING, Admission, Limits, Refused
 
 
 class Clock:
@@ -100,6 +102,27 @@ def test_full_server_evicts_what_produced_nothing_for_longest():
     for key in ("trickler", "idle", "new", "served"):
         adm.leave(key)
     assert adm.live() == 2
+
+
+def test_a_full_server_waits_its_grace_for_a_connection_finishing_its_reply():
+    # the moment a server's thread has sent its reply and not yet marked its connection idle:
+    # a client calling again at once on a new connection must not get "try again"
+    adm = Admission(Limits(max_connections=1, peer_share=1.0), what="the master")
+    adm.admit("replying", "127.0.0.1")
+    adm.set_state("replying", BUSY)
+    with pytest.raises(Refused, match="serving 1 connections"):
+        adm.admit("impatient", "127.0.0.1")  # no grace: refused, as before
+    marked = threading.Timer(0.05, adm.set_state, ("replying", IDLE))
+    marked.start()
+    try:
+        start = time.monotonic()
+        assert adm.admit("next call", "127.0.0.1", grace=5.0) == ["replying"]
+        assert time.monotonic() - start < 4.0  # woken by the state change, not the grace's end
+    finally:
+        marked.join()
+    adm.set_state("next call", BUSY)
+    with pytest.raises(Refused):
+        adm.admit("late", "127.0.0.1", grace=0.05)  # nothing became idle: refused after it
 
 
 def test_at_the_cap_the_peer_holding_most_makes_room():

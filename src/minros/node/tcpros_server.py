@@ -165,7 +165,7 @@ class TCPROSServer:
             try:
                 local = sock.getsockname()
                 victims = adm.admit(key, listener.peer(sock, addr),
-                                    None if listener.unix else local[0])
+                                    None if listener.unix else local[0], admission.ADMIT_GRACE)
             except admission.Refused as refused:
                 if refused.report:
                     self.refused(str(addr), str(refused))

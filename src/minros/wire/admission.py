@@ -31,7 +31,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from minros import rosenv
 
-__all__ = ["Admission", "BUSY", "Connection", "IDLE", "Limits", "READING", "Refused"]
+__all__ = ["ADMIT_GRACE", "Admission", "BUSY", "Connection", "IDLE", "Limits", "READING", "Refused"]
 
 #: a connection waiting for its next request
 IDLE = 0
@@ -97,6 +97,9 @@ class _Ticket:
 
 
 #: refusals of distinct peers remembered for rate-limiting their log lines
+#: how long a server's accept waits, when every connection is being served, for one to become
+#: idle or leave before refusing (the moment between a reply sent and its connection marked idle)
+ADMIT_GRACE = 0.2
 _MAX_REPORTED = 1024
 
 
@@ -114,6 +117,8 @@ class Admission:
         #: named in refusals: "the master", "/talker's TCPROS server", ...
         self.what = what or "this server"
         self._lock = threading.Lock()
+        #: notified when a connection becomes idle or leaves (admit's grace waits on it)
+        self._changed = threading.Condition(self._lock)
         self._tickets: Dict[Any, _Ticket] = {}
         self._by_peer: Dict[str, Dict[Any, _Ticket]] = {}
         self._live = 0
@@ -135,37 +140,55 @@ class Admission:
 
     # -- connections -----------------------------------------------------------------------
 
-    def admit(self, key: Any, peer: str, local: str | None = None) -> List[Any]:
+    def admit(self, key: Any, peer: str, local: str | None = None,
+              grace: float = 0.0) -> List[Any]:
         """Register connection ``key`` from address ``peer`` (arrived at address ``local``).
         Returns the keys of the connections to close to make room for it; raises Refused when
-        the peer is not allowed or nothing can make room (every connection is being served)."""
+        the peer is not allowed or nothing can make room (every connection is being served)
+        within ``grace`` seconds: a server's thread marks its connection idle only after the
+        reply went, so a client that calls again at once, on a new connection, can arrive
+        before the one it just used is idle."""
         if not rosenv.host_allowed(peer, self.allowed, local):
             with self._lock:
                 self.refusals += 1
                 report = self._should_report(peer)
             raise Refused(f"connection from {peer} refused: not in {rosenv.ALLOWED_HOSTS_VAR} "
                           f"of {self.what}", status=403, report=report)
-        limits = self.limits
+        deadline = self.clock() + grace
         with self._lock:
-            victims: List[Any] = []
-            mine = self._by_peer.get(peer, {})
-            # a peer over its share makes room itself, from its own idlest connection
-            victim = None
-            if sum(1 for t in mine.values() if not t.evicted) >= limits.peer_connections:
-                victim = self._oldest(mine.values(), (IDLE, READING))
-            if victim is not None:
-                victims.append(self._evict(victim))
-            elif self._live >= limits.max_connections:
-                victim = self._victim_at_cap()
-                if victim is None:
+            while True:
+                victims = self._room_for(peer)
+                if victims is not None:
+                    break
+                remaining = deadline - self.clock()
+                if remaining <= 0:
                     self.refusals += 1
                     raise Refused(f"{self.what} is serving {self._live} connections: try again")
-                victims.append(self._evict(victim))
+                self._changed.wait(remaining)
             ticket = _Ticket(key, peer, self.clock())
             self._tickets[key] = ticket
             self._by_peer.setdefault(peer, {})[key] = ticket
             self._live += 1
             return victims
+
+    def _room_for(self, peer: str) -> List[Any] | None:
+        """With the lock: the connections to close to make room for one more of ``peer``
+        (evicted now); None when nothing can make room."""
+        limits = self.limits
+        victims: List[Any] = []
+        mine = self._by_peer.get(peer, {})
+        # a peer over its share makes room itself, from its own idlest connection
+        victim = None
+        if sum(1 for t in mine.values() if not t.evicted) >= limits.peer_connections:
+            victim = self._oldest(mine.values(), (IDLE, READING))
+        if victim is not None:
+            victims.append(self._evict(victim))
+        elif self._live >= limits.max_connections:
+            victim = self._victim_at_cap()
+            if victim is None:
+                return None
+            victims.append(self._evict(victim))
+        return victims
 
     def leave(self, key: Any) -> None:
         """Connection ``key`` is closed: forget it and what it held."""
@@ -181,6 +204,7 @@ class Admission:
             if not ticket.evicted:
                 self._live -= 1
                 self._uncharge(ticket)
+            self._changed.notify_all()
 
     def set_state(self, key: Any, state: int) -> None:
         """Connection ``key`` now waits (IDLE), reads a request (READING) or is served (BUSY)."""
@@ -189,6 +213,8 @@ class Admission:
             if ticket is not None:
                 ticket.state = state
                 ticket.since = self.clock()
+                if state != BUSY:
+                    self._changed.notify_all()
 
     def evicted(self, key: Any) -> bool:
         with self._lock:

@@ -445,7 +445,8 @@ class XmlRpcServer:
         make room when the server is full); refuse it with one status line otherwise."""
         key = self.admission.new_key()
         try:
-            victims = self.admission.admit(key, addr[0], _local_address(conn))
+            victims = self.admission.admit(key, addr[0], _local_address(conn),
+                                           admission.ADMIT_GRACE)
         except admission.Refused as refused:
             if refused.report:
                 self.on_refused(addr[0], str(refused))
