@@ -10,12 +10,10 @@
 #     /opt/minros-ros2, built on /usr/bin/python3, which needs apt's python3-venv) in the
 #     background beside the next steps;
 #  3. the main venv, ruff, lint-imports, mypy;
-#  4. the main run: every test in parallel workers; beside it, at a lower priority (they take
-#     the CPU its workers leave while they wait on the processes they start), the other
-#     Pythons: tests/unit (but the fuzz tier) and the tests marked `smoke` (a few of each
-#     subsystem's), each Python in one process;
-#  5. ROS's own rostest suites on minros and on Debian's ROS (beside the other Pythons' rest);
-#  6. the tests marked `timing`, alone, once nothing else runs.
+#  4. the main run: every test in parallel workers, then the tests marked `timing` alone, then
+#     ROS's own rostest suites on minros and on Debian's ROS;
+#  5. the other Pythons: tests/unit (but the fuzz tier) and the tests marked `smoke` (a few of
+#     each subsystem's), the Pythons side by side, each in one process.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # Bytecode is cached as Python does by default, even where the machine turned it off: without
@@ -148,40 +146,22 @@ run_tests() {  # label python pytest-args...
   return "$code"
 }
 status=0
-
-# The other Pythons' runs start first, beside the main run, at a lower priority (nice 10: the
-# main run's workers and the processes they start come first; these take the CPU left while
-# those wait). The fuzz tier, hypothesis's many examples, runs in the main run only. A run
-# whose venv did not build fails with the end of its log.
-run_pids=()
-for entry in "${venv_pids[@]}"; do
-  v=${entry%%:*}
-  if ! wait "${entry#*:}"; then
-    echo "Python $v: its venv did not build; the end of .venv-$v.log:" >&2
-    tail -n 40 ".venv-$v.log" >&2
-    status=1
-    continue
-  fi
-  (
-    renice -n 10 "$BASHPID" > /dev/null  # this run and every process it starts
-    run_tests "Python $v" ".venv-$v/bin/python" -q -p no:cacheprovider -n 1 \
-      -m "not timing and not fuzz and (unit or smoke)" tests
-  ) >> ".venv-$v.log" 2>&1 &
-  run_pids+=("$v:$!")
-done
-
 SECONDS=0
 if [ "$workers" -gt 1 ]; then
   run_tests "main run" .venv/bin/python "${parallel[@]}" -m "not timing" --durations=30 "$@" || status=$?
   echo "main run: ${SECONDS}s"
+  code=0
+  .venv/bin/python -m pytest -m timing "$@" || code=$?
+  [ "$code" -eq 0 ] || [ "$code" -eq 5 ] || status=$code  # 5: the arguments chose no timing test
+  echo "main run and timing tests: ${SECONDS}s"
 else
-  .venv/bin/python -m pytest -m "not timing" "$@" || status=$?
+  .venv/bin/python -m pytest "$@" || status=$?
 fi
 
-# -- 5. ROS's own integration tests (ros_comm's registered .test files, each under rostest with a
+# -- 4b. ROS's own integration tests (ros_comm's registered .test files, each under rostest with a
 # master of its own) on minros and on Debian's ROS side by side, from Debian's source package
 # (scripts/install-ros-reference.sh --sources): fails when minros passes fewer tests than
-# Debian in a suite. 68 rostest runs, 4 at a time: about 3 minutes. ROSTEST_SUITES=0 skips it.
+# Debian in a suite. 68 rostest runs, 4 at a time: about 4 minutes. ROSTEST_SUITES=0 skips it.
 run_rostest_suites() {
   [ "${ROSTEST_SUITES:-1}" != 0 ] || return 0
   if [ ! -x /usr/bin/rostest ]; then
@@ -196,6 +176,23 @@ run_rostest_suites() {
 }
 run_rostest_suites || status=1
 
+# -- 5. the other Pythons, side by side, each in one process with one worker of its own (two
+# CPUs shared by three runs; the fuzz tier, hypothesis's many examples, runs in the main run
+# only). A run whose venv did not build fails with the end of its log.
+SECONDS=0
+run_pids=()
+for entry in "${venv_pids[@]}"; do
+  v=${entry%%:*}
+  if ! wait "${entry#*:}"; then
+    echo "Python $v: its venv did not build; the end of .venv-$v.log:" >&2
+    tail -n 40 ".venv-$v.log" >&2
+    status=1
+    continue
+  fi
+  run_tests "Python $v" ".venv-$v/bin/python" -q -p no:cacheprovider -n 1 \
+    -m "not timing and not fuzz and (unit or smoke)" tests >> ".venv-$v.log" 2>&1 &
+  run_pids+=("$v:$!")
+done
 for entry in "${run_pids[@]}"; do
   v=${entry%%:*}
   if wait "${entry#*:}"; then
@@ -206,15 +203,7 @@ for entry in "${run_pids[@]}"; do
     status=1
   fi
 done
-[ "${#run_pids[@]}" -eq 0 ] || echo "main run, rostest suites and the other Pythons: ${SECONDS}s"
-
-# -- 6. the tests marked `timing` (a rate kept up with, a bound finished within), alone: nothing
-# else runs now
-SECONDS=0
-code=0
-.venv/bin/python -m pytest -m timing "$@" || code=$?
-[ "$code" -eq 0 ] || [ "$code" -eq 5 ] || status=$code  # 5: the arguments chose no timing test
-echo "timing tests: ${SECONDS}s"
+[ "${#run_pids[@]}" -eq 0 ] || echo "other Pythons: ${SECONDS}s"
 if [ -s "$flaky_log" ]; then
   echo "Tests that failed in a parallel run and passed alone (races under load, to fix):"
   cat "$flaky_log"

@@ -206,7 +206,9 @@ def test_many_silent_clients_do_not_block_others(server):
         start = time.monotonic()
         for i in range(20):
             assert proxy.add(i, 1) == i + 1
-        assert time.monotonic() - start < 2.0
+        # a server that a silent client blocked would answer after its idle timeout (5 s) at
+        # the earliest; 20 calls take milliseconds, seconds on a starved machine
+        assert time.monotonic() - start < 4.0
     finally:
         for s in silent:
             s.close()
