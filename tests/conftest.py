@@ -238,8 +238,8 @@ def pytest_sessionfinish(session) -> None:
 
 
 # MINROS_CPU_LOG=FILE: each pytest process adds a line per test file to FILE, the CPU-seconds its
-# tests cost (this process and the processes they started and waited for), so that the test
-# command's time can be spent where it is measured (scripts/test.sh prints the costliest files).
+# tests cost (this process and the processes they started and waited for): where the test
+# command's CPU goes (`sort -rn FILE | head` names the costliest files).
 _cpu: dict[str, float] = {}
 
 

@@ -96,10 +96,10 @@ class _Ticket:
         self.evicted = False
 
 
-#: refusals of distinct peers remembered for rate-limiting their log lines
 #: how long a server's accept waits, when every connection is being served, for one to become
 #: idle or leave before refusing (the moment between a reply sent and its connection marked idle)
 ADMIT_GRACE = 0.2
+#: refusals of distinct peers remembered for rate-limiting their log lines
 _MAX_REPORTED = 1024
 
 
